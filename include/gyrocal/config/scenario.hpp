@@ -1,0 +1,30 @@
+#pragma once
+// A scenario: everything a configuration file describes. Every key is optional; the defaults are the
+// default scenario of MODEL.md section 11.
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/model/gyro.hpp"
+#include "gyrocal/plan/test_spec.hpp"
+
+namespace gyrocal {
+
+struct Scenario {
+  Site site;
+  CentrifugeGeometry centrifuge;
+  CentrifugeErrors errors;          ///< [centrifuge.errors]
+  DriftCoefficients gyro;           ///< [gyro]: the truth, for simulation
+  GyroNoise noise;                  ///< [gyro.noise]
+  TestSpec test;                    ///< [test]
+  CentrifugeErrors uncertainty;     ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+
+  /// The centrifuge model this scenario describes.
+  CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
+};
+
+/// The default scenario of MODEL.md section 11.
+Scenario default_scenario();
+
+}  // namespace gyrocal

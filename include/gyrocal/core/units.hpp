@@ -1,0 +1,21 @@
+#pragma once
+// Units and constants (MODEL.md section 1). Internally SI: rad, rad/s, m, s; specific force in g.
+#include <numbers>
+
+namespace gyrocal {
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kDegToRad = kPi / 180.0;
+inline constexpr double kRadToDeg = 180.0 / kPi;
+inline constexpr double kArcsecToRad = kPi / (180.0 * 3600.0);
+inline constexpr double kRadToArcsec = 1.0 / kArcsecToRad;
+/// 1 deg/h in rad/s.
+inline constexpr double kDegPerHourToRadPerSec = kPi / 180.0 / 3600.0;
+inline constexpr double kRadPerSecToDegPerHour = 1.0 / kDegPerHourToRadPerSec;
+
+/// Default Earth rate, rad/s (MODEL.md section 1).
+inline constexpr double kEarthRateRadS = 7.292115e-5;
+/// Default standard gravity, m/s^2 (MODEL.md section 1).
+inline constexpr double kStandardGravityMS2 = 9.80665;
+
+}  // namespace gyrocal

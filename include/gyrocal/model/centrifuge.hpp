@@ -1,0 +1,123 @@
+#pragma once
+// The exact centrifuge model (MODEL.md sections 2-4): a kinematic chain with every error source,
+// evaluated to the gyro's inertial angular rate and specific force with analytic derivatives.
+//
+// Following Pinocchio's model/data split, CentrifugeModel is constant once built (geometry, errors and
+// what can be precomputed from them); evaluation is a free function of the model and a joint state.
+#include <Eigen/Core>
+
+#include "gyrocal/core/harmonic.hpp"
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+
+/// The test site. Frame G is local level North-West-Up (MODEL.md section 2).
+struct Site {
+  double latitude_rad = 39.13 * kDegToRad;     ///< geodetic latitude, rad, in [-pi/2, pi/2]
+  double gravity_m_s2 = kStandardGravityMS2;   ///< local gravity, m/s^2 (> 0); specific force is in this g
+  double earth_rate_rad_s = kEarthRateRadS;    ///< Earth rate magnitude, rad/s
+
+  /// Earth rate in G (NWU): we*(cos lat, 0, sin lat), rad/s.
+  Eigen::Vector3d earth_rate_g() const;
+};
+
+/// Nominal geometry and motion of the centrifuge (configuration section [centrifuge]).
+struct CentrifugeGeometry {
+  double radius_m = 1.0;                  ///< R0, nominal arm radius to the gyro centre, m (> 0)
+  double rate_rad_s = 9.9;                ///< main-axis rate used by `inputs`, rad/s, + counter-clockwise from above
+  double heading_rad = 0.0;               ///< psi0: direction of I at beta = 0, from North toward West, rad
+  double initial_main_angle_rad = 0.0;    ///< theta0: main-axis angle at t = 0, rad
+};
+
+/// Every mechanical error of the centrifuge (MODEL.md section 3), SI units. All zero = a perfect machine.
+/// Wobbles and runouts are harmonic series of their own joint's angle: main (theta), counter (psi_r),
+/// position (beta' = beta + position_angle_error).
+struct CentrifugeErrors {
+  double base_tilt_x_rad = 0.0;
+  double base_tilt_y_rad = 0.0;
+  double main_perpendicularity_x_rad = 0.0;
+  double main_perpendicularity_y_rad = 0.0;
+  HarmonicSeries main_wobble_x_rad;   ///< of theta, rad
+  HarmonicSeries main_wobble_y_rad;   ///< of theta, rad
+  HarmonicSeries main_runout_x_m;     ///< of theta, m, in the base frame
+  HarmonicSeries main_runout_y_m;     ///< of theta, m, in the base frame
+  double radius_error_m = 0.0;        ///< added to R0, m
+  double radius_stretch_m_per_rad2_s2 = 0.0;  ///< radius grows by this times omega^2, m/(rad/s)^2
+  double counter_perpendicularity_x_rad = 0.0;
+  double counter_perpendicularity_y_rad = 0.0;
+  HarmonicSeries counter_wobble_x_rad;  ///< of psi_r, rad
+  HarmonicSeries counter_wobble_y_rad;  ///< of psi_r, rad
+  double counter_rate_mismatch_rad_s = 0.0;  ///< delta omega: platform heading drift about Up, rad/s
+  double position_perpendicularity_x_rad = 0.0;
+  double position_perpendicularity_z_rad = 0.0;
+  HarmonicSeries position_wobble_x_rad;  ///< of beta', rad
+  HarmonicSeries position_wobble_z_rad;  ///< of beta', rad
+  double position_angle_error_rad = 0.0;  ///< added to the commanded beta, rad
+  Eigen::Vector3d mount_misalignment_rad = Eigen::Vector3d::Zero();  ///< about I, O, S, rad
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  ///< gyro centre offset, position-platform axes, m
+};
+
+/// The three joints at one instant. Encoder angles: the main axis theta, the counter-rotating platform
+/// psi_r relative to the arm, the position platform beta (as commanded; the model adds its angle error).
+struct JointState {
+  double main_angle_rad = 0.0;      ///< theta
+  double main_rate_rad_s = 0.0;     ///< d theta / dt
+  double main_accel_rad_s2 = 0.0;   ///< d2 theta / dt2
+  double counter_angle_rad = 0.0;   ///< psi_r, relative to the arm
+  double counter_rate_rad_s = 0.0;  ///< d psi_r / dt
+  double counter_accel_rad_s2 = 0.0;
+  double position_angle_rad = 0.0;  ///< beta, held during a dwell
+
+  /// gamma = -psi_r: the arm's radial direction seen from the platform (MODEL.md section 3), rad.
+  double gamma_rad() const { return -counter_angle_rad; }
+};
+
+/// The exact inputs to the gyro at one instant, in gyro axes (I, O, S).
+struct GyroInputs {
+  Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();        ///< inertial angular rate, rad/s
+  Eigen::Vector3d specific_force_g = Eigen::Vector3d::Zero();  ///< specific force, in the site's g
+};
+
+/// The centrifuge: site, nominal geometry and errors, immutable once built.
+class CentrifugeModel {
+ public:
+  CentrifugeModel() : CentrifugeModel(Site{}, CentrifugeGeometry{}, CentrifugeErrors{}) {}
+  CentrifugeModel(const Site& site, const CentrifugeGeometry& geometry, const CentrifugeErrors& errors);
+
+  const Site& site() const { return site_; }
+  const CentrifugeGeometry& geometry() const { return geometry_; }
+  const CentrifugeErrors& errors() const { return errors_; }
+
+  /// Earth rate in G, rad/s.
+  const Eigen::Vector3d& earth_rate_g() const { return earth_rate_g_; }
+  /// R_base = Ry(base_tilt_y) Rx(base_tilt_x).
+  const Eigen::Matrix3d& base_rotation() const { return base_rotation_; }
+  /// R_mount = Rz(mis_S) Ry(mis_O) Rx(mis_I).
+  const Eigen::Matrix3d& mount_rotation() const { return mount_rotation_; }
+
+ private:
+  Site site_;
+  CentrifugeGeometry geometry_;
+  CentrifugeErrors errors_;
+  Eigen::Vector3d earth_rate_g_;
+  Eigen::Matrix3d base_rotation_;
+  Eigen::Matrix3d mount_rotation_;
+};
+
+/// Exact inertial rate and specific force in gyro axes (MODEL.md section 4), with analytic derivatives of
+/// the chain of section 3 (wobbles and runouts differentiated through their joint angle).
+GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
+
+/// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
+/// theta = theta0 + omega*t, psi_r = -theta + psi0 + delta_omega*t (MODEL.md section 3).
+JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad, double time_s);
+
+/// Joint state with the main axis stopped at theta0 and the counter-rotating platform indexed so that
+/// gamma = gamma_rad (psi_r = -gamma), position beta (rad). All rates zero.
+JointState static_joint_state(const CentrifugeModel& model, double beta_rad, double gamma_rad);
+
+/// The time (s) at which gamma = gamma_rad during revolution `revolution` (0-based) of the main axis of a
+/// spinning dwell at rate omega != 0 started at t = 0: the first such t >= revolution * 2*pi/|omega|.
+double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution);
+
+}  // namespace gyrocal

@@ -1,0 +1,48 @@
+#pragma once
+// The gyro's static error model (MODEL.md section 6; the seed's eq. 6) and its noise parameters.
+#include <array>
+#include <cstddef>
+#include <string_view>
+
+#include <Eigen/Core>
+
+namespace gyrocal {
+
+/// The ten drift coefficients, in this order everywhere (regressors, results, JSON).
+enum class Coefficient : std::size_t { dF, dI, dO, dS, dII, dOO, dSS, dIO, dIS, dOS };
+inline constexpr std::size_t kNumCoefficients = 10;
+inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientNames = {
+    "dF", "dI", "dO", "dS", "dII", "dOO", "dSS", "dIO", "dIS", "dOS"};
+inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientUnits = {
+    "deg/h", "deg/h/g", "deg/h/g", "deg/h/g", "deg/h/g^2",
+    "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2"};
+
+/// Drift coefficients: dF deg/h; dI, dO, dS deg/h/g; the rest deg/h/g^2 (MODEL.md section 1).
+struct DriftCoefficients {
+  std::array<double, kNumCoefficients> values{};
+
+  double& operator[](Coefficient c) { return values[static_cast<std::size_t>(c)]; }
+  double operator[](Coefficient c) const { return values[static_cast<std::size_t>(c)]; }
+};
+
+/// The regressors of eq. 6 at specific force f (g, gyro axes):
+/// (1, aI, aO, aS, aI^2, aO^2, aS^2, aI*aO, aI*aS, aO*aS), in Coefficient order.
+std::array<double, kNumCoefficients> drift_regressors(const Eigen::Vector3d& specific_force_g);
+
+/// The drift of eq. 6 (everything but omega_I and noise), deg/h.
+double drift_deg_h(const DriftCoefficients& coefficients, const Eigen::Vector3d& specific_force_g);
+
+/// The noise-free output of eq. 6: omega_I (rad/s, converted) + drift, deg/h.
+double gyro_output_deg_h(const DriftCoefficients& coefficients, double omega_I_rad_s,
+                         const Eigen::Vector3d& specific_force_g);
+
+/// Noise of the gyro's output (configuration section [gyro.noise]).
+struct GyroNoise {
+  double angle_random_walk_deg_rt_h = 0.0;    ///< white rate noise, deg/sqrt(h)
+  double bias_instability_deg_h = 0.0;        ///< flat Allan floor, deg/h
+  double rate_random_walk_deg_h_rt_h = 0.0;   ///< deg/h/sqrt(h)
+  double quantization_deg_h = 0.0;            ///< output quantization step, deg/h (0 = none)
+  double output_lag_s = 0.0;                  ///< first-order output lag time constant, s (0 = none)
+};
+
+}  // namespace gyrocal

@@ -1,0 +1,39 @@
+# Shared by scripts/demo and scripts/test: install what is missing, configure, build.
+# Sourced, not run. Every dependency is a Debian package (README.md, "Dependencies").
+set -euo pipefail
+
+GYROCAL_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+# ensure_packages PKG...: install the Debian packages that are missing (as root), or print the exact
+# install line and stop (as anyone else).
+ensure_packages() {
+  local missing=()
+  local pkg
+  for pkg in "$@"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$pkg")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "gyrocal: installing ${missing[*]}" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >&2
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+  else
+    echo "gyrocal: missing Debian packages. Install them with:" >&2
+    echo "  sudo apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+}
+
+GYROCAL_BUILD_PACKAGES=(g++ cmake make libeigen3-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev)
+
+# build_gyrocal DIR [CMAKE ARGS...]: configure and build into DIR (Release unless told otherwise).
+build_gyrocal() {
+  local dir=$1
+  shift
+  cmake -S "$GYROCAL_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >&2
+  cmake --build "$dir" -j "$(nproc)" >&2
+}
