@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include "gyrocal/core/units.hpp"
+
 namespace gyrocal {
 
 /// The ten drift coefficients, in this order everywhere (regressors, results, JSON).
