@@ -14,11 +14,11 @@ namespace gyrocal {
 struct Scenario {
   Site site;
   CentrifugeGeometry centrifuge;
-  CentrifugeErrors errors;          ///< [centrifuge.errors]
-  DriftCoefficients gyro;           ///< [gyro]: the truth, for simulation
-  GyroNoise noise;                  ///< [gyro.noise]
-  TestSpec test;                    ///< [test]
-  CentrifugeErrors uncertainty;     ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+  CentrifugeErrors errors;       ///< [centrifuge.errors]
+  DriftCoefficients gyro;        ///< [gyro]: the truth, for simulation
+  GyroNoise noise;               ///< [gyro.noise]
+  TestSpec test;                 ///< [test]
+  CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }

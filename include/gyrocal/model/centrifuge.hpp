@@ -13,9 +13,9 @@ namespace gyrocal {
 
 /// The test site. Frame G is local level North-West-Up (MODEL.md section 2).
 struct Site {
-  double latitude_rad = 39.13 * kDegToRad;     ///< geodetic latitude, rad, in [-pi/2, pi/2]
-  double gravity_m_s2 = kStandardGravityMS2;   ///< local gravity, m/s^2 (> 0); specific force is in this g
-  double earth_rate_rad_s = kEarthRateRadS;    ///< Earth rate magnitude, rad/s
+  double latitude_rad = 39.13 * kDegToRad;    ///< geodetic latitude, rad, in [-pi/2, pi/2]
+  double gravity_m_s2 = kStandardGravityMS2;  ///< local gravity, m/s^2 (> 0); specific force is in this g
+  double earth_rate_rad_s = kEarthRateRadS;   ///< Earth rate magnitude, rad/s
 
   /// Earth rate in G (NWU): we*(cos lat, 0, sin lat), rad/s.
   Eigen::Vector3d earth_rate_g() const;
@@ -23,10 +23,10 @@ struct Site {
 
 /// Nominal geometry and motion of the centrifuge (configuration section [centrifuge]).
 struct CentrifugeGeometry {
-  double radius_m = 1.0;                  ///< R0, nominal arm radius to the gyro centre, m (> 0)
-  double rate_rad_s = 9.9;                ///< main-axis rate used by `inputs`, rad/s, + counter-clockwise from above
-  double heading_rad = 0.0;               ///< psi0: direction of I at beta = 0, from North toward West, rad
-  double initial_main_angle_rad = 0.0;    ///< theta0: main-axis angle at t = 0, rad
+  double radius_m = 1.0;     ///< R0, nominal arm radius to the gyro centre, m (> 0)
+  double rate_rad_s = 9.9;   ///< main-axis rate used by `inputs`, rad/s, + counter-clockwise from above
+  double heading_rad = 0.0;  ///< psi0: direction of I at beta = 0, from North toward West, rad
+  double initial_main_angle_rad = 0.0;  ///< theta0: main-axis angle at t = 0, rad
 };
 
 /// Every mechanical error of the centrifuge (MODEL.md section 3), SI units. All zero = a perfect machine.
@@ -37,22 +37,22 @@ struct CentrifugeErrors {
   double base_tilt_y_rad = 0.0;
   double main_perpendicularity_x_rad = 0.0;
   double main_perpendicularity_y_rad = 0.0;
-  HarmonicSeries main_wobble_x_rad;   ///< of theta, rad
-  HarmonicSeries main_wobble_y_rad;   ///< of theta, rad
-  HarmonicSeries main_runout_x_m;     ///< of theta, m, in the base frame
-  HarmonicSeries main_runout_y_m;     ///< of theta, m, in the base frame
-  double radius_error_m = 0.0;        ///< added to R0, m
+  HarmonicSeries main_wobble_x_rad;           ///< of theta, rad
+  HarmonicSeries main_wobble_y_rad;           ///< of theta, rad
+  HarmonicSeries main_runout_x_m;             ///< of theta, m, in the base frame
+  HarmonicSeries main_runout_y_m;             ///< of theta, m, in the base frame
+  double radius_error_m = 0.0;                ///< added to R0, m
   double radius_stretch_m_per_rad2_s2 = 0.0;  ///< radius grows by this times omega^2, m/(rad/s)^2
   double counter_perpendicularity_x_rad = 0.0;
   double counter_perpendicularity_y_rad = 0.0;
-  HarmonicSeries counter_wobble_x_rad;  ///< of psi_r, rad
-  HarmonicSeries counter_wobble_y_rad;  ///< of psi_r, rad
+  HarmonicSeries counter_wobble_x_rad;       ///< of psi_r, rad
+  HarmonicSeries counter_wobble_y_rad;       ///< of psi_r, rad
   double counter_rate_mismatch_rad_s = 0.0;  ///< delta omega: platform heading drift about Up, rad/s
   double position_perpendicularity_x_rad = 0.0;
   double position_perpendicularity_z_rad = 0.0;
-  HarmonicSeries position_wobble_x_rad;  ///< of beta', rad
-  HarmonicSeries position_wobble_z_rad;  ///< of beta', rad
-  double position_angle_error_rad = 0.0;  ///< added to the commanded beta, rad
+  HarmonicSeries position_wobble_x_rad;                              ///< of beta', rad
+  HarmonicSeries position_wobble_z_rad;                              ///< of beta', rad
+  double position_angle_error_rad = 0.0;                             ///< added to the commanded beta, rad
   Eigen::Vector3d mount_misalignment_rad = Eigen::Vector3d::Zero();  ///< about I, O, S, rad
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  ///< gyro centre offset, position-platform axes, m
 };
@@ -110,7 +110,8 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
 /// theta = theta0 + omega*t, psi_r = -theta + psi0 + delta_omega*t (MODEL.md section 3).
-JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad, double time_s);
+JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,
+                                double time_s);
 
 /// Joint state with the main axis stopped at theta0 and the counter-rotating platform indexed so that
 /// gamma = gamma_rad (psi_r = -gamma), position beta (rad). All rates zero.

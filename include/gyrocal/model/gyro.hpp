@@ -16,7 +16,7 @@ inline constexpr std::size_t kNumCoefficients = 10;
 inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientNames = {
     "dF", "dI", "dO", "dS", "dII", "dOO", "dSS", "dIO", "dIS", "dOS"};
 inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientUnits = {
-    "deg/h", "deg/h/g", "deg/h/g", "deg/h/g", "deg/h/g^2",
+    "deg/h",     "deg/h/g",   "deg/h/g",   "deg/h/g",   "deg/h/g^2",
     "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2"};
 
 /// Drift coefficients: dF deg/h; dI, dO, dS deg/h/g; the rest deg/h/g^2 (MODEL.md section 1).
@@ -40,11 +40,11 @@ double gyro_output_deg_h(const DriftCoefficients& coefficients, double omega_I_r
 
 /// Noise of the gyro's output (configuration section [gyro.noise]).
 struct GyroNoise {
-  double angle_random_walk_deg_rt_h = 0.0;    ///< white rate noise, deg/sqrt(h)
-  double bias_instability_deg_h = 0.0;        ///< flat Allan floor, deg/h
-  double rate_random_walk_deg_h_rt_h = 0.0;   ///< deg/h/sqrt(h)
-  double quantization_deg_h = 0.0;            ///< output quantization step, deg/h (0 = none)
-  double output_lag_s = 0.0;                  ///< first-order output lag time constant, s (0 = none)
+  double angle_random_walk_deg_rt_h = 0.0;   ///< white rate noise, deg/sqrt(h)
+  double bias_instability_deg_h = 0.0;       ///< flat Allan floor, deg/h
+  double rate_random_walk_deg_h_rt_h = 0.0;  ///< deg/h/sqrt(h)
+  double quantization_deg_h = 0.0;           ///< output quantization step, deg/h (0 = none)
+  double output_lag_s = 0.0;                 ///< first-order output lag time constant, s (0 = none)
 };
 
 }  // namespace gyrocal

@@ -1,0 +1,170 @@
+#include "gyrocal/model/centrifuge.hpp"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace gyrocal {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+enum Axis : int { kX = 0, kY = 1, kZ = 2 };
+
+/// A joint or error angle with its first two time derivatives (rad, rad/s, rad/s^2).
+struct Angle {
+  double q = 0.0;
+  double qd = 0.0;
+  double qdd = 0.0;
+};
+
+/// A constant offset plus a harmonic series of a joint angle x(t), with the chain rule:
+/// d/dt h(x) = h'(x) xd,  d2/dt2 h(x) = h''(x) xd^2 + h'(x) xdd.
+Angle through_joint(double constant, const HarmonicSeries& series, double x, double xd, double xdd) {
+  if (series.empty()) return {constant, 0.0, 0.0};
+  const AngleFunction h = series.evaluate(x);
+  return {constant + h.value, h.d1 * xd, h.d2 * xd * xd + h.d1 * xdd};
+}
+
+/// The motion of a frame along the chain, everything expressed in G: orientation (frame axes -> G),
+/// angular velocity and acceleration, and the frame origin's position, velocity and acceleration.
+/// This is the spatial-velocity recursion; each step is exact, so the derivatives are analytic.
+struct FrameMotion {
+  Matrix3d rotation = Matrix3d::Identity();
+  Vector3d angular_velocity = Vector3d::Zero();
+  Vector3d angular_acceleration = Vector3d::Zero();
+  Vector3d position = Vector3d::Zero();
+  Vector3d velocity = Vector3d::Zero();
+  Vector3d acceleration = Vector3d::Zero();
+
+  /// Right-multiply the orientation by an elementary rotation E_axis(q(t)) about the current frame's axis.
+  void rotate(Axis axis, const Angle& a) {
+    const Vector3d u = rotation.col(axis);  // the joint axis in G; E_axis leaves it unchanged
+    angular_acceleration += angular_velocity.cross(u) * a.qd + u * a.qdd;
+    angular_velocity += u * a.qd;
+    const int i = (axis + 1) % 3;
+    const int j = (axis + 2) % 3;
+    const double c = std::cos(a.q);
+    const double s = std::sin(a.q);
+    const Vector3d ci = rotation.col(i);
+    const Vector3d cj = rotation.col(j);
+    rotation.col(i) = c * ci + s * cj;
+    rotation.col(j) = c * cj - s * ci;
+  }
+
+  /// Right-multiply the orientation by a constant rotation (no motion of its own).
+  void rotate_constant(const Matrix3d& r) { rotation = rotation * r; }
+
+  /// Move the origin by r(t), given in the current frame with its derivatives in that frame.
+  void translate(const Vector3d& r, const Vector3d& rd, const Vector3d& rdd) {
+    const Vector3d rg = rotation * r;
+    const Vector3d rdg = rotation * rd;
+    const Vector3d& w = angular_velocity;
+    position += rg;
+    velocity += w.cross(rg) + rdg;
+    acceleration +=
+        angular_acceleration.cross(rg) + w.cross(w.cross(rg)) + 2.0 * w.cross(rdg) + rotation * rdd;
+  }
+
+  /// Move the origin by a constant offset r in the current frame.
+  void translate(const Vector3d& r) { translate(r, Vector3d::Zero(), Vector3d::Zero()); }
+};
+
+Matrix3d elementary(Axis axis, double q) {
+  return Eigen::AngleAxisd(q, Vector3d::Unit(axis)).toRotationMatrix();
+}
+
+}  // namespace
+
+Eigen::Vector3d Site::earth_rate_g() const {
+  return earth_rate_rad_s * Vector3d(std::cos(latitude_rad), 0.0, std::sin(latitude_rad));
+}
+
+CentrifugeModel::CentrifugeModel(const Site& site, const CentrifugeGeometry& geometry,
+                                 const CentrifugeErrors& errors)
+    : site_(site), geometry_(geometry), errors_(errors), earth_rate_g_(site.earth_rate_g()) {
+  base_rotation_ = elementary(kY, errors.base_tilt_y_rad) * elementary(kX, errors.base_tilt_x_rad);
+  mount_rotation_ = elementary(kZ, errors.mount_misalignment_rad.z()) *
+                    elementary(kY, errors.mount_misalignment_rad.y()) *
+                    elementary(kX, errors.mount_misalignment_rad.x());
+}
+
+GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
+  const CentrifugeErrors& e = model.errors();
+  const double th = j.main_angle_rad, thd = j.main_rate_rad_s, thdd = j.main_accel_rad_s2;
+  const double ps = j.counter_angle_rad, psd = j.counter_rate_rad_s, psdd = j.counter_accel_rad_s2;
+
+  FrameMotion f;
+  // R_base; then the main-axis runout, (x, y, 0) in the base frame, a function of theta.
+  f.rotate_constant(model.base_rotation());
+  if (!e.main_runout_x_m.empty() || !e.main_runout_y_m.empty()) {
+    const Angle rx = through_joint(0.0, e.main_runout_x_m, th, thd, thdd);
+    const Angle ry = through_joint(0.0, e.main_runout_y_m, th, thd, thdd);
+    f.translate({rx.q, ry.q, 0.0}, {rx.qd, ry.qd, 0.0}, {rx.qdd, ry.qdd, 0.0});
+  }
+  // R_main(theta) = Ry(perp_y + wobble_y) Rx(perp_x + wobble_x) Rz(theta).
+  f.rotate(kY, through_joint(e.main_perpendicularity_y_rad, e.main_wobble_y_rad, th, thd, thdd));
+  f.rotate(kX, through_joint(e.main_perpendicularity_x_rad, e.main_wobble_x_rad, th, thd, thdd));
+  f.rotate(kZ, {th, thd, thdd});
+  // The arm: (R0 + radius_error + stretch*omega^2, 0, 0) in the rotating main-axis frame.
+  const double stretch = e.radius_stretch_m_per_rad2_s2;
+  f.translate({model.geometry().radius_m + e.radius_error_m + stretch * thd * thd, 0.0, 0.0},
+              {2.0 * stretch * thd * thdd, 0.0, 0.0}, {2.0 * stretch * thdd * thdd, 0.0, 0.0});
+  // R_count(psi_r) = Ry(perp_y + wobble_y) Rx(perp_x + wobble_x) Rz(psi_r).
+  f.rotate(kY, through_joint(e.counter_perpendicularity_y_rad, e.counter_wobble_y_rad, ps, psd, psdd));
+  f.rotate(kX, through_joint(e.counter_perpendicularity_x_rad, e.counter_wobble_x_rad, ps, psd, psdd));
+  f.rotate(kZ, {ps, psd, psdd});
+  // R_pos(beta) = Rz(perp_z + wobble_z(beta')) Rx(perp_x + wobble_x(beta')) Ry(-beta'), held during a dwell.
+  const double beta = j.position_angle_rad + e.position_angle_error_rad;
+  f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta, 0.0, 0.0));
+  f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta, 0.0, 0.0));
+  f.rotate(kY, {-beta, 0.0, 0.0});
+  // The gyro centre's offset in position-platform axes, then the mounting misalignment.
+  if (!e.lever_arm_m.isZero(0.0)) f.translate(e.lever_arm_m);
+  f.rotate_constant(model.mount_rotation());
+
+  // MODEL.md section 4.
+  const Vector3d& we = model.earth_rate_g();
+  const double g = model.site().gravity_m_s2;
+  const Vector3d inertial_acceleration =
+      f.acceleration + 2.0 * we.cross(f.velocity) + we.cross(we.cross(f.position)) + Vector3d(0.0, 0.0, g);
+  GyroInputs in;
+  in.rate_rad_s = f.rotation.transpose() * (we + f.angular_velocity);
+  in.specific_force_g = f.rotation.transpose() * inertial_acceleration / g;
+  return in;
+}
+
+JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,
+                                double time_s) {
+  const double delta_omega = model.errors().counter_rate_mismatch_rad_s;
+  JointState j;
+  j.main_angle_rad = model.geometry().initial_main_angle_rad + rate_rad_s * time_s;
+  j.main_rate_rad_s = rate_rad_s;
+  j.counter_angle_rad = -j.main_angle_rad + model.geometry().heading_rad + delta_omega * time_s;
+  j.counter_rate_rad_s = -rate_rad_s + delta_omega;
+  j.position_angle_rad = beta_rad;
+  return j;
+}
+
+JointState static_joint_state(const CentrifugeModel& model, double beta_rad, double gamma_rad) {
+  JointState j;
+  j.main_angle_rad = model.geometry().initial_main_angle_rad;
+  j.counter_angle_rad = -gamma_rad;
+  j.position_angle_rad = beta_rad;
+  return j;
+}
+
+double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution) {
+  // gamma(t) = -psi_r(t) = theta0 - psi0 + (omega - delta_omega) t.
+  const double gamma_rate = rate_rad_s - model.errors().counter_rate_mismatch_rad_s;
+  const double t_start = revolution * 2.0 * kPi / std::abs(rate_rad_s);
+  const double gamma_start =
+      model.geometry().initial_main_angle_rad - model.geometry().heading_rad + gamma_rate * t_start;
+  const double ahead = gamma_rate > 0 ? gamma_rad - gamma_start : gamma_start - gamma_rad;
+  double wrapped = std::fmod(ahead, 2.0 * kPi);
+  if (wrapped < 0) wrapped += 2.0 * kPi;
+  return t_start + wrapped / std::abs(gamma_rate);
+}
+
+}  // namespace gyrocal
