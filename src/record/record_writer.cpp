@@ -1,0 +1,119 @@
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/record/record.hpp"
+
+namespace gyrocal {
+namespace {
+
+constexpr std::size_t kBufferBytes = std::size_t{256} << 10;
+// Longest row: 13 numbers of at most 24 characters ("-2.2250738585072014e-308"), separators, newline.
+constexpr std::size_t kMaxRowBytes = (kRecordColumns.size() + kMaxExtraColumns) * 25 + 1;
+
+bool has_line_break(std::string_view text) {
+  return text.find_first_of("\r\n") != std::string_view::npos;
+}
+
+bool is_column_name(std::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+}  // namespace
+
+RecordWriter::RecordWriter(std::ostream& out, const RecordMetadata& metadata,
+                           const std::vector<std::string>& extra_columns)
+    : out_(out),
+      columns_(kRecordColumns.begin(), kRecordColumns.end()),
+      extra_count_(extra_columns.size()),
+      buffer_(kBufferBytes) {
+  if (extra_columns.size() > kMaxExtraColumns) {
+    throw Error(fmt::format("A record holds at most {} extra columns; {} were given.", kMaxExtraColumns,
+                            extra_columns.size()));
+  }
+  std::string head(kRecordMagic);
+  head += '\n';
+  for (const auto& [key, value] : metadata) {
+    if (key.empty() || key.find('=') != std::string::npos || has_line_break(key) || has_line_break(value)) {
+      throw Error(
+          fmt::format("Record metadata key '{}' is not allowed: a key is non-empty and holds no '=' "
+                      "or line break, and a value holds no line break.",
+                      key));
+    }
+    head += "# " + key + " = " + value + '\n';
+  }
+  for (const std::string& name : extra_columns) {
+    if (!is_column_name(name) || std::find(columns_.begin(), columns_.end(), name) != columns_.end()) {
+      throw Error(
+          fmt::format("Extra record column '{}' is not allowed: a name is letters, digits and '_', "
+                      "and appears once.",
+                      name));
+    }
+    columns_.push_back(name);
+  }
+  head += fmt::format("{}\n", fmt::join(columns_, ","));
+  out_.write(head.data(), static_cast<std::streamsize>(head.size()));
+}
+
+RecordWriter::~RecordWriter() {
+  if (finished_) return;
+  try {
+    flush_buffer();
+  } catch (...) {
+    // A destructor must not throw; finish() is the place to learn about errors.
+  }
+}
+
+void RecordWriter::write(const RecordSample& sample) {
+  const double fixed[] = {sample.time_s, sample.main_angle_deg, sample.counter_angle_deg,
+                          sample.position_angle_deg, sample.gyro_deg_h};
+  for (std::size_t i = 0; i < kRecordColumns.size() + extra_count_; ++i) {
+    const double value = i < kRecordColumns.size() ? fixed[i] : sample.extra[i - kRecordColumns.size()];
+    if (!std::isfinite(value)) {
+      throw Error(
+          fmt::format("Cannot write row {} of the record: {} is {}; a record holds finite numbers only.",
+                      rows_ + 1, columns_[i], value));
+    }
+  }
+  if (rows_ > 0 && !(sample.time_s > previous_time_s_)) {
+    throw Error(fmt::format("Cannot write row {} of the record: time_s {} does not increase (previous {}).",
+                            rows_ + 1, sample.time_s, previous_time_s_));
+  }
+  if (buffer_.size() - used_ < kMaxRowBytes) flush_buffer();
+
+  char* p = buffer_.data() + used_;
+  char* const end = buffer_.data() + buffer_.size();
+  // Room is guaranteed by kMaxRowBytes, so to_chars cannot fail.
+  for (const double value : fixed) {
+    p = std::to_chars(p, end, value).ptr;
+    *p++ = ',';
+  }
+  for (std::size_t i = 0; i < extra_count_; ++i) {
+    p = std::to_chars(p, end, sample.extra[i]).ptr;
+    *p++ = ',';
+  }
+  p[-1] = '\n';  // replaces the last separator
+  used_ = static_cast<std::size_t>(p - buffer_.data());
+  previous_time_s_ = sample.time_s;
+  ++rows_;
+}
+
+void RecordWriter::finish() {
+  finished_ = true;
+  flush_buffer();
+  out_.flush();
+  if (!out_) throw Error("Cannot write the record: the output stream failed.");
+}
+
+void RecordWriter::flush_buffer() {
+  out_.write(buffer_.data(), static_cast<std::streamsize>(used_));
+  used_ = 0;
+}
+
+}  // namespace gyrocal
