@@ -1,0 +1,37 @@
+#pragma once
+// The configuration file (INTERFACE.md, "Configuration (TOML)"): reading a scenario from TOML and writing one
+// back as a commented file. Keys carry their unit in their name (deg, arcsec, m, rad_s, ...); the scenario
+// holds SI values (MODEL.md section 1). Every key is optional and defaults to default_scenario().
+//
+// Relation of [centrifuge] rate_rad_s and [test] rates_rad_s: rate_rad_s is the main rate of a single
+// instant (`gyrocal inputs`), rates_rad_s the rates of the test. When [test] has no rates_rad_s, the test
+// runs at the configured centrifuge rate alone: rates_rad_s = [rate_rad_s].
+//
+// [uncertainty] has the keys of [centrifuge.errors] with their units; each value is the standard
+// uncertainty of that error (all zero by default). In a harmonic term, amplitude is the standard
+// uncertainty of that harmonic's amplitude and phase_deg its nominal phase.
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "gyrocal/config/scenario.hpp"
+
+namespace gyrocal {
+
+/// Parse a TOML configuration into a scenario (SI units). source_name names the file in error messages.
+/// Throws Error, with one sentence naming the file, the line and the full key path (such as
+/// centrifuge.errors.counter_wobble_x[0].harmonic), on a TOML syntax error, an unknown key, a value of the
+/// wrong type, or a value that is not finite or out of its range.
+Scenario parse_scenario(std::string_view toml_text, const std::string& source_name);
+
+/// Read and parse the configuration file at path. Throws Error naming the file if it cannot be read.
+Scenario load_scenario(const std::filesystem::path& path);
+
+/// The scenario as a commented TOML configuration with every key, one comment per key giving its meaning
+/// and unit. Numbers are written in their shortest exact form, so that parse_scenario gives back s bit for
+/// bit whenever s's angles are reachable from the file's units (any scenario that parse_scenario returned,
+/// default_scenario() included; an arbitrary SI angle may come back within one unit in the last place).
+/// Throws Error if test.seed exceeds the largest TOML integer (2^63 - 1).
+std::string scenario_to_toml(const Scenario& s);
+
+}  // namespace gyrocal

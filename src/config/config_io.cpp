@@ -1,0 +1,656 @@
+#include "gyrocal/config/config_io.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------------------------------------
+// The keys. Each list is used by both the reader and the writer, so the two cannot disagree.
+
+/// Allowed interval of a value, in the file's unit.
+struct Range {
+  double min = -kInf;
+  double max = kInf;
+  bool min_exclusive = false;
+};
+
+constexpr Range kAnyValue{};
+constexpr Range kPositive{0.0, kInf, true};
+constexpr Range kNonNegative{0.0, kInf, false};
+constexpr Range kLatitude{-90.0, 90.0, false};
+
+/// A number key of section struct S: the file holds member / to_si.
+template <class S>
+struct NumberKey {
+  std::string_view key;
+  double S::*member;
+  double to_si;  ///< file unit -> SI
+  Range range;
+  std::string_view comment;
+};
+
+constexpr NumberKey<Site> kSiteKeys[] = {
+    {"latitude_deg", &Site::latitude_rad, kDegToRad, kLatitude, "geodetic latitude, deg, in [-90, 90]"},
+    {"gravity_m_s2", &Site::gravity_m_s2, 1.0, kPositive,
+     "local gravity, m/s^2; specific force is in this g"},
+    {"earth_rate_rad_s", &Site::earth_rate_rad_s, 1.0, kNonNegative, "Earth rate magnitude, rad/s"},
+};
+
+constexpr NumberKey<CentrifugeGeometry> kCentrifugeKeys[] = {
+    {"radius_m", &CentrifugeGeometry::radius_m, 1.0, kPositive,
+     "R0, nominal arm radius to the gyro centre, m"},
+    {"rate_rad_s", &CentrifugeGeometry::rate_rad_s, 1.0, kAnyValue,
+     "main-axis rate, rad/s, signed: + is counter-clockwise seen from above"},
+    {"heading_deg", &CentrifugeGeometry::heading_rad, kDegToRad, kAnyValue,
+     "psi0: direction of I at beta = 0, from North toward West, deg"},
+    {"initial_main_angle_deg", &CentrifugeGeometry::initial_main_angle_rad, kDegToRad, kAnyValue,
+     "theta0: main-axis angle at t = 0, deg"},
+};
+
+constexpr NumberKey<GyroNoise> kNoiseKeys[] = {
+    {"angle_random_walk_deg_rt_h", &GyroNoise::angle_random_walk_deg_rt_h, 1.0, kNonNegative,
+     "white rate noise, deg/sqrt(h)"},
+    {"bias_instability_deg_h", &GyroNoise::bias_instability_deg_h, 1.0, kNonNegative,
+     "flat Allan deviation floor, deg/h"},
+    {"rate_random_walk_deg_h_rt_h", &GyroNoise::rate_random_walk_deg_h_rt_h, 1.0, kNonNegative,
+     "rate random walk, deg/h/sqrt(h)"},
+    {"quantization_deg_h", &GyroNoise::quantization_deg_h, 1.0, kNonNegative,
+     "output quantization step, deg/h (0 = none)"},
+    {"output_lag_s", &GyroNoise::output_lag_s, 1.0, kNonNegative,
+     "first-order output lag time constant, s (0 = none)"},
+};
+
+/// The meaning of each drift coefficient, in Coefficient order; the unit comes from kCoefficientUnits.
+constexpr std::string_view kCoefficientMeanings[kNumCoefficients] = {
+    "bias",           "drift per g along I", "drift per g along O", "drift per g along S", "drift per aI^2",
+    "drift per aO^2", "drift per aS^2",      "drift per aI*aO",     "drift per aI*aS",     "drift per aO*aS",
+};
+
+/// A key of [centrifuge.errors] and [uncertainty] (MODEL.md section 3): exactly one of scalar, series,
+/// triple is set. A series' terms have the keys harmonic, amplitude_key (in the series' file unit) and
+/// phase_deg.
+struct ErrorKey {
+  std::string_view key;
+  double to_si;  ///< file unit -> SI (of a series: of its amplitude)
+  std::string_view comment;
+  double CentrifugeErrors::*scalar = nullptr;
+  HarmonicSeries CentrifugeErrors::*series = nullptr;
+  Eigen::Vector3d CentrifugeErrors::*triple = nullptr;
+  std::string_view amplitude_key = {};
+};
+
+using E = CentrifugeErrors;
+constexpr ErrorKey kErrorKeys[] = {
+    {.key = "base_tilt_x_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "tilt of the base about x (North), arcsec",
+     .scalar = &E::base_tilt_x_rad},
+    {.key = "base_tilt_y_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "tilt of the base about y (West), arcsec",
+     .scalar = &E::base_tilt_y_rad},
+    {.key = "main_perpendicularity_x_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "main axis tilt about x, arcsec",
+     .scalar = &E::main_perpendicularity_x_rad},
+    {.key = "main_perpendicularity_y_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "main axis tilt about y, arcsec",
+     .scalar = &E::main_perpendicularity_y_rad},
+    {.key = "main_wobble_x",
+     .to_si = kArcsecToRad,
+     .comment = "main axis wobble about x, harmonics of theta, arcsec",
+     .series = &E::main_wobble_x_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "main_wobble_y",
+     .to_si = kArcsecToRad,
+     .comment = "main axis wobble about y, harmonics of theta, arcsec",
+     .series = &E::main_wobble_y_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "main_runout_x",
+     .to_si = 1.0,
+     .comment = "main axis runout along x, harmonics of theta, m",
+     .series = &E::main_runout_x_m,
+     .amplitude_key = "amplitude_m"},
+    {.key = "main_runout_y",
+     .to_si = 1.0,
+     .comment = "main axis runout along y, harmonics of theta, m",
+     .series = &E::main_runout_y_m,
+     .amplitude_key = "amplitude_m"},
+    {.key = "radius_error_m", .to_si = 1.0, .comment = "added to R0, m", .scalar = &E::radius_error_m},
+    {.key = "radius_stretch_m_per_rad2_s2",
+     .to_si = 1.0,
+     .comment = "radius growth per omega^2, m/(rad/s)^2",
+     .scalar = &E::radius_stretch_m_per_rad2_s2},
+    {.key = "counter_perpendicularity_x_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "counter-rotating platform tilt about x, arcsec",
+     .scalar = &E::counter_perpendicularity_x_rad},
+    {.key = "counter_perpendicularity_y_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "counter-rotating platform tilt about y, arcsec",
+     .scalar = &E::counter_perpendicularity_y_rad},
+    {.key = "counter_wobble_x",
+     .to_si = kArcsecToRad,
+     .comment = "counter platform wobble about x, harmonics of psi_r, arcsec",
+     .series = &E::counter_wobble_x_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "counter_wobble_y",
+     .to_si = kArcsecToRad,
+     .comment = "counter platform wobble about y, harmonics of psi_r, arcsec",
+     .series = &E::counter_wobble_y_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "counter_rate_mismatch_rad_s",
+     .to_si = 1.0,
+     .comment = "delta omega: platform heading drift about Up, rad/s",
+     .scalar = &E::counter_rate_mismatch_rad_s},
+    {.key = "position_perpendicularity_x_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "position platform tilt about x, arcsec",
+     .scalar = &E::position_perpendicularity_x_rad},
+    {.key = "position_perpendicularity_z_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "position platform tilt about z, arcsec",
+     .scalar = &E::position_perpendicularity_z_rad},
+    {.key = "position_wobble_x",
+     .to_si = kArcsecToRad,
+     .comment = "position platform wobble about x, harmonics of beta', arcsec",
+     .series = &E::position_wobble_x_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "position_wobble_z",
+     .to_si = kArcsecToRad,
+     .comment = "position platform wobble about z, harmonics of beta', arcsec",
+     .series = &E::position_wobble_z_rad,
+     .amplitude_key = "amplitude_arcsec"},
+    {.key = "position_angle_error_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "added to the commanded beta, arcsec",
+     .scalar = &E::position_angle_error_rad},
+    {.key = "mount_misalignment_arcsec",
+     .to_si = kArcsecToRad,
+     .comment = "gyro mounting misalignment about I, O, S, arcsec",
+     .triple = &E::mount_misalignment_rad},
+    {.key = "lever_arm_m",
+     .to_si = 1.0,
+     .comment = "gyro centre offset in position-platform axes (I, O, S at beta = 0), m",
+     .triple = &E::lever_arm_m},
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Numbers as text.
+
+/// Shortest decimal form that reads back to the same double.
+std::string shortest(double v) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+  return std::string(buffer, result.ptr);
+}
+
+/// A TOML float, bit exact: the shortest form, with ".0" added where it would otherwise read as an integer.
+std::string toml_number(double v) {
+  std::string text = shortest(v);
+  if (text.find_first_of(".en") == std::string::npos) text += ".0";  // "nan" and "inf" hold an 'n'
+  return text;
+}
+
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+/// The value in the file's unit that the reader turns back into si exactly (as value * to_si); among the
+/// candidates, the one with the shortest text, so that 3 arcsec is written 3.0 and not 2.9999999999999996.
+double in_file_unit(double si, double to_si) {
+  const double guess = si / to_si;
+  if (to_si == 1.0 || !std::isfinite(guess)) return guess;
+  double best = guess;
+  std::size_t best_length = SIZE_MAX;
+  double below = guess;
+  double above = guess;
+  for (int step = 0; step < 4; ++step) {
+    for (double candidate : {below, above}) {
+      const std::size_t length = shortest(candidate).size();
+      if (same_bits(candidate * to_si, si) && length < best_length) {
+        best = candidate;
+        best_length = length;
+      }
+    }
+    below = std::nextafter(below, -kInf);
+    above = std::nextafter(above, kInf);
+  }
+  return best;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Reading.
+
+std::string describe(const Range& range) {
+  if (range.max < kInf) return "between " + shortest(range.min) + " and " + shortest(range.max);
+  return (range.min_exclusive ? "> " : ">= ") + shortest(range.min);
+}
+
+bool contains(const Range& range, double v) {
+  return (range.min_exclusive ? v > range.min : v >= range.min) && v <= range.max;
+}
+
+std::string type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a floating-point number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+    case toml::node_type::none:
+      break;
+  }
+  return "nothing";
+}
+
+/// Throws the errors of one file.
+class Reader {
+ public:
+  explicit Reader(const std::string& file) : file_(file) {}
+
+  /// Throws Error "<file>, line <n>: <what>."
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& what) const {
+    throw Error(file_ + ", line " + std::to_string(where.begin.line) + ": " + what + ".");
+  }
+
+  /// A number (integer or float), finite and within range, in the file's unit.
+  double number(const toml::node& node, const std::string& path, const Range& range) const {
+    double value = 0.0;
+    if (const auto* integer = node.as_integer()) {
+      value = static_cast<double>(integer->get());
+    } else if (const auto* floating = node.as_floating_point()) {
+      value = floating->get();
+    } else {
+      fail(node.source(), path + " must be a number, not " + type_name(node));
+    }
+    if (!std::isfinite(value)) fail(node.source(), path + " must be a finite number, not " + shortest(value));
+    if (!contains(range, value)) {
+      fail(node.source(), path + " must be " + describe(range) + ", not " + shortest(value));
+    }
+    return value;
+  }
+
+  /// An integer in [min, max].
+  std::int64_t integer(const toml::node& node, const std::string& path, std::int64_t min,
+                       std::int64_t max) const {
+    const auto* integer = node.as_integer();
+    if (integer == nullptr) fail(node.source(), path + " must be an integer, not " + type_name(node));
+    const std::int64_t value = integer->get();
+    if (value < min)
+      fail(node.source(),
+           path + " must be an integer >= " + std::to_string(min) + ", not " + std::to_string(value));
+    if (value > max)
+      fail(node.source(),
+           path + " must be an integer <= " + std::to_string(max) + ", not " + std::to_string(value));
+    return value;
+  }
+
+  const toml::array& array(const toml::node& node, const std::string& path) const {
+    if (!node.is_array()) fail(node.source(), path + " must be an array, not " + type_name(node));
+    return *node.as_array();
+  }
+
+  const toml::table& table(const toml::node& node, const std::string& path) const {
+    if (!node.is_table()) fail(node.source(), path + " must be a table, not " + type_name(node));
+    return *node.as_table();
+  }
+
+  /// An array of numbers, each within range: of exactly `size` numbers if size > 0, else non-empty.
+  std::vector<double> numbers(const toml::node& node, const std::string& path, const Range& range,
+                              std::size_t size) const {
+    const toml::array& items = array(node, path);
+    if (size > 0 && items.size() != size) {
+      fail(node.source(), path + " must be an array of exactly " + std::to_string(size) + " numbers, not " +
+                              std::to_string(items.size()));
+    }
+    if (items.empty()) fail(node.source(), path + " must not be empty");
+    std::vector<double> values;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      values.push_back(number(items[i], path + "[" + std::to_string(i) + "]", range));
+    }
+    return values;
+  }
+
+ private:
+  std::string file_;
+};
+
+/// One table of the file (possibly absent), with the keys asked for so far: any other key is unknown.
+class Section {
+ public:
+  /// table == nullptr: the section is absent, every key keeps its default. path: the table's key path.
+  Section(const Reader& reader, const toml::table* table, std::string path)
+      : reader_(reader), table_(table), path_(std::move(path)) {}
+
+  /// The node of key, or nullptr if absent.
+  const toml::node* find(std::string_view key) {
+    known_.push_back(key);
+    return table_ == nullptr ? nullptr : table_->get(key);
+  }
+
+  std::string path(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  /// If key is present, target = its value * to_si.
+  void number(std::string_view key, double to_si, const Range& range, double& target) {
+    if (const toml::node* node = find(key)) target = reader_.number(*node, path(key), range) * to_si;
+  }
+
+  /// The sub-table of key, or nullptr if absent.
+  const toml::table* table(std::string_view key) {
+    const toml::node* node = find(key);
+    return node == nullptr ? nullptr : &reader_.table(*node, path(key));
+  }
+
+  /// Throws on the first (by line) key that was never asked for.
+  void reject_unknown() const {
+    if (table_ == nullptr) return;
+    const toml::key* unknown = nullptr;
+    for (const auto& [key, node] : *table_) {
+      const bool is_known = std::find(known_.begin(), known_.end(), key.str()) != known_.end();
+      if (!is_known && (unknown == nullptr || key.source().begin < unknown->source().begin)) unknown = &key;
+    }
+    if (unknown == nullptr) return;
+    std::string expected;
+    for (std::string_view key : known_) expected += (expected.empty() ? "" : ", ") + std::string(key);
+    reader_.fail(unknown->source(),
+                 "unknown key " + path(unknown->str()) + " (expected one of " + expected + ")");
+  }
+
+ private:
+  const Reader& reader_;
+  const toml::table* table_;
+  std::string path_;
+  std::vector<std::string_view> known_;
+};
+
+template <class S, std::size_t N>
+void read_numbers(Section& section, const NumberKey<S> (&keys)[N], S& target) {
+  for (const NumberKey<S>& k : keys) section.number(k.key, k.to_si, k.range, target.*k.member);
+  section.reject_unknown();
+}
+
+/// A harmonic series: an array of tables { harmonic, <amplitude_key>, phase_deg }.
+HarmonicSeries read_series(const Reader& reader, const toml::node& node, const std::string& path,
+                           const ErrorKey& key) {
+  const toml::array& items = reader.array(node, path);
+  HarmonicSeries series;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const std::string item_path = path + "[" + std::to_string(i) + "]";
+    Section item(reader, &reader.table(items[i], item_path), item_path);
+    HarmonicTerm term;
+    if (const toml::node* harmonic = item.find("harmonic")) {
+      term.harmonic = static_cast<int>(reader.integer(*harmonic, item.path("harmonic"), 1, INT_MAX));
+    }
+    item.number(key.amplitude_key, key.to_si, kNonNegative, term.amplitude);
+    item.number("phase_deg", kDegToRad, kAnyValue, term.phase_rad);
+    item.reject_unknown();
+    series.terms.push_back(term);
+  }
+  return series;
+}
+
+/// [centrifuge.errors] or [uncertainty] (where every value is a standard uncertainty, so >= 0).
+void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors) {
+  for (const ErrorKey& key : kErrorKeys) {
+    const toml::node* node = section.find(key.key);
+    if (node == nullptr) continue;
+    const std::string path = section.path(key.key);
+    if (key.scalar != nullptr) {
+      errors.*key.scalar = reader.number(*node, path, range) * key.to_si;
+    } else if (key.series != nullptr) {
+      errors.*key.series = read_series(reader, *node, path, key);
+    } else {
+      const std::vector<double> values = reader.numbers(*node, path, range, 3);
+      errors.*key.triple = Eigen::Vector3d(values[0], values[1], values[2]) * key.to_si;
+    }
+  }
+  section.reject_unknown();
+}
+
+std::vector<double> scaled(std::vector<double> values, double factor) {
+  for (double& v : values) v *= factor;
+  return values;
+}
+
+void read_test(const Reader& reader, Section& section, TestSpec& test) {
+  section.number("sample_rate_hz", 1.0, kPositive, test.sample_rate_hz);
+  if (const toml::node* node = section.find("revolutions")) {
+    test.revolutions = static_cast<int>(reader.integer(*node, section.path("revolutions"), 1, INT_MAX));
+  }
+  section.number("settle_s", 1.0, kNonNegative, test.settle_s);
+  if (const toml::node* node = section.find("beta_deg")) {
+    test.beta_rad = scaled(reader.numbers(*node, section.path("beta_deg"), kAnyValue, 0), kDegToRad);
+  }
+  if (const toml::node* node = section.find("gamma_deg")) {
+    test.gamma_rad = scaled(reader.numbers(*node, section.path("gamma_deg"), kAnyValue, 0), kDegToRad);
+  }
+  if (const toml::node* node = section.find("rates_rad_s")) {
+    test.rates_rad_s = reader.numbers(*node, section.path("rates_rad_s"), kAnyValue, 0);
+  }
+  if (const toml::node* node = section.find("seed")) {
+    test.seed = static_cast<std::uint64_t>(reader.integer(*node, section.path("seed"), 0, INT64_MAX));
+  }
+  section.reject_unknown();
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Writing.
+
+/// Lines "key = value  # comment", the comments aligned.
+class TomlWriter {
+ public:
+  void comment(std::string_view text) { out_ << "# " << text << "\n"; }
+  /// A table header after a blank line, its note (lines separated by \n) as comment lines above it.
+  void section(std::string_view name, std::string_view note) {
+    out_ << "\n";
+    for (std::size_t begin = 0; begin < note.size();) {
+      const std::size_t end = std::min(note.find('\n', begin), note.size());
+      comment(note.substr(begin, end - begin));
+      begin = end + 1;
+    }
+    out_ << "[" << name << "]\n";
+  }
+  void key(std::string_view key, const std::string& value, std::string_view note) {
+    constexpr std::size_t kCommentColumn = 44;
+    std::string line = std::string(key) + " = " + value;
+    line.resize(std::max(line.size() + 2, kCommentColumn), ' ');
+    out_ << line << "# " << note << "\n";
+  }
+  std::string text() const { return out_.str(); }
+
+ private:
+  std::ostringstream out_;
+};
+
+std::string number_array(const std::vector<double>& values_si, double to_si) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values_si.size(); ++i) {
+    text += (i == 0 ? "" : ", ") + toml_number(in_file_unit(values_si[i], to_si));
+  }
+  return text + "]";
+}
+
+std::string series_text(const HarmonicSeries& series, const ErrorKey& key) {
+  if (series.empty()) return "[]";
+  std::string text = "[";
+  for (std::size_t i = 0; i < series.terms.size(); ++i) {
+    const HarmonicTerm& term = series.terms[i];
+    text += (i == 0 ? " { " : ", { ");
+    text += "harmonic = " + std::to_string(term.harmonic) + ", " + std::string(key.amplitude_key) + " = " +
+            toml_number(in_file_unit(term.amplitude, key.to_si)) +
+            ", phase_deg = " + toml_number(in_file_unit(term.phase_rad, kDegToRad)) + " }";
+  }
+  return text + " ]";
+}
+
+template <class S, std::size_t N>
+void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source) {
+  for (const NumberKey<S>& k : keys) {
+    writer.key(k.key, toml_number(in_file_unit(source.*k.member, k.to_si)), k.comment);
+  }
+}
+
+void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
+  for (const ErrorKey& key : kErrorKeys) {
+    std::string value;
+    if (key.scalar != nullptr) {
+      value = toml_number(in_file_unit(errors.*key.scalar, key.to_si));
+    } else if (key.series != nullptr) {
+      value = series_text(errors.*key.series, key);
+    } else {
+      const Eigen::Vector3d& v = errors.*key.triple;
+      value = number_array({v.x(), v.y(), v.z()}, key.to_si);
+    }
+    writer.key(key.key, value, key.comment);
+  }
+}
+
+}  // namespace
+
+Scenario parse_scenario(std::string_view toml_text, const std::string& source_name) {
+  const Reader reader(source_name);
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, source_name);
+  } catch (const toml::parse_error& e) {
+    std::string description(e.description());
+    while (!description.empty() && description.back() == '.') description.pop_back();
+    reader.fail(e.source(), "TOML syntax error: " + description);
+  }
+
+  Scenario s = default_scenario();
+  Section top(reader, &root, "");
+
+  Section site(reader, top.table("site"), "site");
+  read_numbers(site, kSiteKeys, s.site);
+
+  Section centrifuge(reader, top.table("centrifuge"), "centrifuge");
+  const toml::table* errors_table = centrifuge.table("errors");
+  read_numbers(centrifuge, kCentrifugeKeys, s.centrifuge);
+  Section errors(reader, errors_table, "centrifuge.errors");
+  read_errors(reader, errors, kAnyValue, s.errors);
+
+  Section gyro(reader, top.table("gyro"), "gyro");
+  const toml::table* noise_table = gyro.table("noise");
+  for (std::size_t i = 0; i < kNumCoefficients; ++i)
+    gyro.number(kCoefficientNames[i], 1.0, kAnyValue, s.gyro.values[i]);
+  gyro.reject_unknown();
+  Section noise(reader, noise_table, "gyro.noise");
+  read_numbers(noise, kNoiseKeys, s.noise);
+
+  // Without rates of its own, the test runs at the configured centrifuge rate (see config_io.hpp).
+  s.test.rates_rad_s = {s.centrifuge.rate_rad_s};
+  Section test(reader, top.table("test"), "test");
+  read_test(reader, test, s.test);
+
+  Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
+  read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
+
+  top.reject_unknown();
+  return s;
+}
+
+Scenario load_scenario(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::string name = path.string();
+  if (!std::filesystem::exists(path, ec))
+    throw Error("Cannot read configuration file " + name + ": it does not exist.");
+  if (std::filesystem::is_directory(path, ec)) {
+    throw Error("Cannot read configuration file " + name + ": it is a directory.");
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || !text) throw Error("Cannot read configuration file " + name + ": it cannot be opened or read.");
+  return parse_scenario(text.str(), name);
+}
+
+std::string scenario_to_toml(const Scenario& s) {
+  if (s.test.seed > static_cast<std::uint64_t>(INT64_MAX)) {
+    throw Error("Cannot write test.seed " + std::to_string(s.test.seed) +
+                ": TOML integers end at 9223372036854775807.");
+  }
+  TomlWriter w;
+  w.comment("gyrocal configuration (INTERFACE.md, \"Configuration (TOML)\"). Every key is optional: a");
+  w.comment(
+      "missing key keeps the value of the default scenario (MODEL.md section 11). Units are in the key");
+  w.comment(
+      "names. A harmonic series is an array of { harmonic = n >= 1, amplitude_<unit> >= 0, phase_deg }");
+  w.comment(
+      "terms, sum of a_n * cos(n * angle + phase); a series given here replaces the default one ([] = "
+      "none).");
+
+  w.section("site", "");
+  write_numbers(w, kSiteKeys, s.site);
+
+  w.section("centrifuge", "");
+  write_numbers(w, kCentrifugeKeys, s.centrifuge);
+
+  w.section("centrifuge.errors", "Machine errors, names as in MODEL.md section 3.");
+  write_errors(w, s.errors);
+
+  w.section("gyro", "The gyro's drift coefficients (MODEL.md section 6): the truth, for simulation.");
+  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+    w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
+          std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
+  }
+
+  w.section("gyro.noise", "");
+  write_numbers(w, kNoiseKeys, s.noise);
+
+  const TestSpec& t = s.test;
+  w.section("test",
+            "The test: at each rate and beta, the output is read as the arm passes each gamma. A rate of 0\n"
+            "means the main axis stopped and the platform indexed to each gamma.");
+  w.key("sample_rate_hz", toml_number(t.sample_rate_hz), "gyro and encoder sampling rate, Hz");
+  w.key("revolutions", std::to_string(t.revolutions), "whole main-axis revolutions per beta and rate");
+  w.key("settle_s", toml_number(t.settle_s), "discarded after each change of beta or rate, s");
+  w.key("beta_deg", number_array(t.beta_rad, kDegToRad), "position-platform angles, deg");
+  w.key("gamma_deg", number_array(t.gamma_rad, kDegToRad), "arm angles read out at each beta, deg");
+  w.key("rates_rad_s", number_array(t.rates_rad_s, 1.0),
+        "main rates, rad/s; absent = [centrifuge rate_rad_s]");
+  w.key("seed", std::to_string(t.seed), "random seed of the simulation, integer >= 0");
+
+  w.section(
+      "uncertainty",
+      "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry, same keys and units, all zero\n"
+      "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
+      "and phase_deg its nominal phase.");
+  write_errors(w, s.uncertainty);
+  return w.text();
+}
+
+}  // namespace gyrocal

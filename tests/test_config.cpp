@@ -1,0 +1,401 @@
+// The configuration file: round trips, units, defaults, and every kind of bad value refused with its key
+// and line (INTERFACE.md, "Configuration (TOML)").
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal {
+namespace {
+
+// Independent of the library's constants: 1 rad = 180*3600/pi arcsec.
+constexpr double kArcsecPerRad = 206264.80624709636;
+
+// ---- exact comparison of every field -------------------------------------------------------------------
+
+void expect_same(double a, double b, const std::string& what) {
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(a), std::bit_cast<std::uint64_t>(b))
+      << what << ": " << a << " != " << b;
+}
+
+void expect_same(const std::vector<double>& a, const std::vector<double>& b, const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t i = 0; i < a.size(); ++i) expect_same(a[i], b[i], what + "[" + std::to_string(i) + "]");
+}
+
+void expect_same(const HarmonicSeries& a, const HarmonicSeries& b, const std::string& what) {
+  ASSERT_EQ(a.terms.size(), b.terms.size()) << what;
+  for (std::size_t i = 0; i < a.terms.size(); ++i) {
+    const std::string term = what + "[" + std::to_string(i) + "]";
+    EXPECT_EQ(a.terms[i].harmonic, b.terms[i].harmonic) << term;
+    expect_same(a.terms[i].amplitude, b.terms[i].amplitude, term + ".amplitude");
+    expect_same(a.terms[i].phase_rad, b.terms[i].phase_rad, term + ".phase");
+  }
+}
+
+void expect_same(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const std::string& what) {
+  for (int i = 0; i < 3; ++i) expect_same(a[i], b[i], what + "[" + std::to_string(i) + "]");
+}
+
+void expect_same(const CentrifugeErrors& a, const CentrifugeErrors& b, const std::string& w) {
+  expect_same(a.base_tilt_x_rad, b.base_tilt_x_rad, w + "base_tilt_x");
+  expect_same(a.base_tilt_y_rad, b.base_tilt_y_rad, w + "base_tilt_y");
+  expect_same(a.main_perpendicularity_x_rad, b.main_perpendicularity_x_rad, w + "main_perpendicularity_x");
+  expect_same(a.main_perpendicularity_y_rad, b.main_perpendicularity_y_rad, w + "main_perpendicularity_y");
+  expect_same(a.main_wobble_x_rad, b.main_wobble_x_rad, w + "main_wobble_x");
+  expect_same(a.main_wobble_y_rad, b.main_wobble_y_rad, w + "main_wobble_y");
+  expect_same(a.main_runout_x_m, b.main_runout_x_m, w + "main_runout_x");
+  expect_same(a.main_runout_y_m, b.main_runout_y_m, w + "main_runout_y");
+  expect_same(a.radius_error_m, b.radius_error_m, w + "radius_error");
+  expect_same(a.radius_stretch_m_per_rad2_s2, b.radius_stretch_m_per_rad2_s2, w + "radius_stretch");
+  expect_same(a.counter_perpendicularity_x_rad, b.counter_perpendicularity_x_rad,
+              w + "counter_perpendicularity_x");
+  expect_same(a.counter_perpendicularity_y_rad, b.counter_perpendicularity_y_rad,
+              w + "counter_perpendicularity_y");
+  expect_same(a.counter_wobble_x_rad, b.counter_wobble_x_rad, w + "counter_wobble_x");
+  expect_same(a.counter_wobble_y_rad, b.counter_wobble_y_rad, w + "counter_wobble_y");
+  expect_same(a.counter_rate_mismatch_rad_s, b.counter_rate_mismatch_rad_s, w + "counter_rate_mismatch");
+  expect_same(a.position_perpendicularity_x_rad, b.position_perpendicularity_x_rad, w + "position_perp_x");
+  expect_same(a.position_perpendicularity_z_rad, b.position_perpendicularity_z_rad, w + "position_perp_z");
+  expect_same(a.position_wobble_x_rad, b.position_wobble_x_rad, w + "position_wobble_x");
+  expect_same(a.position_wobble_z_rad, b.position_wobble_z_rad, w + "position_wobble_z");
+  expect_same(a.position_angle_error_rad, b.position_angle_error_rad, w + "position_angle_error");
+  expect_same(a.mount_misalignment_rad, b.mount_misalignment_rad, w + "mount_misalignment");
+  expect_same(a.lever_arm_m, b.lever_arm_m, w + "lever_arm");
+}
+
+void expect_same(const Scenario& a, const Scenario& b) {
+  expect_same(a.site.latitude_rad, b.site.latitude_rad, "site.latitude");
+  expect_same(a.site.gravity_m_s2, b.site.gravity_m_s2, "site.gravity");
+  expect_same(a.site.earth_rate_rad_s, b.site.earth_rate_rad_s, "site.earth_rate");
+  expect_same(a.centrifuge.radius_m, b.centrifuge.radius_m, "centrifuge.radius");
+  expect_same(a.centrifuge.rate_rad_s, b.centrifuge.rate_rad_s, "centrifuge.rate");
+  expect_same(a.centrifuge.heading_rad, b.centrifuge.heading_rad, "centrifuge.heading");
+  expect_same(a.centrifuge.initial_main_angle_rad, b.centrifuge.initial_main_angle_rad, "centrifuge.theta0");
+  expect_same(a.errors, b.errors, "errors.");
+  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+    expect_same(a.gyro.values[i], b.gyro.values[i], "gyro." + std::string(kCoefficientNames[i]));
+  }
+  expect_same(a.noise.angle_random_walk_deg_rt_h, b.noise.angle_random_walk_deg_rt_h, "noise.arw");
+  expect_same(a.noise.bias_instability_deg_h, b.noise.bias_instability_deg_h, "noise.bias_instability");
+  expect_same(a.noise.rate_random_walk_deg_h_rt_h, b.noise.rate_random_walk_deg_h_rt_h, "noise.rrw");
+  expect_same(a.noise.quantization_deg_h, b.noise.quantization_deg_h, "noise.quantization");
+  expect_same(a.noise.output_lag_s, b.noise.output_lag_s, "noise.output_lag");
+  expect_same(a.test.sample_rate_hz, b.test.sample_rate_hz, "test.sample_rate");
+  EXPECT_EQ(a.test.revolutions, b.test.revolutions);
+  expect_same(a.test.settle_s, b.test.settle_s, "test.settle");
+  expect_same(a.test.beta_rad, b.test.beta_rad, "test.beta");
+  expect_same(a.test.gamma_rad, b.test.gamma_rad, "test.gamma");
+  expect_same(a.test.rates_rad_s, b.test.rates_rad_s, "test.rates");
+  EXPECT_EQ(a.test.seed, b.test.seed);
+  expect_same(a.uncertainty, b.uncertainty, "uncertainty.");
+}
+
+Scenario round_trip(const Scenario& s) {
+  return parse_scenario(scenario_to_toml(s), "round-trip.toml");
+}
+
+/// A scenario with every field away from its default (angles given in the file's units).
+Scenario changed_scenario() {
+  Scenario s;
+  s.site = {-33.5 * kDegToRad, 9.79, 7.3e-5};
+  s.centrifuge = {2.25, -12.5, 15.0 * kDegToRad, -30.0 * kDegToRad};
+  CentrifugeErrors& e = s.errors;
+  e.base_tilt_x_rad = 1.5 * kArcsecToRad;
+  e.base_tilt_y_rad = -2.5 * kArcsecToRad;
+  e.main_perpendicularity_x_rad = 0.7 * kArcsecToRad;
+  e.main_perpendicularity_y_rad = -0.3 * kArcsecToRad;
+  e.main_wobble_x_rad.terms = {{1, 0.25 * kArcsecToRad, 10.0 * kDegToRad},
+                               {3, 0.1 * kArcsecToRad, -45.0 * kDegToRad}};
+  e.main_wobble_y_rad.terms = {{2, 0.4 * kArcsecToRad, 33.3 * kDegToRad}};
+  e.main_runout_x_m.terms = {{1, 2e-6, 5.0 * kDegToRad}};
+  e.main_runout_y_m.terms = {{4, 1.25e-7, 0.0}};
+  e.radius_error_m = 1e-4;
+  e.radius_stretch_m_per_rad2_s2 = 3e-8;
+  e.counter_perpendicularity_x_rad = 4.1 * kArcsecToRad;
+  e.counter_perpendicularity_y_rad = 1.1 * kArcsecToRad;
+  e.counter_wobble_x_rad.terms = {{5, 0.9 * kArcsecToRad, 123.0 * kDegToRad}};
+  e.counter_wobble_y_rad.terms = {};
+  e.counter_rate_mismatch_rad_s = -3.3e-6;
+  e.position_perpendicularity_x_rad = 0.2 * kArcsecToRad;
+  e.position_perpendicularity_z_rad = -0.6 * kArcsecToRad;
+  e.position_wobble_x_rad.terms = {{1, 0.05 * kArcsecToRad, 1.0 * kDegToRad}};
+  e.position_wobble_z_rad.terms = {{2, 0.07 * kArcsecToRad, 2.0 * kDegToRad}};
+  e.position_angle_error_rad = 3.7 * kArcsecToRad;
+  e.mount_misalignment_rad = Eigen::Vector3d(10.0, -20.0, 30.5) * kArcsecToRad;
+  e.lever_arm_m = Eigen::Vector3d(0.01, -0.02, 0.003);
+  for (std::size_t i = 0; i < kNumCoefficients; ++i) s.gyro.values[i] = 0.1 * static_cast<double>(i) - 0.37;
+  s.noise = {0.01, 0.02, 0.03, 0.004, 0.005};
+  s.test.sample_rate_hz = 1000.0;
+  s.test.revolutions = 17;
+  s.test.settle_s = 0.5;
+  s.test.beta_rad = {45.0 * kDegToRad, 135.0 * kDegToRad};
+  s.test.gamma_rad = {10.0 * kDegToRad, 20.0 * kDegToRad, 30.0 * kDegToRad};
+  s.test.rates_rad_s = {0.0, 5.0, -9.9};
+  s.test.seed = 123456789012345ULL;
+  CentrifugeErrors& u = s.uncertainty;
+  u.base_tilt_x_rad = 0.5 * kArcsecToRad;
+  u.counter_perpendicularity_x_rad = 0.3 * kArcsecToRad;
+  u.counter_wobble_x_rad.terms = {{2, 0.2 * kArcsecToRad, 20.0 * kDegToRad}};
+  u.main_runout_x_m.terms = {{1, 1e-7, 0.0}};
+  u.counter_rate_mismatch_rad_s = 1e-7;
+  u.mount_misalignment_rad = Eigen::Vector3d(1.0, 2.0, 3.0) * kArcsecToRad;
+  u.lever_arm_m = Eigen::Vector3d(1e-3, 2e-3, 3e-3);
+  return s;
+}
+
+// ---- round trips and defaults ----------------------------------------------------------------------------
+
+TEST(Config, DefaultScenarioRoundTripsExactly) {
+  expect_same(round_trip(default_scenario()), default_scenario());
+}
+
+TEST(Config, ChangedScenarioRoundTripsExactly) {
+  const Scenario s = changed_scenario();
+  expect_same(round_trip(s), s);
+  // The comparison itself must see the changes.
+  EXPECT_NE(std::bit_cast<std::uint64_t>(s.errors.lever_arm_m.z()),
+            std::bit_cast<std::uint64_t>(default_scenario().errors.lever_arm_m.z()));
+}
+
+TEST(Config, RandomValuesRoundTripBitForBit) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-12, 6);
+  const auto random_value = [&] { return unit(rng) * std::pow(10.0, exponent(rng)); };
+  for (int trial = 0; trial < 300; ++trial) {
+    Scenario s = default_scenario();
+    s.site.latitude_rad = 90.0 * unit(rng) * kDegToRad;
+    s.site.gravity_m_s2 = std::abs(random_value()) + 1e-3;
+    s.centrifuge.rate_rad_s = random_value();
+    s.centrifuge.heading_rad = random_value() * kDegToRad;
+    s.errors.counter_perpendicularity_x_rad = random_value() * kArcsecToRad;
+    s.errors.lever_arm_m = Eigen::Vector3d(random_value(), random_value(), random_value());
+    s.errors.counter_wobble_x_rad.terms = {
+        {3, std::abs(random_value()) * kArcsecToRad, random_value() * kDegToRad}};
+    s.gyro.values[0] = random_value();
+    s.test.gamma_rad = {random_value() * kDegToRad};
+    s.uncertainty.position_angle_error_rad = std::abs(random_value()) * kArcsecToRad;
+    expect_same(round_trip(s), s);
+    if (HasFailure()) break;
+  }
+}
+
+TEST(Config, WrittenFileIsReadableAndUsesTheInterfaceNames) {
+  const std::string text = scenario_to_toml(default_scenario());
+  // Shortest decimal forms: 3 arcsec is written 3.0, not 2.9999999999999996.
+  for (const char* line :
+       {"latitude_deg = 39.13 ", "counter_perpendicularity_x_arcsec = 3.0 ",
+        "counter_perpendicularity_y_arcsec = -2.0 ", "beta_deg = [0.0, 180.0, 90.0, 270.0] ",
+        "counter_wobble_x = [ { harmonic = 2, amplitude_arcsec = 1.0, phase_deg = 20.0 } ]", "[uncertainty]",
+        "[gyro.noise]", "seed = 1 "}) {
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
+  }
+  // Every key line carries a comment.
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.starts_with("#") && line.find(" = ") != std::string::npos) {
+      EXPECT_NE(line.find("  # "), std::string::npos) << line;
+    }
+  }
+}
+
+TEST(Config, EmptyTextGivesTheDefaultScenario) {
+  expect_same(parse_scenario("", "empty.toml"), default_scenario());
+  expect_same(parse_scenario("# only a comment\n\n", "empty.toml"), default_scenario());
+}
+
+TEST(Config, UnitsAreConvertedToSi) {
+  const Scenario s = parse_scenario(
+      "[site]\nlatitude_deg = 45\n"
+      "[centrifuge]\nradius_m = 2\nheading_deg = 90.0\n"
+      "[centrifuge.errors]\ncounter_perpendicularity_x_arcsec = 3.0\n"
+      "main_wobble_y = [ { harmonic = 3, amplitude_arcsec = 2.0, phase_deg = 180.0 } ]\n"
+      "main_runout_x = [ { harmonic = 1, amplitude_m = 1e-6 } ]\n"
+      "mount_misalignment_arcsec = [1.0, -2.0, 0]\n"
+      "[test]\nbeta_deg = [30.0]\n",
+      "units.toml");
+  EXPECT_DOUBLE_EQ(s.site.latitude_rad, std::numbers::pi / 4);
+  EXPECT_EQ(s.centrifuge.radius_m, 2.0);  // an integer where a float is expected
+  EXPECT_DOUBLE_EQ(s.centrifuge.heading_rad, std::numbers::pi / 2);
+  EXPECT_DOUBLE_EQ(s.errors.counter_perpendicularity_x_rad, 3.0 / kArcsecPerRad);
+  ASSERT_EQ(s.errors.main_wobble_y_rad.terms.size(), 1u);
+  EXPECT_EQ(s.errors.main_wobble_y_rad.terms[0].harmonic, 3);
+  EXPECT_DOUBLE_EQ(s.errors.main_wobble_y_rad.terms[0].amplitude, 2.0 / kArcsecPerRad);
+  EXPECT_DOUBLE_EQ(s.errors.main_wobble_y_rad.terms[0].phase_rad, std::numbers::pi);
+  ASSERT_EQ(s.errors.main_runout_x_m.terms.size(), 1u);
+  EXPECT_EQ(s.errors.main_runout_x_m.terms[0].amplitude, 1e-6);  // metres stay metres
+  EXPECT_EQ(s.errors.main_runout_x_m.terms[0].phase_rad, 0.0);
+  EXPECT_DOUBLE_EQ(s.errors.mount_misalignment_rad.y(), -2.0 / kArcsecPerRad);
+  EXPECT_DOUBLE_EQ(s.test.beta_rad.at(0), std::numbers::pi / 6);
+  // Keys not given keep their defaults.
+  EXPECT_EQ(s.errors.counter_perpendicularity_y_rad,
+            default_scenario().errors.counter_perpendicularity_y_rad);
+}
+
+TEST(Config, TestRatesDefaultToTheCentrifugeRate) {
+  const Scenario alone = parse_scenario("[centrifuge]\nrate_rad_s = 5.5\n", "rate.toml");
+  EXPECT_EQ(alone.test.rates_rad_s, std::vector<double>{5.5});
+  const Scenario both =
+      parse_scenario("[centrifuge]\nrate_rad_s = 5.5\n[test]\nrates_rad_s = [0, 3.0]\n", "rate.toml");
+  EXPECT_EQ(both.centrifuge.rate_rad_s, 5.5);
+  EXPECT_EQ(both.test.rates_rad_s, (std::vector<double>{0.0, 3.0}));
+}
+
+TEST(Config, UncertaintySectionIsReadAndDefaultsToZero) {
+  const Scenario none = parse_scenario("", "u.toml");
+  EXPECT_EQ(none.uncertainty.counter_perpendicularity_x_rad, 0.0);
+  EXPECT_TRUE(none.uncertainty.counter_wobble_x_rad.empty());
+  const Scenario s = parse_scenario(
+      "[uncertainty]\ncounter_perpendicularity_x_arcsec = 0.5\n"
+      "counter_wobble_y = [ { harmonic = 2, amplitude_arcsec = 0.25, phase_deg = 70.0 } ]\n",
+      "u.toml");
+  EXPECT_DOUBLE_EQ(s.uncertainty.counter_perpendicularity_x_rad, 0.5 / kArcsecPerRad);
+  ASSERT_EQ(s.uncertainty.counter_wobble_y_rad.terms.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.uncertainty.counter_wobble_y_rad.terms[0].amplitude, 0.25 / kArcsecPerRad);
+  // The nominal errors are untouched by their uncertainties.
+  expect_same(s.errors, default_scenario().errors, "errors.");
+}
+
+// ---- bad values ------------------------------------------------------------------------------------------
+
+/// The error message parse_scenario gives for text (a test failure if it accepts the text).
+std::string error_of(const std::string& text) {
+  try {
+    parse_scenario(text, "bad.toml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return "";
+}
+
+/// Checks that text is refused with a message naming the file, line and key path.
+void expect_refused(const std::string& text, int line, const std::string& key, const std::string& why) {
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find("bad.toml, line " + std::to_string(line) + ":"), std::string::npos) << message;
+  EXPECT_NE(message.find(key), std::string::npos) << message;
+  EXPECT_NE(message.find(why), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
+TEST(ConfigErrors, UnknownKeys) {
+  expect_refused("[site]\nlatitude_deg = 1.0\n\nfoo = 1\n", 4, "site.foo", "unknown key");
+  expect_refused("bar = 1\n", 1, "unknown key bar", "expected one of site, centrifuge");
+  expect_refused("[centrifuge.errors]\nbase_tilt_x = 1.0\n", 2, "centrifuge.errors.base_tilt_x",
+                 "unknown key");
+  expect_refused("[gyro.noise]\nangle_random_walk = 0.1\n", 2, "gyro.noise.angle_random_walk", "unknown key");
+  // A wobble's amplitude is in arcsec, a runout's in metres.
+  expect_refused("[centrifuge.errors]\n\ncounter_wobble_x = [ { harmonic = 2, amplitude_m = 1.0 } ]\n", 3,
+                 "centrifuge.errors.counter_wobble_x[0].amplitude_m", "unknown key");
+  expect_refused("[uncertainty]\nradius_m = 1.0\n", 2, "uncertainty.radius_m", "unknown key");
+}
+
+TEST(ConfigErrors, WrongTypes) {
+  expect_refused("[centrifuge]\nradius_m = \"one\"\n", 2, "centrifuge.radius_m",
+                 "must be a number, not a string");
+  expect_refused("site = 3\n", 1, "site", "must be a table");
+  expect_refused("[test]\nbeta_deg = 90.0\n", 2, "test.beta_deg", "must be an array");
+  expect_refused("[test]\nbeta_deg = [0.0, true]\n", 2, "test.beta_deg[1]",
+                 "must be a number, not a boolean");
+  expect_refused("[centrifuge.errors]\nmain_wobble_x = [ 1.0 ]\n", 2, "centrifuge.errors.main_wobble_x[0]",
+                 "must be a table");
+  expect_refused("[test]\nrevolutions = 10.0\n", 2, "test.revolutions", "must be an integer");
+}
+
+TEST(ConfigErrors, NonFiniteValues) {
+  expect_refused("[site]\n\nlatitude_deg = nan\n", 3, "site.latitude_deg", "finite");
+  expect_refused("[gyro]\ndF = inf\n", 2, "gyro.dF", "finite");
+  expect_refused("[centrifuge.errors]\ncounter_rate_mismatch_rad_s = -inf\n", 2,
+                 "centrifuge.errors.counter_rate_mismatch_rad_s", "finite");
+  expect_refused("[test]\nrates_rad_s = [1.0, nan]\n", 2, "test.rates_rad_s[1]", "finite");
+}
+
+TEST(ConfigErrors, OutOfRange) {
+  expect_refused("[centrifuge]\nradius_m = -1.0\n", 2, "centrifuge.radius_m", "must be > 0, not -1");
+  expect_refused("[centrifuge]\nradius_m = 0\n", 2, "centrifuge.radius_m", "must be > 0");
+  expect_refused("[site]\nlatitude_deg = 91\n", 2, "site.latitude_deg", "between -90 and 90");
+  expect_refused("[site]\ngravity_m_s2 = 0.0\n", 2, "site.gravity_m_s2", "> 0");
+  expect_refused("[site]\nearth_rate_rad_s = -1e-5\n", 2, "site.earth_rate_rad_s", ">= 0");
+  expect_refused("[gyro.noise]\nquantization_deg_h = -0.1\n", 2, "gyro.noise.quantization_deg_h", ">= 0");
+  expect_refused("[test]\nsample_rate_hz = 0\n", 2, "test.sample_rate_hz", "> 0");
+  expect_refused("[test]\nrevolutions = 0\n", 2, "test.revolutions", "integer >= 1");
+  expect_refused("[test]\nsettle_s = -2.0\n", 2, "test.settle_s", ">= 0");
+  expect_refused("[test]\nseed = -1\n", 2, "test.seed", "integer >= 0");
+  expect_refused("[test]\ngamma_deg = []\n", 2, "test.gamma_deg", "must not be empty");
+  expect_refused("[uncertainty]\nbase_tilt_x_arcsec = -0.5\n", 2, "uncertainty.base_tilt_x_arcsec", ">= 0");
+}
+
+TEST(ConfigErrors, BadHarmonics) {
+  const std::string head =
+      "[centrifuge.errors]\nmain_wobble_y = [\n  { harmonic = 1, amplitude_arcsec = 1.0 },\n";
+  expect_refused(head + "  { harmonic = 0, amplitude_arcsec = 1.0 },\n]\n", 4,
+                 "centrifuge.errors.main_wobble_y[1].harmonic", "integer >= 1, not 0");
+  expect_refused(head + "  { harmonic = 1.5 },\n]\n", 4, "centrifuge.errors.main_wobble_y[1].harmonic",
+                 "must be an integer");
+  expect_refused(head + "  { amplitude_arcsec = -1.0 },\n]\n", 4,
+                 "centrifuge.errors.main_wobble_y[1].amplitude_arcsec", ">= 0");
+}
+
+TEST(ConfigErrors, WrongArrayLength) {
+  expect_refused("[centrifuge.errors]\nmount_misalignment_arcsec = [1.0, 2.0]\n", 2,
+                 "centrifuge.errors.mount_misalignment_arcsec", "exactly 3 numbers, not 2");
+  expect_refused("[centrifuge.errors]\nlever_arm_m = [0.0, 0.0, 0.0, 0.0]\n", 2,
+                 "centrifuge.errors.lever_arm_m", "exactly 3 numbers, not 4");
+}
+
+TEST(ConfigErrors, SyntaxError) {
+  const std::string message = error_of("[site]\nlatitude_deg = 1.0\nlatitude_deg = = 3\n");
+  EXPECT_NE(message.find("bad.toml, line 3:"), std::string::npos) << message;
+  EXPECT_NE(message.find("TOML syntax error"), std::string::npos) << message;
+}
+
+// ---- files ----------------------------------------------------------------------------------------------
+
+TEST(ConfigFile, MissingFileIsNamed) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "gyrocal-no-such-dir" / "missing.toml";
+  try {
+    load_scenario(path);
+    ADD_FAILURE() << "a missing file was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConfigFile, LoadsAFileAndNamesItInErrors) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("gyrocal-test-config-" + std::to_string(::getpid()) + ".toml");
+  {
+    std::ofstream out(path);
+    out << scenario_to_toml(changed_scenario());
+  }
+  expect_same(load_scenario(path), changed_scenario());
+  {
+    std::ofstream out(path);
+    out << "[centrifuge]\nradius_m = -3\n";
+  }
+  try {
+    load_scenario(path);
+    ADD_FAILURE() << "a negative radius was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string() + ", line 2: centrifuge.radius_m"), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace gyrocal
