@@ -1,5 +1,6 @@
 #include "gyrocal/model/centrifuge.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -19,12 +20,22 @@ struct Angle {
   double qdd = 0.0;
 };
 
+/// A joint angle x(t) with its cosine and sine, computed once for the joint and all its harmonics.
+struct Joint {
+  double x, xd, xdd, c, s;
+  Joint(double angle, double rate, double accel)
+      : x(angle), xd(rate), xdd(accel), c(std::cos(angle)), s(std::sin(angle)) {}
+};
+
 /// A constant offset plus a harmonic series of a joint angle x(t), with the chain rule:
 /// d/dt h(x) = h'(x) xd,  d2/dt2 h(x) = h''(x) xd^2 + h'(x) xdd.
-Angle through_joint(double constant, const HarmonicSeries& series, double x, double xd, double xdd) {
+Angle through_joint(double constant, const PreparedHarmonicSeries& series, const Joint& j) {
   if (series.empty()) return {constant, 0.0, 0.0};
-  const AngleFunction h = series.evaluate(x);
-  return {constant + h.value, h.d1 * xd, h.d2 * xd * xd + h.d1 * xdd};
+  const AngleFunction h = series.evaluate(j.c, j.s);
+  return {constant + h.value, h.d1 * j.xd, h.d2 * j.xd * j.xd + h.d1 * j.xdd};
+}
+Angle through_joint(double constant, const HarmonicSeries& series, double x) {
+  return {constant + (series.empty() ? 0.0 : series.value(x)), 0.0, 0.0};
 }
 
 /// The motion of a frame along the chain, everything expressed in G: orientation (frame axes -> G),
@@ -40,13 +51,16 @@ struct FrameMotion {
 
   /// Right-multiply the orientation by an elementary rotation E_axis(q(t)) about the current frame's axis.
   void rotate(Axis axis, const Angle& a) {
+    if (a.q == 0.0 && a.qd == 0.0 && a.qdd == 0.0) return;  // an error that is not there
+    rotate(axis, a, std::cos(a.q), std::sin(a.q));
+  }
+  /// The same with cos q and sin q already known.
+  void rotate(Axis axis, const Angle& a, double c, double s) {
     const Vector3d u = rotation.col(axis);  // the joint axis in G; E_axis leaves it unchanged
     angular_acceleration += angular_velocity.cross(u) * a.qd + u * a.qdd;
     angular_velocity += u * a.qd;
     const int i = (axis + 1) % 3;
     const int j = (axis + 2) % 3;
-    const double c = std::cos(a.q);
-    const double s = std::sin(a.q);
     const Vector3d ci = rotation.col(i);
     const Vector3d cj = rotation.col(j);
     rotation.col(i) = c * ci + s * cj;
@@ -54,7 +68,9 @@ struct FrameMotion {
   }
 
   /// Right-multiply the orientation by a constant rotation (no motion of its own).
-  void rotate_constant(const Matrix3d& r) { rotation = rotation * r; }
+  void rotate_constant(const Matrix3d& r) {
+    if (!r.isIdentity(0.0)) rotation = rotation * r;
+  }
 
   /// Move the origin by r(t), given in the current frame with its derivatives in that frame.
   void translate(const Vector3d& r, const Vector3d& rd, const Vector3d& rdd) {
@@ -77,6 +93,34 @@ Matrix3d elementary(Axis axis, double q) {
 
 }  // namespace
 
+PreparedHarmonicSeries::PreparedHarmonicSeries(const HarmonicSeries& series) {
+  for (const HarmonicTerm& t : series.terms) {
+    terms_.push_back({t.harmonic, t.amplitude, std::cos(t.phase_rad), std::sin(t.phase_rad)});
+    max_harmonic_ = std::max(max_harmonic_, t.harmonic);
+  }
+}
+
+AngleFunction PreparedHarmonicSeries::evaluate(double cos_x, double sin_x) const {
+  // cos(n x + phi) = cos nx cos phi - sin nx sin phi, with cos nx, sin nx by angle addition from n - 1.
+  AngleFunction f;
+  double cn = 1.0, sn = 0.0;
+  for (int n = 1; n <= max_harmonic_; ++n) {
+    const double c_next = cn * cos_x - sn * sin_x;
+    sn = sn * cos_x + cn * sin_x;
+    cn = c_next;
+    for (const Term& t : terms_) {
+      if (t.harmonic != n) continue;
+      const double dn = static_cast<double>(n);
+      const double c = cn * t.cos_phase - sn * t.sin_phase;  // cos(n x + phi)
+      const double s = sn * t.cos_phase + cn * t.sin_phase;  // sin(n x + phi)
+      f.value += t.amplitude * c;
+      f.d1 -= t.amplitude * dn * s;
+      f.d2 -= t.amplitude * dn * dn * c;
+    }
+  }
+  return f;
+}
+
 Eigen::Vector3d Site::earth_rate_g() const {
   return earth_rate_rad_s * Vector3d(std::cos(latitude_rad), 0.0, std::sin(latitude_rad));
 }
@@ -88,37 +132,44 @@ CentrifugeModel::CentrifugeModel(const Site& site, const CentrifugeGeometry& geo
   mount_rotation_ = elementary(kZ, errors.mount_misalignment_rad.z()) *
                     elementary(kY, errors.mount_misalignment_rad.y()) *
                     elementary(kX, errors.mount_misalignment_rad.x());
+  prepared_.main_wobble_x = PreparedHarmonicSeries(errors.main_wobble_x_rad);
+  prepared_.main_wobble_y = PreparedHarmonicSeries(errors.main_wobble_y_rad);
+  prepared_.main_runout_x = PreparedHarmonicSeries(errors.main_runout_x_m);
+  prepared_.main_runout_y = PreparedHarmonicSeries(errors.main_runout_y_m);
+  prepared_.counter_wobble_x = PreparedHarmonicSeries(errors.counter_wobble_x_rad);
+  prepared_.counter_wobble_y = PreparedHarmonicSeries(errors.counter_wobble_y_rad);
 }
 
 GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   const CentrifugeErrors& e = model.errors();
-  const double th = j.main_angle_rad, thd = j.main_rate_rad_s, thdd = j.main_accel_rad_s2;
-  const double ps = j.counter_angle_rad, psd = j.counter_rate_rad_s, psdd = j.counter_accel_rad_s2;
+  const CentrifugeModel::PreparedErrors& h = model.prepared();
+  const Joint th(j.main_angle_rad, j.main_rate_rad_s, j.main_accel_rad_s2);
+  const Joint ps(j.counter_angle_rad, j.counter_rate_rad_s, j.counter_accel_rad_s2);
 
   FrameMotion f;
   // R_base; then the main-axis runout, (x, y, 0) in the base frame, a function of theta.
   f.rotate_constant(model.base_rotation());
-  if (!e.main_runout_x_m.empty() || !e.main_runout_y_m.empty()) {
-    const Angle rx = through_joint(0.0, e.main_runout_x_m, th, thd, thdd);
-    const Angle ry = through_joint(0.0, e.main_runout_y_m, th, thd, thdd);
+  if (!h.main_runout_x.empty() || !h.main_runout_y.empty()) {
+    const Angle rx = through_joint(0.0, h.main_runout_x, th);
+    const Angle ry = through_joint(0.0, h.main_runout_y, th);
     f.translate({rx.q, ry.q, 0.0}, {rx.qd, ry.qd, 0.0}, {rx.qdd, ry.qdd, 0.0});
   }
   // R_main(theta) = Ry(perp_y + wobble_y) Rx(perp_x + wobble_x) Rz(theta).
-  f.rotate(kY, through_joint(e.main_perpendicularity_y_rad, e.main_wobble_y_rad, th, thd, thdd));
-  f.rotate(kX, through_joint(e.main_perpendicularity_x_rad, e.main_wobble_x_rad, th, thd, thdd));
-  f.rotate(kZ, {th, thd, thdd});
+  f.rotate(kY, through_joint(e.main_perpendicularity_y_rad, h.main_wobble_y, th));
+  f.rotate(kX, through_joint(e.main_perpendicularity_x_rad, h.main_wobble_x, th));
+  f.rotate(kZ, {th.x, th.xd, th.xdd}, th.c, th.s);
   // The arm: (R0 + radius_error + stretch*omega^2, 0, 0) in the rotating main-axis frame.
   const double stretch = e.radius_stretch_m_per_rad2_s2;
-  f.translate({model.geometry().radius_m + e.radius_error_m + stretch * thd * thd, 0.0, 0.0},
-              {2.0 * stretch * thd * thdd, 0.0, 0.0}, {2.0 * stretch * thdd * thdd, 0.0, 0.0});
+  f.translate({model.geometry().radius_m + e.radius_error_m + stretch * th.xd * th.xd, 0.0, 0.0},
+              {2.0 * stretch * th.xd * th.xdd, 0.0, 0.0}, {2.0 * stretch * th.xdd * th.xdd, 0.0, 0.0});
   // R_count(psi_r) = Ry(perp_y + wobble_y) Rx(perp_x + wobble_x) Rz(psi_r).
-  f.rotate(kY, through_joint(e.counter_perpendicularity_y_rad, e.counter_wobble_y_rad, ps, psd, psdd));
-  f.rotate(kX, through_joint(e.counter_perpendicularity_x_rad, e.counter_wobble_x_rad, ps, psd, psdd));
-  f.rotate(kZ, {ps, psd, psdd});
+  f.rotate(kY, through_joint(e.counter_perpendicularity_y_rad, h.counter_wobble_y, ps));
+  f.rotate(kX, through_joint(e.counter_perpendicularity_x_rad, h.counter_wobble_x, ps));
+  f.rotate(kZ, {ps.x, ps.xd, ps.xdd}, ps.c, ps.s);
   // R_pos(beta) = Rz(perp_z + wobble_z(beta')) Rx(perp_x + wobble_x(beta')) Ry(-beta'), held during a dwell.
   const double beta = j.position_angle_rad + e.position_angle_error_rad;
-  f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta, 0.0, 0.0));
-  f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta, 0.0, 0.0));
+  f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta));
+  f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta));
   f.rotate(kY, {-beta, 0.0, 0.0});
   // The gyro centre's offset in position-platform axes, then the mounting misalignment.
   if (!e.lever_arm_m.isZero(0.0)) f.translate(e.lever_arm_m);

@@ -4,6 +4,8 @@
 //
 // Following Pinocchio's model/data split, CentrifugeModel is constant once built (geometry, errors and
 // what can be precomputed from them); evaluation is a free function of the model and a joint state.
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "gyrocal/core/harmonic.hpp"
@@ -78,6 +80,24 @@ struct GyroInputs {
   Eigen::Vector3d specific_force_g = Eigen::Vector3d::Zero();  ///< specific force, in the site's g
 };
 
+/// A harmonic series prepared for fast evaluation from cos x and sin x (phases' sines precomputed).
+class PreparedHarmonicSeries {
+ public:
+  PreparedHarmonicSeries() = default;
+  explicit PreparedHarmonicSeries(const HarmonicSeries& series);
+  bool empty() const { return terms_.empty(); }
+  /// h(x), h'(x), h''(x) given cos x and sin x (cos nx, sin nx by the Chebyshev recurrence).
+  AngleFunction evaluate(double cos_x, double sin_x) const;
+
+ private:
+  struct Term {
+    int harmonic;
+    double amplitude, cos_phase, sin_phase;
+  };
+  std::vector<Term> terms_;
+  int max_harmonic_ = 0;
+};
+
 /// The centrifuge: site, nominal geometry and errors, immutable once built.
 class CentrifugeModel {
  public:
@@ -95,6 +115,13 @@ class CentrifugeModel {
   /// R_mount = Rz(mis_S) Ry(mis_O) Rx(mis_I).
   const Eigen::Matrix3d& mount_rotation() const { return mount_rotation_; }
 
+  /// The wobbles and runouts of the main axis (of theta) and of the counter platform (of psi_r), prepared.
+  struct PreparedErrors {
+    PreparedHarmonicSeries main_wobble_x, main_wobble_y, main_runout_x, main_runout_y;
+    PreparedHarmonicSeries counter_wobble_x, counter_wobble_y;
+  };
+  const PreparedErrors& prepared() const { return prepared_; }
+
  private:
   Site site_;
   CentrifugeGeometry geometry_;
@@ -102,6 +129,7 @@ class CentrifugeModel {
   Eigen::Vector3d earth_rate_g_;
   Eigen::Matrix3d base_rotation_;
   Eigen::Matrix3d mount_rotation_;
+  PreparedErrors prepared_;
 };
 
 /// Exact inertial rate and specific force in gyro axes (MODEL.md section 4), with analytic derivatives of
