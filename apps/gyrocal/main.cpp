@@ -1,7 +1,29 @@
 // gyrocal: the command line (INTERFACE.md). Parsing arguments and printing only; no physics here.
-#include <cstdio>
+#include <exception>
 
-int main() {
-  std::puts("gyrocal");
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "cli.hpp"
+#include "gyrocal/core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "gyrocal: calibrate a gyroscope's drift coefficients on a centrifuge with a counter-rotating platform"};
+  app.require_subcommand(1);
+  gyrocal::cli::register_demo(app);
+  gyrocal::cli::register_init(app);
+  gyrocal::cli::register_inputs(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const gyrocal::Error& e) {
+    fmt::print(stderr, "gyrocal: {}\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "gyrocal: internal error: {}\n", e.what());
+    return 2;
+  }
   return 0;
 }

@@ -1,0 +1,31 @@
+#include "cli.hpp"
+
+#include <filesystem>
+#include <iostream>
+
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/core/atomic_file.hpp"
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal::cli {
+
+Scenario load_configuration(const std::string& path) {
+  return path.empty() ? default_scenario() : load_scenario(path);
+}
+
+void write_output(const std::string& path, std::string_view content, bool overwrite) {
+  if (path == "-") {
+    std::cout << content << std::flush;
+    return;
+  }
+  write_file_atomically(path, content, overwrite);
+}
+
+void refuse_to_overwrite_input(const std::string& output, const std::string& input) {
+  if (output.empty() || output == "-" || input.empty()) return;
+  std::error_code ec;
+  if (std::filesystem::equivalent(output, input, ec))
+    throw Error("refusing to write " + output + ": it is the input " + input + ".");
+}
+
+}  // namespace gyrocal::cli

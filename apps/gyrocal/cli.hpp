@@ -1,0 +1,28 @@
+#pragma once
+// Shared pieces of the command line: reading the configuration, writing outputs. No physics here.
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <CLI/CLI.hpp>
+
+#include "gyrocal/config/scenario.hpp"
+
+namespace gyrocal::cli {
+
+/// The built-in default scenario, or the configuration file at `path` when it is not empty.
+Scenario load_configuration(const std::string& path);
+
+/// Write `content` to `path`: standard output for "-", else atomically (temporary file, then rename).
+/// An existing file is replaced only when `overwrite`.
+void write_output(const std::string& path, std::string_view content, bool overwrite);
+
+/// Refuse an output path that names one of the inputs (no input is ever overwritten).
+void refuse_to_overwrite_input(const std::string& output, const std::string& input);
+
+/// Each subcommand registers itself on the application.
+void register_init(CLI::App& app);
+void register_inputs(CLI::App& app);
+void register_demo(CLI::App& app);
+
+}  // namespace gyrocal::cli

@@ -1,0 +1,73 @@
+// gyrocal inputs: exact and nominal inputs to the gyro at one instant.
+#include <fmt/format.h>
+
+#include "cli.hpp"
+#include "gyrocal/model/instant.hpp"
+#include "gyrocal/result/inputs_json.hpp"
+
+namespace gyrocal::cli {
+namespace {
+
+std::string inputs_table(const InstantInputs& in) {
+  const auto& j = in.joints;
+  std::string s;
+  s += fmt::format("time                 {:.9f} s\n", in.time_s);
+  s += fmt::format("main angle theta     {:.9f} deg   rate {:.9f} rad/s\n", j.main_angle_rad * kRadToDeg,
+                   j.main_rate_rad_s);
+  s += fmt::format("counter angle psi_r  {:.9f} deg   rate {:.9f} rad/s\n", j.counter_angle_rad * kRadToDeg,
+                   j.counter_rate_rad_s);
+  s += fmt::format("beta                 {:.6f} deg\ngamma                {:.9f} deg\n\n",
+                   j.position_angle_rad * kRadToDeg, j.gamma_rad() * kRadToDeg);
+  s += fmt::format("{:<10}{:>22}{:>22}{:>22}\n", "", "exact", "nominal", "exact - nominal");
+  s += fmt::format("{:<10}{:>22.12e}{:>22.12e}{:>22.3e}  rad/s\n", "omega_I", in.exact.rate_rad_s.x(),
+                   in.nominal.omega_I_rad_s, in.exact.rate_rad_s.x() - in.nominal.omega_I_rad_s);
+  s += fmt::format("{:<10}{:>22.12e}{:>22}{:>22}  rad/s\n", "omega_O", in.exact.rate_rad_s.y(), "", "");
+  s += fmt::format("{:<10}{:>22.12e}{:>22}{:>22}  rad/s\n", "omega_S", in.exact.rate_rad_s.z(), "", "");
+  const double nominal_f[3] = {in.nominal.a_I_g, in.nominal.a_O_g, in.nominal.a_S_g};
+  const char* names[3] = {"a_I", "a_O", "a_S"};
+  for (int k = 0; k < 3; ++k)
+    s += fmt::format("{:<10}{:>22.12f}{:>22.12f}{:>22.3e}  g\n", names[k], in.exact.specific_force_g[k],
+                     nominal_f[k], in.exact.specific_force_g[k] - nominal_f[k]);
+  return s;
+}
+
+}  // namespace
+
+void register_inputs(CLI::App& app) {
+  struct Options {
+    std::string config, json;
+    double beta_deg = 0.0, time_s = 0.0, gamma_deg = 0.0;
+    int revolution = 0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("inputs", "Exact and nominal inputs to the gyro at one instant");
+  sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
+  sub->add_option("--beta-deg", opt->beta_deg, "Position-platform angle beta, deg")->required();
+  CLI::Option* time = sub->add_option("--time-s", opt->time_s, "Time since the start of the dwell, s");
+  CLI::Option* gamma =
+      sub->add_option("--gamma-deg", opt->gamma_deg, "Arm angle gamma seen from the platform, deg");
+  CLI::Option* rev = sub->add_option("--revolution", opt->revolution,
+                                     "Main-axis revolution (from 0) in which gamma is taken")
+                         ->check(CLI::NonNegativeNumber)
+                         ->needs(gamma);
+  time->excludes(gamma)->excludes(rev);
+  sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  sub->require_option(0);
+  sub->callback([opt, time, gamma] {
+    if (time->count() == 0 && gamma->count() == 0)
+      throw CLI::ValidationError("inputs", "give the instant with --time-s T or --gamma-deg G");
+    const Scenario s = load_configuration(opt->config);
+    const CentrifugeModel model = s.model();
+    const double rate = s.centrifuge.rate_rad_s, beta = opt->beta_deg * kDegToRad;
+    const InstantInputs in =
+        time->count() ? inputs_at_time(model, rate, beta, opt->time_s)
+                      : inputs_at_gamma(model, rate, beta, opt->gamma_deg * kDegToRad, opt->revolution);
+    if (!opt->json.empty()) {
+      refuse_to_overwrite_input(opt->json, opt->config);
+      write_output(opt->json, inputs_to_json(in).dump(2) + "\n", true);
+    }
+    if (opt->json != "-") fmt::print("{}", inputs_table(in));
+  });
+}
+
+}  // namespace gyrocal::cli

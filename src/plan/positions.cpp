@@ -1,0 +1,14 @@
+#include "gyrocal/plan/positions.hpp"
+
+namespace gyrocal {
+
+std::vector<Position> test_positions(const TestSpec& test) {
+  std::vector<Position> out;
+  int index = 1;
+  for (double rate : test.rates_rad_s)
+    for (double beta : test.beta_rad)
+      for (double gamma : test.gamma_rad) out.push_back({index++, rate, beta, gamma});
+  return out;
+}
+
+}  // namespace gyrocal
