@@ -1,6 +1,7 @@
 // The configuration file: round trips, units, defaults, and every kind of bad value refused with its key
 // and line (INTERFACE.md, "Configuration (TOML)").
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -208,6 +209,30 @@ TEST(Config, WrittenFileIsReadableAndUsesTheInterfaceNames) {
   for (std::string line; std::getline(lines, line);) {
     if (!line.starts_with("#") && line.find(" = ") != std::string::npos) {
       EXPECT_NE(line.find("  # "), std::string::npos) << line;
+    }
+  }
+}
+
+/// k/100 as a TOML float: "-127.96", "0.07", "3.0".
+std::string hundredths_text(int k) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, k / 100.0);
+  std::string text(buffer, result.ptr);
+  if (text.find_first_of(".e") == std::string::npos) text += ".0";
+  return text;
+}
+
+TEST(Config, AnglesAreWrittenBackAsTyped) {
+  // Dividing by the unit factor alone gives e.g. 127.96000000000001 deg for 127.96 deg (about one value in
+  // ten with two decimals): the writer must find the shortest number that reads back to the same radians.
+  for (int k = -20000; k <= 20000; k += 13) {
+    const std::string value = hundredths_text(k);
+    for (const char* key : {"heading_deg", "counter_perpendicularity_x_arcsec"}) {
+      const std::string section =
+          std::string(key) == "heading_deg" ? "[centrifuge]\n" : "[centrifuge.errors]\n";
+      const std::string line = std::string(key) + " = " + value;
+      const std::string text = scenario_to_toml(parse_scenario(section + line + "\n", "typed.toml"));
+      ASSERT_NE(text.find(line + " "), std::string::npos) << line;
     }
   }
 }
