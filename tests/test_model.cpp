@@ -55,13 +55,14 @@ struct Pose {
   Matrix3r r;
   Vector3r p;
 };
-// theta(t) = theta0 + omega*t + accel*t^2/2 (accel != 0: spinning up).
-Pose pose_at(const CentrifugeModel& m, double omega, double beta, Real t, double accel = 0) {
+// theta(t) = theta0 + omega*t + accel*t^2/2 (accel != 0: spinning up); beta(t) = beta + beta_rate*t.
+Pose pose_at(const CentrifugeModel& m, double omega, double beta, Real t, double accel = 0,
+             double beta_rate = 0) {
   const CentrifugeErrors& e = m.errors();
   const Real th = m.geometry().initial_main_angle_rad + omega * t + accel * t * t / 2;
   const Real thd = omega + accel * t;
   const Real ps = -th + m.geometry().heading_rad + e.counter_rate_mismatch_rad_s * t;
-  const Real bp = Real(beta) + e.position_angle_error_rad;
+  const Real bp = Real(beta) + beta_rate * t + e.position_angle_error_rad;
   const Matrix3r base = ry_l(e.base_tilt_y_rad) * rx_l(e.base_tilt_x_rad);
   const Matrix3r main = ry_l(e.main_perpendicularity_y_rad + series_l(e.main_wobble_y_rad, th)) *
                         rx_l(e.main_perpendicularity_x_rad + series_l(e.main_wobble_x_rad, th)) * rz_l(th);
@@ -83,15 +84,16 @@ Pose pose_at(const CentrifugeModel& m, double omega, double beta, Real t, double
 
 // Inputs from the pose by 8th-order central differences (weights of f' and f'' at offsets 1..4).
 GyroInputs finite_difference_inputs(const CentrifugeModel& m, double omega, double beta, double t,
-                                    double accel = 0) {
+                                    double accel = 0, double beta_rate = 0) {
   const Real h = 1e-3L;
   const Real d1[] = {4.0L / 5, -1.0L / 5, 4.0L / 105, -1.0L / 280};
   const Real d2[] = {8.0L / 5, -1.0L / 5, 8.0L / 315, -1.0L / 560};
-  const Pose c = pose_at(m, omega, beta, t, accel);
+  const Pose c = pose_at(m, omega, beta, t, accel, beta_rate);
   Matrix3r rdot = Matrix3r::Zero();
   Vector3r pdot = Vector3r::Zero(), pddot = -205.0L / 72 * c.p;
   for (int k = 1; k <= 4; ++k) {
-    const Pose a = pose_at(m, omega, beta, t + k * h, accel), b = pose_at(m, omega, beta, t - k * h, accel);
+    const Pose a = pose_at(m, omega, beta, t + k * h, accel, beta_rate);
+    const Pose b = pose_at(m, omega, beta, t - k * h, accel, beta_rate);
     rdot += d1[k - 1] * (a.r - b.r) / h;
     pdot += d1[k - 1] * (a.p - b.p) / h;
     pddot += d2[k - 1] * (a.p + b.p);
@@ -171,7 +173,7 @@ TEST(ExactModel, AgreesWithFiniteDifferenceOfThePoseForRandomErrors) {
   }
 }
 
-TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAccelerates) {
+TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAcceleratesAndThePlatformTurns) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int trial = 0; trial < 20; ++trial) {
@@ -179,6 +181,7 @@ TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAccelerates) {
     geo.initial_main_angle_rad = kPi * u(rng);
     const CentrifugeModel m(Site{}, geo, random_errors(rng, 1 * kDeg));
     const double omega = 5 * u(rng), accel = 2 * u(rng), beta = kPi * u(rng), t = 3 * std::abs(u(rng));
+    const double beta_rate = 0.2 * u(rng);
     // The joints as the machine drives them: psi_r = -theta + psi0 + delta_omega*t.
     JointState j;
     j.main_angle_rad = geo.initial_main_angle_rad + omega * t + accel * t * t / 2;
@@ -187,9 +190,10 @@ TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAccelerates) {
     j.counter_angle_rad = -j.main_angle_rad + geo.heading_rad + m.errors().counter_rate_mismatch_rad_s * t;
     j.counter_rate_rad_s = -j.main_rate_rad_s + m.errors().counter_rate_mismatch_rad_s;
     j.counter_accel_rad_s2 = -accel;
-    j.position_angle_rad = beta;
+    j.position_angle_rad = beta + beta_rate * t;
+    j.position_rate_rad_s = beta_rate;
     const GyroInputs exact = exact_inputs(m, j);
-    const GyroInputs fd = finite_difference_inputs(m, omega, beta, t, accel);
+    const GyroInputs fd = finite_difference_inputs(m, omega, beta, t, accel, beta_rate);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(exact.rate_rad_s[k], fd.rate_rad_s[k], 1e-9) << "trial " << trial << " axis " << k;
       EXPECT_NEAR(exact.specific_force_g[k], fd.specific_force_g[k], 1e-9)

@@ -34,8 +34,10 @@ Angle through_joint(double constant, const PreparedHarmonicSeries& series, const
   const AngleFunction h = series.evaluate(j.c, j.s);
   return {constant + h.value, h.d1 * j.xd, h.d2 * j.xd * j.xd + h.d1 * j.xdd};
 }
-Angle through_joint(double constant, const HarmonicSeries& series, double x) {
-  return {constant + (series.empty() ? 0.0 : series.value(x)), 0.0, 0.0};
+Angle through_joint(double constant, const HarmonicSeries& series, double x, double xd, double xdd) {
+  if (series.empty()) return {constant, 0.0, 0.0};
+  const AngleFunction h = series.evaluate(x);
+  return {constant + h.value, h.d1 * xd, h.d2 * xd * xd + h.d1 * xdd};
 }
 
 /// The motion of a frame along the chain, everything expressed in G: orientation (frame axes -> G),
@@ -166,11 +168,12 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   f.rotate(kY, through_joint(e.counter_perpendicularity_y_rad, h.counter_wobble_y, ps));
   f.rotate(kX, through_joint(e.counter_perpendicularity_x_rad, h.counter_wobble_x, ps));
   f.rotate(kZ, {ps.x, ps.xd, ps.xdd}, ps.c, ps.s);
-  // R_pos(beta) = Rz(perp_z + wobble_z(beta')) Rx(perp_x + wobble_x(beta')) Ry(-beta'), held during a dwell.
+  // R_pos(beta) = Rz(perp_z + wobble_z(beta')) Rx(perp_x + wobble_x(beta')) Ry(-beta').
   const double beta = j.position_angle_rad + e.position_angle_error_rad;
-  f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta));
-  f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta));
-  f.rotate(kY, {-beta, 0.0, 0.0});
+  const double bd = j.position_rate_rad_s, bdd = j.position_accel_rad_s2;
+  f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta, bd, bdd));
+  f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta, bd, bdd));
+  f.rotate(kY, {-beta, -bd, -bdd});
   // The gyro centre's offset in position-platform axes, then the mounting misalignment.
   if (!e.lever_arm_m.isZero(0.0)) f.translate(e.lever_arm_m);
   f.rotate_constant(model.mount_rotation());

@@ -68,7 +68,9 @@ struct JointState {
   double counter_angle_rad = 0.0;   ///< psi_r, relative to the arm
   double counter_rate_rad_s = 0.0;  ///< d psi_r / dt
   double counter_accel_rad_s2 = 0.0;
-  double position_angle_rad = 0.0;  ///< beta, held during a dwell
+  double position_angle_rad = 0.0;   ///< beta (commanded; the model adds the angle error)
+  double position_rate_rad_s = 0.0;  ///< d beta / dt: zero during a dwell, not while the platform moves
+  double position_accel_rad_s2 = 0.0;
 
   /// gamma = -psi_r: the arm's radial direction seen from the platform (MODEL.md section 3), rad.
   double gamma_rad() const { return -counter_angle_rad; }
