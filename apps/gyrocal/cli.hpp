@@ -24,5 +24,11 @@ void refuse_to_overwrite_input(const std::string& output, const std::string& inp
 void register_init(CLI::App& app);
 void register_inputs(CLI::App& app);
 void register_demo(CLI::App& app);
+void register_simulate(CLI::App& app);
+void register_calibrate(CLI::App& app);
+void register_plan(CLI::App& app);
+void register_sensitivity(CLI::App& app);
+void register_montecarlo(CLI::App& app);
+void register_report(CLI::App& app);
 
 }  // namespace gyrocal::cli

@@ -14,6 +14,12 @@ int main(int argc, char** argv) {
   gyrocal::cli::register_demo(app);
   gyrocal::cli::register_init(app);
   gyrocal::cli::register_inputs(app);
+  gyrocal::cli::register_simulate(app);
+  gyrocal::cli::register_calibrate(app);
+  gyrocal::cli::register_plan(app);
+  gyrocal::cli::register_sensitivity(app);
+  gyrocal::cli::register_montecarlo(app);
+  gyrocal::cli::register_report(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,13 @@
+// gyrocal montecarlo (INTERFACE.md). Placeholder until its issue lands.
+#include "cli.hpp"
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal::cli {
+
+void register_montecarlo(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand("montecarlo", "(not yet available)");
+  sub->allow_extras();
+  sub->callback([] { throw Error("'gyrocal montecarlo' is not available yet in this version."); });
+}
+
+}  // namespace gyrocal::cli

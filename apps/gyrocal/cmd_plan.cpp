@@ -1,0 +1,13 @@
+// gyrocal plan (INTERFACE.md). Placeholder until its issue lands.
+#include "cli.hpp"
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal::cli {
+
+void register_plan(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand("plan", "(not yet available)");
+  sub->allow_extras();
+  sub->callback([] { throw Error("'gyrocal plan' is not available yet in this version."); });
+}
+
+}  // namespace gyrocal::cli
