@@ -18,6 +18,7 @@ namespace gyrocal {
 namespace {
 
 constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+constexpr std::size_t kDirectBytes = std::size_t{64} << 10;
 
 std::string errno_text(int error) {
   return std::error_code(error, std::generic_category()).message();
@@ -76,18 +77,14 @@ class AtomicOutputFile::Buffer : public std::streambuf {
 
   std::streamsize xsputn(const char* s, std::streamsize n) override {
     const auto count = static_cast<std::size_t>(n);
-    const auto room = static_cast<std::size_t>(epptr() - pptr());
-    if (count <= room) {
+    if (count >= kDirectBytes) {
+      // Large blocks (e.g. a RecordWriter's buffer) skip the copy.
+      flush_buffer();
+      write_all(s, count);
+    } else {
+      if (count > static_cast<std::size_t>(epptr() - pptr())) flush_buffer();
       std::copy(s, s + count, pptr());
       pbump(static_cast<int>(count));
-    } else {
-      flush_buffer();
-      if (count < data_.size()) {
-        std::copy(s, s + count, pptr());
-        pbump(static_cast<int>(count));
-      } else {
-        write_all(s, count);  // large blocks bypass the buffer
-      }
     }
     return n;
   }
