@@ -61,7 +61,8 @@ class RecordWriter {
   /// Writes the magic line, `metadata` and the header (the five required columns, then
   /// `extra_columns`, e.g. {"temperature_c"}). Throws gyrocal::Error for a metadata key that is empty
   /// or holds '=', a key or value holding a line break, or an extra column name that is not
-  /// [A-Za-z0-9_]+, repeats a name, or exceeds kMaxExtraColumns.
+  /// [A-Za-z0-9_]+, repeats a name, or exceeds kMaxExtraColumns. Spaces around a key or value do not
+  /// survive a round trip (the reader trims them).
   RecordWriter(std::ostream& out, const RecordMetadata& metadata,
                const std::vector<std::string>& extra_columns);
   /// Flushes what finish() has not (errors are ignored here; call finish() to see them).
