@@ -214,7 +214,8 @@ bool same_bits(double a, double b) {
 }
 
 /// The value in the file's unit that the reader turns back into si exactly (as value * to_si); among the
-/// candidates, the one with the shortest text, so that 3 arcsec is written 3.0 and not 2.9999999999999996.
+/// candidates, the one with the shortest text: 127.96 deg is read as 127.96 * kDegToRad, and dividing that
+/// by kDegToRad gives 127.96000000000001, a neighbour that reads back to the same radians.
 double in_file_unit(double si, double to_si) {
   const double guess = si / to_si;
   if (to_si == 1.0 || !std::isfinite(guess)) return guess;
@@ -287,8 +288,8 @@ class Reader {
   /// A number (integer or float), finite and within range, in the file's unit.
   double number(const toml::node& node, const std::string& path, const Range& range) const {
     double value = 0.0;
-    if (const auto* integer = node.as_integer()) {
-      value = static_cast<double>(integer->get());
+    if (const auto* whole = node.as_integer()) {
+      value = static_cast<double>(whole->get());
     } else if (const auto* floating = node.as_floating_point()) {
       value = floating->get();
     } else {
@@ -304,9 +305,9 @@ class Reader {
   /// An integer in [min, max].
   std::int64_t integer(const toml::node& node, const std::string& path, std::int64_t min,
                        std::int64_t max) const {
-    const auto* integer = node.as_integer();
-    if (integer == nullptr) fail(node.source(), path + " must be an integer, not " + type_name(node));
-    const std::int64_t value = integer->get();
+    const auto* whole = node.as_integer();
+    if (whole == nullptr) fail(node.source(), path + " must be an integer, not " + type_name(node));
+    const std::int64_t value = whole->get();
     if (value < min)
       fail(node.source(),
            path + " must be an integer >= " + std::to_string(min) + ", not " + std::to_string(value));
