@@ -25,8 +25,8 @@ struct AllanDeviation {
 };
 
 /// About points_per_decade (>= 1) distinct cluster sizes from 1 to floor(sample_count / 2), spaced
-/// logarithmically (round(10^(j / points_per_decade)), j = 0, 1, ...), increasing. Empty when sample_count
-/// < 2.
+/// logarithmically (round(10^(j / points_per_decade)), j = 0, 1, ...), increasing; none for fewer than 2
+/// samples.
 std::vector<std::size_t> log_spaced_cluster_sizes(std::size_t sample_count, int points_per_decade = 10);
 
 /// Overlapping Allan deviation of rate (any unit) sampled at sample_rate_hz (> 0) for each cluster size m of

@@ -2,17 +2,15 @@
 // A reproducible random source: the same seed gives the same sequence bit for bit on any platform and
 // compiler (docs/noise.md, "Reproducibility").
 //
-// - Generator: xoshiro256** 1.0 (Blackman & Vigna 2018), its 256-bit state filled by splitmix64 from a 64-bit
-//   seed, as the authors recommend. Both are specified by integer arithmetic, hence exact everywhere.
+// - Generator: xoshiro256** 1.0 (Blackman & Vigna 2018), its 256-bit state filled by splitmix64 from a
+//   64-bit seed, as the authors recommend. Both are integer arithmetic, hence exact everywhere.
 // - Streams: derive_stream_seed(seed, k) hashes (seed, k) with splitmix64's finaliser, so that Monte Carlo
-// trial k
-//   or noise component k draws from its own stream whatever the number of threads or the order of the work.
-// - Normal deviates: Marsaglia's polar method (Marsaglia & Bray 1964) instead of std::normal_distribution,
-// whose
-//   algorithm is implementation-defined. It needs only +, -, *, /, sqrt (correctly rounded by IEEE 754) and a
-//   logarithm; portable_log below is built from those operations alone, since std::log may differ in the last
-//   bit between C libraries. The implementation files are compiled without floating-point contraction (no
-//   FMA), which would otherwise change the rounding on some targets.
+//   trial k or noise term k draws from its own stream whatever the number of threads or the order of work.
+// - Normal deviates: Marsaglia's polar method (Marsaglia & Bray 1964), not std::normal_distribution, whose
+//   algorithm is implementation-defined. It needs only +, -, *, /, sqrt (correctly rounded by IEEE 754) and
+//   a logarithm; portable_log below is built from those operations alone, since std::log may differ in the
+//   last bit between C libraries. The implementation files forbid floating-point contraction (FMA), which
+//   would otherwise change the rounding on some targets; do not build with -ffast-math.
 #include <array>
 #include <cstdint>
 
