@@ -1,0 +1,96 @@
+#pragma once
+// Identify the drift coefficients from a reduced record (MODEL.md sections 8 and 9): the seed's closed
+// forms or general weighted least squares, with compensation none, seed or full.
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/least_squares.hpp"
+#include "gyrocal/plan/test_spec.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+
+namespace gyrocal {
+
+enum class Method { kClosedForm, kLeastSquares };
+
+/// Every choice of a calibration, with its default; IsValid() checks them in one place.
+struct CalibrationOptions {
+  Method method = Method::kLeastSquares;            ///< default: least squares, any plan
+  Compensation compensation = Compensation::kFull;  ///< default: every configured machine error
+  ReduceOptions reduce;                             ///< how dwells are reduced
+  LeastSquaresOptions least_squares;                ///< the solver's options
+  /// Reduced positions whose standard error is below this (a noise-free record) are weighted with it,
+  /// deg/h. Default 1e-9.
+  double min_std_err_deg_h = 1e-9;
+  /// A direction of the coefficients is unidentifiable when its predicted standard uncertainty is more
+  /// than this many times that of the best-determined direction (both from the same weights, so the
+  /// judgement does not depend on the noise level). Default 1e4.
+  double max_uncertainty_ratio = 1e4;
+  /// A coefficient (or combination) is reported as identifiable when its share along the unidentifiable
+  /// directions, in equilibrated coordinates, is at most this. Default 1e-4: exact regressors tilt the
+  /// unidentifiable direction of a single-speed plan by ~1e-6 off MODEL.md's, onto every coefficient.
+  double estimable_tolerance = 1e-4;
+
+  bool IsValid(std::string* error) const;
+};
+
+/// A coefficient's estimate; value and std are NaN when it is not identifiable.
+struct CoefficientEstimate {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  double std = std::numeric_limits<double>::quiet_NaN();
+  bool identifiable = false;
+};
+
+struct NamedEstimate {
+  std::string name;
+  std::string unit;
+  double value = 0.0;
+  double std = std::numeric_limits<double>::quiet_NaN();
+  /// For a combination: its coefficients on dF..dOS as estimated. With exact regressors the unidentifiable
+  /// direction is not exactly MODEL.md's, so the estimable combination differs from the named one in the
+  /// sixth digit or so; these are the coefficients of the one actually estimated. Empty otherwise.
+  std::vector<double> coefficients;
+};
+
+struct CalibrationResult {
+  Method method = Method::kLeastSquares;
+  Compensation compensation = Compensation::kFull;
+  double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
+  std::array<CoefficientEstimate, kNumCoefficients> coefficients;
+  std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
+  std::vector<NamedEstimate> alternatives;  ///< closed form's second expressions (dI_1g, ...)
+  std::vector<ReducedPosition> positions;   ///< the reduced positions
+  std::vector<double> residuals_deg_h;      ///< per position: W - model at the estimate (least squares)
+  std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
+  int rank = 0;
+  double condition_number = 0.0;
+  double chi2 = 0.0;
+  int dof = 0;
+  std::vector<std::string> warnings;
+
+  /// One line: method, compensation, rank, condition, warnings.
+  std::string BriefReport() const;
+};
+
+std::string to_string(Method m);
+std::string to_string(Compensation c);
+/// "closed-form" / "least-squares" and "none" / "seed" / "full", as on the command line.
+Method parse_method(const std::string& text);
+Compensation parse_compensation(const std::string& text);
+
+/// Identify from a reduction and its model channels (identify/channels.hpp).
+CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+                           const CentrifugeModel& model, const TestSpec& plan,
+                           const CalibrationOptions& options);
+
+/// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
+CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
+                                   const TestSpec& plan, const CalibrationOptions& options);
+
+/// The 16 positions of MODEL.md section 7 in the plan, at its first spinning rate: for k = 1..16 the index
+/// into reduction.positions, or an empty vector when the plan does not hold them.
+std::vector<int> sixteen_positions(const std::vector<ReducedPosition>& positions);
+
+}  // namespace gyrocal

@@ -1,0 +1,45 @@
+#pragma once
+// The model's side of each reduced position: omega_I and the drift regressors, exact (MODEL.md section 4)
+// and nominal (section 5), evaluated on each dwell's samples and reduced by the very operator that
+// reduced the gyro output (reduce/dwell_accumulator.hpp).
+#include <array>
+#include <vector>
+
+#include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/model/gyro.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+
+namespace gyrocal {
+
+/// What is subtracted from the measurements before identification (MODEL.md section 8).
+enum class Compensation {
+  kNone,  ///< nothing known of the machine's errors: nominal inputs of a perfect machine
+  kSeed,  ///< the seed's terms (k1 cos g - k2 sin g) w cos b + dw sin b from the configured errors
+  kFull,  ///< omega_I(exact) - omega_I(nominal) from every configured error; exact regressors
+};
+
+/// Reduced model channels at one position.
+struct PositionChannels {
+  double omega_exact_deg_h = 0.0;    ///< omega_I of the exact model, deg/h
+  double omega_nominal_deg_h = 0.0;  ///< omega_I of section 5 for a perfect machine, deg/h
+  double omega_seed_deg_h = 0.0;     ///< omega_I of section 5 with the seed's k1, k2, dw, deg/h
+  std::array<double, kNumCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
+  std::array<double, kNumCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
+
+  /// The omega_I the compensation assumes, deg/h.
+  double omega_deg_h(Compensation c) const {
+    return c == Compensation::kFull   ? omega_exact_deg_h
+           : c == Compensation::kSeed ? omega_seed_deg_h
+                                      : omega_nominal_deg_h;
+  }
+  /// The regressors the compensation assumes: exact with full compensation, nominal otherwise.
+  const std::array<double, kNumCoefficients>& regressors(Compensation c) const {
+    return c == Compensation::kFull ? regressors_exact : regressors_nominal;
+  }
+};
+
+/// Channels of every position of `reduction`, in its order, for `model`.
+std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                    const ReduceOptions& options);
+
+}  // namespace gyrocal

@@ -1,0 +1,117 @@
+#pragma once
+// The reduction of one dwell: a linear operator from a dwell's samples to one value per gamma of the
+// plan. The same operator reduces the gyro output and, in the identify stage, the model's channels
+// (omega_I and the drift regressors) evaluated on the dwell's samples, so that
+//   reduce(W) = reduce(omega_I) + sum_j c_j reduce(x_j)
+// holds exactly whatever harmonics the machine's errors add.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace gyrocal {
+
+/// How a dwell is reduced. Defaults as stated; IsValid() checks them.
+struct ReduceOptions {
+  enum class Method {
+    kHarmonicFit,  ///< least-squares fit of a harmonic series in gamma plus a linear drift in time (default)
+    kWindowMean,   ///< mean of the samples within +-window/2 of each gamma
+  };
+  Method method = Method::kHarmonicFit;
+  int harmonic_order = 3;            ///< harmonic fit: orders 0..harmonic_order in gamma
+  bool linear_drift = true;          ///< harmonic fit and window mean: a linear drift in time
+  double window_deg = 10.0;          ///< window mean: full width of the window around each gamma, deg
+  double beta_tolerance_deg = 1e-3;  ///< a dwell's beta stays within this of its first value, deg
+  double rate_tolerance = 1e-3;  ///< relative to the planned rate: a spinning dwell's sample-to-sample rate
+  double static_rate_tolerance_rad_s = 0.01;  ///< below this the main axis (or platform) counts as stopped
+  int static_batches = 16;                    ///< a static hold's standard error from this many batch means
+
+  /// True when every option is in range; otherwise false with a sentence in *error.
+  bool IsValid(std::string* error) const;
+};
+
+/// The result of reducing one dwell for one column of values.
+struct DwellValues {
+  std::vector<double> value;  ///< per gamma, in the values' unit
+  std::vector<double>
+      std_err;  ///< per gamma: from the scatter between revolutions (or batches); NaN if unknown
+  std::vector<std::size_t> samples;  ///< per gamma: samples that entered
+  int revolutions = 0;               ///< complete revolutions (or batches) the standard error comes from
+};
+
+/// Accumulates one dwell's samples (streaming, memory independent of the dwell's length) and reduces them.
+/// Spinning dwell: the values at each gamma of `gammas_rad`. Static hold: one value (the mean).
+class DwellAccumulator {
+ public:
+  /// columns: how many value columns each sample carries (1 for the gyro output, more for model channels).
+  /// planned_duration_s: the planned length of the measured part (> 0), to scale time and size batches.
+  /// with_std_err: also compute the standard errors of column 0 (scatter between revolutions or batches).
+  DwellAccumulator(const ReduceOptions& options, std::vector<double> gammas_rad, bool is_static, int columns,
+                   double planned_duration_s, bool with_std_err);
+
+  /// One sample at time t (s) and arm angle gamma (rad, unwrapped: it must progress monotonically while
+  /// spinning), with `columns` values.
+  void add(double time_s, double gamma_rad, const double* values);
+
+  /// The reduced values of column `column`, evaluated at the dwell's mid-time.
+  DwellValues finish(int column) const;
+
+  std::size_t samples() const { return samples_; }
+  double first_time_s() const { return t_first_; }
+  double last_time_s() const { return t_last_; }
+  /// Complete revolutions seen (spinning).
+  int complete_revolutions() const { return revolution_; }
+
+ private:
+  void close_revolution();
+  int basis_size() const;
+  void basis(double gamma_rad, double t_scaled, double* out) const;
+
+  ReduceOptions options_;
+  std::vector<double> gammas_;
+  bool static_;
+  int columns_;
+  double duration_s_;
+  bool with_std_err_;
+
+  std::size_t samples_ = 0;
+  double t_first_ = 0.0, t_last_ = 0.0;
+  double gamma_first_ = 0.0;
+  int revolution_ = 0;
+
+  // Harmonic fit over the whole dwell: normal equations of the (well-conditioned) harmonic basis.
+  Eigen::MatrixXd normal_;  // basis x basis
+  Eigen::MatrixXd rhs_;     // basis x columns
+  // Per revolution (std err): the same fit without drift, on column 0 only.
+  Eigen::MatrixXd rev_normal_;
+  Eigen::VectorXd rev_rhs_;
+  std::size_t rev_samples_ = 0;
+  double rev_time_sum_ = 0.0;
+  // Window mean: per gamma, sums over the whole dwell (with drift: also t and t^2) and per revolution.
+  Eigen::MatrixXd window_sum_;                                             // gamma x columns
+  Eigen::MatrixXd window_tsum_;                                            // gamma x columns: sum of t*value
+  Eigen::Vector<double, Eigen::Dynamic> window_n_, window_t_, window_tt_;  // per gamma
+  Eigen::VectorXd rev_window_sum_, rev_window_n_, rev_window_t_;           // per gamma, column 0
+  // Per-revolution (or batch) values of column 0 per gamma, as sums for a straight-line fit in time.
+  struct TrendSums {
+    double n = 0, t = 0, tt = 0, v = 0, tv = 0, vv = 0;
+    void add(double ti, double vi) {
+      n += 1;
+      t += ti;
+      tt += ti * ti;
+      v += vi;
+      tv += ti * vi;
+      vv += vi * vi;
+    }
+  };
+  std::vector<TrendSums> trend_;
+  // Static hold: sums per column, and batch means of column 0.
+  Eigen::VectorXd static_sum_;
+  double batch_sum_ = 0.0;
+  std::size_t batch_n_ = 0;
+  int batch_index_ = 0;
+  TrendSums batches_;
+};
+
+}  // namespace gyrocal

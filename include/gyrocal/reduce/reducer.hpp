@@ -1,0 +1,91 @@
+#pragma once
+// Reduce a record, read as a stream: split it into dwells from the encoder angles, drop the settle
+// interval, and reduce each dwell to one value per gamma of the plan (reduce/dwell_accumulator.hpp).
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gyrocal/plan/test_spec.hpp"
+#include "gyrocal/record/record.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
+
+namespace gyrocal {
+
+/// A straight line angle(t) = at_first + rate * (t - t_first), fitted to unwrapped encoder readings.
+struct AngleLine {
+  double at_first_rad = 0.0;
+  double rate_rad_s = 0.0;
+  double rms_residual_rad = 0.0;  ///< scatter of the readings about the line
+  double at(double t, double t_first) const { return at_first_rad + rate_rad_s * (t - t_first); }
+};
+
+/// One measured dwell: a spinning dwell (rate, beta) or a static hold (beta, gamma).
+struct Dwell {
+  bool is_static = false;
+  double planned_rate_rad_s = 0.0;  ///< the plan's rate this dwell was matched to
+  double beta_rad = 0.0;            ///< the plan's beta this dwell was matched to
+  double measured_beta_rad = 0.0;   ///< mean position encoder reading
+  std::vector<double> gammas_rad;   ///< the plan's gammas reduced here (one for a static hold)
+  std::vector<int> position_index;  ///< per gamma: the plan's position index (1-based, plan/positions.hpp)
+  double first_time_s = 0.0, last_time_s = 0.0;  ///< the measured part (after the settle interval)
+  std::size_t samples = 0;                       ///< samples in the measured part
+  double sample_interval_s = 0.0;                ///< mean interval between samples
+  AngleLine main;                                ///< theta(t), from the main-axis encoder
+  AngleLine counter;                             ///< psi_r(t), from the counter-platform encoder
+  double planned_duration_s = 0.0;               ///< what the plan asked for the measured part
+  DwellValues gyro;                              ///< the reduced gyro output, deg/h, per gamma
+
+  /// theta, psi_r, beta and rates at the i-th of `samples` evenly spaced instants of the measured part: the
+  /// grid on which the model's channels are evaluated and reduced like the gyro output.
+  double time_of_sample(std::size_t i) const {
+    return first_time_s + static_cast<double>(i) * sample_interval_s;
+  }
+};
+
+/// One reduced position, in the plan's order.
+struct ReducedPosition {
+  int index = 0;            ///< plan/positions.hpp numbering (MODEL.md section 7 for the default test)
+  double rate_rad_s = 0.0;  ///< planned rate
+  double beta_rad = 0.0;    ///< planned beta
+  double gamma_rad = 0.0;   ///< planned gamma
+  double mean_deg_h = 0.0;  ///< reduced gyro output
+  double std_err_deg_h = 0.0;
+  std::size_t samples = 0;
+  int dwell = 0;       ///< index into Reduction::dwells
+  int gamma_slot = 0;  ///< index into that dwell's gammas
+};
+
+struct Reduction {
+  std::vector<Dwell> dwells;
+  std::vector<ReducedPosition> positions;  ///< every position of the plan, in order
+  std::vector<std::string> warnings;
+  std::size_t samples_read = 0;
+};
+
+/// Streaming reducer: push every sample of a record in order, then finish(). Memory is independent of the
+/// record's length. Errors (gyrocal::Error) name the source and, where it applies, the time in the record.
+class Reducer {
+ public:
+  /// plan: the configured test (rates, betas, gammas, revolutions, settle); source_name for messages.
+  Reducer(const TestSpec& plan, const ReduceOptions& options, std::string source_name,
+          double reference_rate_rad_s);
+  ~Reducer();
+  Reducer(const Reducer&) = delete;
+  Reducer& operator=(const Reducer&) = delete;
+
+  void push(const RecordSample& sample);
+  /// Match the dwells to the plan; an error if a planned position has no dwell.
+  Reduction finish();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// Reduce a whole record file (streaming).
+Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
+                        double reference_rate_rad_s);
+
+}  // namespace gyrocal

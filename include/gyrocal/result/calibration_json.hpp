@@ -1,0 +1,24 @@
+#pragma once
+// The result JSON of `gyrocal calibrate` (INTERFACE.md, "Result (JSON)"), and the pieces the report reads.
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/model/gyro.hpp"
+#include "gyrocal/plan/test_spec.hpp"
+
+namespace gyrocal {
+
+/// coefficients {name: {value, std, unit, identifiable}} (value and std null when not identifiable),
+/// combinations, positions (with residual_deg_h for least squares), alternatives, method, compensation,
+/// g_level, warnings; and rank, condition_number, chi2, dof, unidentifiable.
+nlohmann::json calibration_to_json(const CalibrationResult& result);
+
+/// {name: value} of the ten coefficients.
+nlohmann::json coefficients_to_json(const DriftCoefficients& coefficients);
+
+/// The test plan: sample_rate_hz, revolutions, settle_s, beta_deg, gamma_deg, rates_rad_s, positions.
+nlohmann::json plan_to_json(const TestSpec& plan);
+
+}  // namespace gyrocal

@@ -1,0 +1,59 @@
+#include "gyrocal/identify/channels.hpp"
+
+#include "gyrocal/model/nominal.hpp"
+
+namespace gyrocal {
+
+std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                    const ReduceOptions& options) {
+  // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors.
+  constexpr int kColumns = 3 + 2 * static_cast<int>(kNumCoefficients);
+  std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
+  for (std::size_t di = 0; di < reduction.dwells.size(); ++di) {
+    const Dwell& d = reduction.dwells[di];
+    DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
+    double v[kColumns];
+    for (std::size_t i = 0; i < d.samples; ++i) {
+      const double t = d.time_of_sample(i);
+      // The joints on the dwell's constant-rate lines fitted to the encoders.
+      JointState j;
+      j.main_angle_rad = d.main.at(t, d.first_time_s);
+      j.main_rate_rad_s = d.main.rate_rad_s;
+      j.counter_angle_rad = d.counter.at(t, d.first_time_s);
+      j.counter_rate_rad_s = d.counter.rate_rad_s;
+      j.position_angle_rad = d.measured_beta_rad;
+      const GyroInputs exact = exact_inputs(model, j);
+      const NominalInputs nominal = nominal_inputs(model, j, false);
+      v[0] = exact.rate_rad_s.x() * kRadPerSecToDegPerHour;
+      v[1] = nominal.omega_I_rad_s * kRadPerSecToDegPerHour;
+      v[2] = nominal_inputs(model, j, true).omega_I_rad_s * kRadPerSecToDegPerHour;
+      const auto re = drift_regressors(exact.specific_force_g);
+      const auto rn = drift_regressors(Eigen::Vector3d(nominal.a_I_g, nominal.a_O_g, nominal.a_S_g));
+      for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+        v[3 + k] = re[k];
+        v[3 + kNumCoefficients + k] = rn[k];
+      }
+      acc.add(t, -j.counter_angle_rad, v);
+    }
+    for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
+  }
+  std::vector<PositionChannels> out;
+  for (const ReducedPosition& p : reduction.positions) {
+    const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];
+    const auto at = [&](int c) {
+      return cols[static_cast<std::size_t>(c)].value[static_cast<std::size_t>(p.gamma_slot)];
+    };
+    PositionChannels ch;
+    ch.omega_exact_deg_h = at(0);
+    ch.omega_nominal_deg_h = at(1);
+    ch.omega_seed_deg_h = at(2);
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      ch.regressors_exact[k] = at(3 + static_cast<int>(k));
+      ch.regressors_nominal[k] = at(3 + static_cast<int>(kNumCoefficients + k));
+    }
+    out.push_back(ch);
+  }
+  return out;
+}
+
+}  // namespace gyrocal

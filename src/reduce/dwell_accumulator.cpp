@@ -1,0 +1,254 @@
+#include "gyrocal/reduce/dwell_accumulator.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Angle difference wrapped to (-pi, pi].
+double wrap(double a) {
+  return std::remainder(a, 2.0 * kPi);
+}
+
+}  // namespace
+
+bool ReduceOptions::IsValid(std::string* error) const {
+  const auto fail = [error](const char* message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (harmonic_order < 0 || harmonic_order > 12) return fail("harmonic_order must be between 0 and 12");
+  if (!(window_deg > 0.0 && window_deg < 90.0)) return fail("window_deg must be in (0, 90) degrees");
+  if (!(beta_tolerance_deg > 0.0)) return fail("beta_tolerance_deg must be positive");
+  if (!(rate_tolerance > 0.0 && rate_tolerance < 0.5)) return fail("rate_tolerance must be in (0, 0.5)");
+  if (!(static_rate_tolerance_rad_s > 0.0)) return fail("static_rate_tolerance_rad_s must be positive");
+  if (static_batches < 2) return fail("static_batches must be at least 2");
+  return true;
+}
+
+DwellAccumulator::DwellAccumulator(const ReduceOptions& options, std::vector<double> gammas_rad,
+                                   bool is_static, int columns, double planned_duration_s, bool with_std_err)
+    : options_(options),
+      gammas_(std::move(gammas_rad)),
+      static_(is_static),
+      columns_(columns),
+      duration_s_(planned_duration_s),
+      with_std_err_(with_std_err),
+      trend_(gammas_.size()) {
+  const int n = basis_size();
+  const auto ng = static_cast<Eigen::Index>(gammas_.size());
+  if (static_) {
+    static_sum_ = Eigen::VectorXd::Zero(columns_);
+  } else if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    normal_ = Eigen::MatrixXd::Zero(n, n);
+    rhs_ = Eigen::MatrixXd::Zero(n, columns_);
+    const int nr = 2 * options_.harmonic_order + 1;
+    rev_normal_ = Eigen::MatrixXd::Zero(nr, nr);
+    rev_rhs_ = Eigen::VectorXd::Zero(nr);
+  } else {
+    window_sum_ = Eigen::MatrixXd::Zero(ng, columns_);
+    window_tsum_ = Eigen::MatrixXd::Zero(ng, columns_);
+    window_n_ = window_t_ = window_tt_ = Eigen::VectorXd::Zero(ng);
+    rev_window_sum_ = rev_window_n_ = rev_window_t_ = Eigen::VectorXd::Zero(ng);
+  }
+}
+
+int DwellAccumulator::basis_size() const {
+  return 2 * options_.harmonic_order + 1 + (options_.linear_drift ? 1 : 0);
+}
+
+// 1, cos g, sin g, ..., cos Ng, sin Ng [, t_scaled]; cos kg, sin kg by angle addition.
+void DwellAccumulator::basis(double gamma_rad, double t_scaled, double* out) const {
+  const double c1 = std::cos(gamma_rad), s1 = std::sin(gamma_rad);
+  out[0] = 1.0;
+  double c = 1.0, s = 0.0;
+  for (int k = 1; k <= options_.harmonic_order; ++k) {
+    const double cn = c * c1 - s * s1;
+    s = s * c1 + c * s1;
+    c = cn;
+    out[2 * k - 1] = c;
+    out[2 * k] = s;
+  }
+  if (options_.linear_drift) out[2 * options_.harmonic_order + 1] = t_scaled;
+}
+
+void DwellAccumulator::add(double t, double gamma, const double* values) {
+  if (samples_ == 0) {
+    t_first_ = t;
+    gamma_first_ = gamma;
+  }
+  t_last_ = t;
+  ++samples_;
+  // Time scaled to about [-0.5, 0.5] over the planned dwell, for a well-conditioned drift column.
+  const double ts = (t - t_first_) / duration_s_ - 0.5;
+
+  if (static_) {
+    for (int c = 0; c < columns_; ++c) static_sum_[c] += values[c];
+    if (!with_std_err_) return;
+    const int batch = static_cast<int>(std::floor((t - t_first_) / (duration_s_ / options_.static_batches)));
+    if (batch != batch_index_ && batch_n_ > 0) {
+      batches_.add(0.0, batch_sum_ / static_cast<double>(batch_n_));
+      batch_sum_ = 0.0;
+      batch_n_ = 0;
+    }
+    batch_index_ = batch;
+    batch_sum_ += values[0];
+    ++batch_n_;
+    return;
+  }
+
+  // Revolutions counted from the first sample's gamma, in either sense of rotation.
+  const int rev = static_cast<int>(std::floor(std::abs(gamma - gamma_first_) / (2.0 * kPi)));
+  if (with_std_err_ && rev != revolution_) close_revolution();
+  revolution_ = rev;
+
+  if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    double b[32];
+    basis(gamma, ts, b);
+    const int n = basis_size();
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j <= i; ++j) normal_(i, j) += b[i] * b[j];
+      for (int c = 0; c < columns_; ++c) rhs_(i, c) += b[i] * values[c];
+    }
+    if (with_std_err_) {
+      const int nr = 2 * options_.harmonic_order + 1;
+      for (int i = 0; i < nr; ++i) {
+        for (int j = 0; j <= i; ++j) rev_normal_(i, j) += b[i] * b[j];
+        rev_rhs_[i] += b[i] * values[0];
+      }
+      ++rev_samples_;
+      rev_time_sum_ += ts;
+    }
+    return;
+  }
+
+  // Window mean.
+  const double half = 0.5 * options_.window_deg * kDegToRad;
+  for (std::size_t k = 0; k < gammas_.size(); ++k) {
+    if (std::abs(wrap(gamma - gammas_[k])) > half) continue;
+    const auto kk = static_cast<Eigen::Index>(k);
+    for (int c = 0; c < columns_; ++c) {
+      window_sum_(kk, c) += values[c];
+      window_tsum_(kk, c) += ts * values[c];
+    }
+    window_n_[kk] += 1;
+    window_t_[kk] += ts;
+    window_tt_[kk] += ts * ts;
+    if (with_std_err_) {
+      rev_window_sum_[kk] += values[0];
+      rev_window_n_[kk] += 1;
+      rev_window_t_[kk] += ts;
+    }
+  }
+}
+
+void DwellAccumulator::close_revolution() {
+  if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    const int nr = 2 * options_.harmonic_order + 1;
+    if (rev_samples_ >= static_cast<std::size_t>(2 * nr)) {
+      const Eigen::MatrixXd full = rev_normal_.selfadjointView<Eigen::Lower>();
+      const Eigen::VectorXd x = full.ldlt().solve(rev_rhs_);
+      const double t_mean = rev_time_sum_ / static_cast<double>(rev_samples_);
+      for (std::size_t k = 0; k < gammas_.size(); ++k) {
+        double b[32];
+        basis(gammas_[k], 0.0, b);
+        double v = 0.0;
+        for (int i = 0; i < nr; ++i) v += b[i] * x[i];
+        trend_[k].add(t_mean, v);
+      }
+    }
+    rev_normal_.setZero();
+    rev_rhs_.setZero();
+    rev_samples_ = 0;
+    rev_time_sum_ = 0.0;
+  } else {
+    for (std::size_t k = 0; k < gammas_.size(); ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      if (rev_window_n_[kk] > 0)
+        trend_[k].add(rev_window_t_[kk] / rev_window_n_[kk], rev_window_sum_[kk] / rev_window_n_[kk]);
+    }
+    rev_window_sum_.setZero();
+    rev_window_n_.setZero();
+    rev_window_t_.setZero();
+  }
+}
+
+DwellValues DwellAccumulator::finish(int column) const {
+  DwellValues out;
+  const std::size_t ng = gammas_.size();
+  out.value.assign(ng, kNaN);
+  out.std_err.assign(ng, kNaN);
+  out.samples.assign(ng, 0);
+  if (samples_ == 0) return out;
+  const double t_mid = (0.5 * (t_first_ + t_last_) - t_first_) / duration_s_ - 0.5;
+
+  // Standard error of the value at t_mid from per-revolution (or batch) values: the scatter about their
+  // straight line in time (about their mean without drift), as the line's prediction at t_mid.
+  const auto std_err_of = [&](const TrendSums& s, bool drift) {
+    const double n = s.n;
+    const double dof = n - (drift ? 2.0 : 1.0);
+    if (dof < 1.0) return kNaN;
+    const double tbar = s.t / n, vbar = s.v / n;
+    const double stt = s.tt - n * tbar * tbar, svv = s.vv - n * vbar * vbar, stv = s.tv - n * tbar * vbar;
+    const double ss = drift && stt > 0 ? svv - stv * stv / stt : svv;
+    const double var = std::max(ss, 0.0) / dof;
+    const double lever = drift && stt > 0 ? (t_mid - tbar) * (t_mid - tbar) / stt : 0.0;
+    return std::sqrt(var * (1.0 / n + lever));
+  };
+
+  if (static_) {
+    out.value[0] = static_sum_[column] / static_cast<double>(samples_);
+    out.samples[0] = samples_;
+    if (with_std_err_ && column == 0) {
+      TrendSums b = batches_;
+      if (batch_n_ > 0) b.add(0.0, batch_sum_ / static_cast<double>(batch_n_));
+      out.std_err[0] = std_err_of(b, false);
+      out.revolutions = static_cast<int>(b.n);
+    }
+    return out;
+  }
+
+  if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
+    const Eigen::VectorXd x = full.ldlt().solve(rhs_.col(column));
+    const int n = basis_size();
+    for (std::size_t k = 0; k < ng; ++k) {
+      double b[32];
+      basis(gammas_[k], t_mid, b);
+      double v = 0.0;
+      for (int i = 0; i < n; ++i) v += b[i] * x[i];
+      out.value[k] = v;
+      out.samples[k] = samples_;
+    }
+  } else {
+    for (std::size_t k = 0; k < ng; ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      const double nk = window_n_[kk];
+      if (nk == 0) continue;
+      const double mean = window_sum_(kk, column) / nk;
+      double v = mean;
+      if (options_.linear_drift) {
+        const double tbar = window_t_[kk] / nk;
+        const double stt = window_tt_[kk] - nk * tbar * tbar;
+        const double stv = window_tsum_(kk, column) - nk * tbar * mean;
+        if (stt > 0) v = mean + stv / stt * (t_mid - tbar);
+      }
+      out.value[k] = v;
+      out.samples[k] = static_cast<std::size_t>(nk);
+    }
+  }
+  if (with_std_err_ && column == 0) {
+    for (std::size_t k = 0; k < ng; ++k) out.std_err[k] = std_err_of(trend_[k], options_.linear_drift);
+    out.revolutions = static_cast<int>(trend_.empty() ? 0 : trend_[0].n);
+  }
+  return out;
+}
+
+}  // namespace gyrocal

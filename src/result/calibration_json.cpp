@@ -1,0 +1,92 @@
+#include "gyrocal/result/calibration_json.hpp"
+
+#include <cmath>
+
+#include "gyrocal/plan/positions.hpp"
+
+namespace gyrocal {
+namespace {
+
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+nlohmann::json calibration_to_json(const CalibrationResult& r) {
+  nlohmann::json j;
+  nlohmann::json coefficients = nlohmann::json::object();
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    const CoefficientEstimate& c = r.coefficients[k];
+    coefficients[std::string(kCoefficientNames[k])] = {
+        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::json(nullptr)},
+        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::json(nullptr)},
+        {"unit", kCoefficientUnits[k]},
+        {"identifiable", c.identifiable}};
+  }
+  j["coefficients"] = coefficients;
+  j["combinations"] = nlohmann::json::array();
+  for (const NamedEstimate& c : r.combinations)
+    j["combinations"].push_back({{"name", c.name},
+                                 {"value", number_or_null(c.value)},
+                                 {"std", number_or_null(c.std)},
+                                 {"unit", c.unit}});
+  j["alternatives"] = nlohmann::json::array();
+  for (const NamedEstimate& c : r.alternatives)
+    j["alternatives"].push_back({{"name", c.name},
+                                 {"value", number_or_null(c.value)},
+                                 {"std", number_or_null(c.std)},
+                                 {"unit", c.unit}});
+  j["positions"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.positions.size(); ++i) {
+    const ReducedPosition& p = r.positions[i];
+    nlohmann::json e = {{"index", p.index},
+                        {"beta_deg", p.beta_rad * kRadToDeg},
+                        {"gamma_deg", p.gamma_rad * kRadToDeg},
+                        {"rate_rad_s", p.rate_rad_s},
+                        {"mean_deg_h", p.mean_deg_h},
+                        {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
+                        {"samples", p.samples}};
+    if (i < r.residuals_deg_h.size()) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
+    j["positions"].push_back(e);
+  }
+  j["method"] = to_string(r.method);
+  j["compensation"] = to_string(r.compensation);
+  j["g_level"] = r.g_level;
+  j["warnings"] = r.warnings;
+  j["rank"] = r.rank;
+  j["condition_number"] = number_or_null(r.condition_number);
+  j["chi2"] = number_or_null(r.chi2);
+  j["dof"] = r.dof;
+  j["unidentifiable"] = r.unidentifiable;
+  return j;
+}
+
+nlohmann::json coefficients_to_json(const DriftCoefficients& c) {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) j[std::string(kCoefficientNames[k])] = c.values[k];
+  return j;
+}
+
+nlohmann::json plan_to_json(const TestSpec& t) {
+  const auto deg = [](const std::vector<double>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (double x : v) a.push_back(x * kRadToDeg);
+    return a;
+  };
+  nlohmann::json positions = nlohmann::json::array();
+  for (const Position& p : test_positions(t))
+    positions.push_back({{"index", p.index},
+                         {"beta_deg", p.beta_rad * kRadToDeg},
+                         {"gamma_deg", p.gamma_rad * kRadToDeg},
+                         {"rate_rad_s", p.rate_rad_s}});
+  return {{"sample_rate_hz", t.sample_rate_hz},
+          {"revolutions", t.revolutions},
+          {"settle_s", t.settle_s},
+          {"beta_deg", deg(t.beta_rad)},
+          {"gamma_deg", deg(t.gamma_rad)},
+          {"rates_rad_s", t.rates_rad_s},
+          {"positions", positions}};
+}
+
+}  // namespace gyrocal
