@@ -1,0 +1,53 @@
+#pragma once
+// Simulation of a whole test (issue 3; MODEL.md sections 4 and 6): for each sample k at t_k = k / fs over the
+// timeline of plan/timeline.hpp, the joints -> the exact inputs -> the gyro's static model with the truth
+// coefficients -> the noise of [gyro.noise] -> one row of the record (record/record.hpp).
+//
+// Encoder angles are written as the joints' angles in degrees wrapped to [0, 360), as an encoder reads them
+// (theta, psi_r relative to the arm, beta as commanded). Rows stream out one at a time, so memory does not
+// depend on the length of the test. The same scenario and seed give the same rows bit for bit.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <ostream>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/record/record.hpp"
+
+namespace gyrocal {
+
+struct SimulationOptions {
+  std::optional<std::uint64_t> seed;  ///< the noise's seed; default: the scenario's test.seed
+  /// Called with the fraction of samples done, in [0, 1]: every 2^16 samples and once at the end with 1.
+  std::function<void(double fraction)> progress;
+};
+
+struct SimulationSummary {
+  std::uint64_t samples = 0;  ///< rows produced
+  double duration_s = 0.0;    ///< duration of the test (the timeline), s
+  std::uint64_t seed = 0;     ///< the seed used
+};
+
+/// Receives each simulated row, in time order.
+using SampleSink = std::function<void(const RecordSample&)>;
+
+/// The record's `# key = value` metadata for a simulation of `scenario` with `seed`: generator, seed,
+/// sample_rate_hz, settle_s, revolutions, rates_rad_s, beta_deg, gamma_deg (lists as "[a, b]"), hold_s,
+/// reference_rate_rad_s, radius_m, latitude_deg, heading_deg, initial_main_angle_deg, angles (how encoder
+/// angles are written), duration_s, samples, the noise parameters (noise_<key of [gyro.noise]>) and the truth
+/// (truth_dF ... truth_dOS, in the units of MODEL.md section 1). Numbers are in their shortest exact form,
+/// angles in degrees to 15 significant digits.
+RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed);
+
+/// Simulates every sample of the scenario's test (timeline with the default MotionLimits) and hands each
+/// row to `sink`. Throws Error for a test that cannot be planned or invalid noise parameters.
+SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& options,
+                           const SampleSink& sink);
+
+/// Simulates the scenario's test into a record (metadata, header, rows) written to `out`. Throws Error as
+/// simulate() does, or if writing fails.
+SimulationSummary simulate_record(const Scenario& scenario, const SimulationOptions& options,
+                                  std::ostream& out);
+
+}  // namespace gyrocal

@@ -1,0 +1,116 @@
+#include "gyrocal/simulate/simulator.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gyrocal/model/gyro.hpp"
+#include "gyrocal/simulate/noise.hpp"
+
+namespace gyrocal {
+namespace {
+
+constexpr std::uint64_t kProgressEverySamples = std::uint64_t{1} << 16;
+
+/// An encoder's reading of an angle (rad): degrees in [0, 360).
+double encoder_deg(double angle_rad) {
+  const double deg = angle_rad * kRadToDeg;
+  double wrapped = deg - 360.0 * std::floor(deg / 360.0);  // exact floor; rounding may leave -0 ... 360
+  if (wrapped < 0.0) wrapped += 360.0;
+  return wrapped >= 360.0 ? 0.0 : wrapped;
+}
+
+/// Degrees to 15 significant digits: reads as typed (270, not 270.00000000000006).
+std::string degrees(double angle_rad) {
+  return fmt::format("{:.15g}", angle_rad * kRadToDeg);
+}
+
+std::string list(const std::vector<double>& values, double scale) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    s += (i ? ", " : "") + (scale == 1.0 ? fmt::format("{}", values[i]) : degrees(values[i]));
+  }
+  return s + "]";
+}
+
+SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed,
+                      const SimulationOptions& options, const SampleSink& sink) {
+  const CentrifugeModel model = scenario.model();
+  const double fs = scenario.test.sample_rate_hz;
+  GyroNoiseGenerator noise(scenario.noise, fs, seed);
+  const std::uint64_t n = sample_count(timeline, fs);
+  RecordSample sample;
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs;
+    const JointState joints = joint_state_at(timeline, t);
+    const GyroInputs inputs = exact_inputs(model, joints);
+    sample.time_s = t;
+    sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
+    sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
+    sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
+    sample.gyro_deg_h =
+        noise.next(gyro_output_deg_h(scenario.gyro, inputs.rate_rad_s.x(), inputs.specific_force_g));
+    sink(sample);
+    if (options.progress && (k + 1) % kProgressEverySamples == 0) {
+      options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
+    }
+  }
+  if (options.progress) options.progress(1.0);
+  return {n, timeline.duration_s, seed};
+}
+
+}  // namespace
+
+RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed) {
+  const TestSpec& test = scenario.test;
+  const GyroNoise& noise = scenario.noise;
+  RecordMetadata m = {
+      {"generator", "gyrocal simulate"},
+      {"seed", fmt::format("{}", seed)},
+      {"sample_rate_hz", fmt::format("{}", test.sample_rate_hz)},
+      {"settle_s", fmt::format("{}", test.settle_s)},
+      {"revolutions", fmt::format("{}", test.revolutions)},
+      {"rates_rad_s", list(test.rates_rad_s, 1.0)},
+      {"beta_deg", list(test.beta_rad, kRadToDeg)},
+      {"gamma_deg", list(test.gamma_rad, kRadToDeg)},
+      {"hold_s", fmt::format("{}", timeline.hold_s)},
+      {"reference_rate_rad_s", fmt::format("{}", timeline.reference_rate_rad_s)},
+      {"radius_m", fmt::format("{}", scenario.centrifuge.radius_m)},
+      {"latitude_deg", degrees(scenario.site.latitude_rad)},
+      {"heading_deg", degrees(scenario.centrifuge.heading_rad)},
+      {"initial_main_angle_deg", degrees(scenario.centrifuge.initial_main_angle_rad)},
+      {"angles", "encoder readings in deg, wrapped to [0, 360)"},
+      {"duration_s", fmt::format("{}", timeline.duration_s)},
+      {"samples", fmt::format("{}", sample_count(timeline, test.sample_rate_hz))},
+      {"noise_angle_random_walk_deg_rt_h", fmt::format("{}", noise.angle_random_walk_deg_rt_h)},
+      {"noise_bias_instability_deg_h", fmt::format("{}", noise.bias_instability_deg_h)},
+      {"noise_rate_random_walk_deg_h_rt_h", fmt::format("{}", noise.rate_random_walk_deg_h_rt_h)},
+      {"noise_quantization_deg_h", fmt::format("{}", noise.quantization_deg_h)},
+      {"noise_output_lag_s", fmt::format("{}", noise.output_lag_s)},
+  };
+  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+    m.emplace_back(fmt::format("truth_{}", kCoefficientNames[i]), fmt::format("{}", scenario.gyro.values[i]));
+  }
+  return m;
+}
+
+SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& options,
+                           const SampleSink& sink) {
+  const Timeline timeline = make_timeline(scenario.test, scenario.model());
+  return run(scenario, timeline, options.seed.value_or(scenario.test.seed), options, sink);
+}
+
+SimulationSummary simulate_record(const Scenario& scenario, const SimulationOptions& options,
+                                  std::ostream& out) {
+  const Timeline timeline = make_timeline(scenario.test, scenario.model());
+  const std::uint64_t seed = options.seed.value_or(scenario.test.seed);
+  RecordWriter writer(out, simulation_metadata(scenario, timeline, seed), {});
+  const SimulationSummary summary =
+      run(scenario, timeline, seed, options, [&writer](const RecordSample& s) { writer.write(s); });
+  writer.finish();
+  return summary;
+}
+
+}  // namespace gyrocal
