@@ -9,6 +9,7 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
 namespace gyrocal {
@@ -209,6 +210,54 @@ TEST(Calibrate, UncertaintiesAreHonest) {
     EXPECT_LT(sd, 1.15) << name;
     EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(trials)) << name;  // unbiased (4 sigma)
   }
+}
+
+TEST(Predict, PlannedReductionMatchesAReducedNoiseFreeRecord) {
+  // Two routes to the same numbers: the record route (simulate, segment, reduce) and the plan route
+  // (dwells from the timeline, outputs from the reduced channels and the truth).
+  for (const std::vector<double>& rates : {std::vector<double>{9.9}, std::vector<double>{9.9, 0.0}}) {
+    Scenario s = noise_free_default();
+    s.test.revolutions = 10;
+    s.test.rates_rad_s = rates;
+    const Pipeline recorded = run(s);
+    Reduction planned = planned_reduction(s);
+    const auto channels = reduce_model_channels(planned, s.model(), ReduceOptions{});
+    set_noise_free_outputs(planned, channels, s.gyro);
+    ASSERT_EQ(planned.positions.size(), recorded.reduction.positions.size());
+    for (std::size_t i = 0; i < planned.positions.size(); ++i) {
+      EXPECT_EQ(planned.positions[i].index, recorded.reduction.positions[i].index);
+      // A window of the planned duration holds 1269 or 1270 samples depending on where it starts.
+      EXPECT_LE(std::abs(static_cast<double>(planned.positions[i].samples) -
+                         static_cast<double>(recorded.reduction.positions[i].samples)),
+                1.0)
+          << i;
+      // The reducer starts a dwell's clock when beta comes within its tolerance, a few samples before the
+      // platform's move ends: the same duration of steady spin, shifted, which moves only the harmonics above
+      // the fit's order (below 1e-6 deg/h on outputs of tens of deg/h).
+      EXPECT_NEAR(planned.positions[i].mean_deg_h, recorded.reduction.positions[i].mean_deg_h, 1e-6) << i;
+    }
+  }
+}
+
+TEST(Predict, PredictedStandardErrorsMatchTheScatterOfANoisyRecord) {
+  Scenario s = default_scenario();
+  s.test.revolutions = sanitized() ? 40 : 200;
+  const Pipeline noisy = run(s, 7);
+  Reduction planned = planned_reduction(s);
+  set_predicted_std_errors(planned, noisy.channels, s.noise, s.test.sample_rate_hz);
+  // Each measured standard error has ~revolutions-2 degrees of freedom; their mean ratio to the prediction
+  // over the 16 positions is 1 within a few per cent.
+  double ratio = 0;
+  for (std::size_t i = 0; i < planned.positions.size(); ++i)
+    ratio += noisy.reduction.positions[i].std_err_deg_h / planned.positions[i].std_err_deg_h;
+  ratio /= static_cast<double>(planned.positions.size());
+  EXPECT_NEAR(ratio, 1.0, sanitized() ? 0.08 : 0.04);
+  // And the prediction itself against the closed form for a harmonic fit over whole revolutions: the value at
+  // one gamma of a fit of orders 0..3 has variance (1 + 2*3) sigma^2 / n.
+  const double sigma = 0.002 * 60 * std::sqrt(s.test.sample_rate_hz);
+  const double n = static_cast<double>(planned.positions[0].samples);
+  EXPECT_NEAR(planned.positions[0].std_err_deg_h, sigma * std::sqrt(7.0 / n),
+              0.01 * sigma * std::sqrt(7.0 / n));
 }
 
 }  // namespace

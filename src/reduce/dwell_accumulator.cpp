@@ -251,4 +251,35 @@ DwellValues DwellAccumulator::finish(int column) const {
   return out;
 }
 
+std::vector<double> DwellAccumulator::white_noise_gain() const {
+  std::vector<double> gain(gammas_.size(), kNaN);
+  if (samples_ == 0) return gain;
+  const double t_mid = (0.5 * (t_first_ + t_last_) - t_first_) / duration_s_ - 0.5;
+  if (static_) {
+    gain[0] = 1.0 / static_cast<double>(samples_);
+  } else if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
+    const auto ldlt = full.ldlt();
+    const int n = basis_size();
+    for (std::size_t k = 0; k < gammas_.size(); ++k) {
+      Eigen::VectorXd b(n);
+      basis(gammas_[k], t_mid, b.data());
+      gain[k] = b.dot(ldlt.solve(b));
+    }
+  } else {
+    for (std::size_t k = 0; k < gammas_.size(); ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      const double nk = window_n_[kk];
+      if (nk == 0) continue;
+      double g = 1.0 / nk;
+      if (options_.linear_drift) {
+        const double tbar = window_t_[kk] / nk, stt = window_tt_[kk] - nk * tbar * tbar;
+        if (stt > 0) g += (t_mid - tbar) * (t_mid - tbar) / stt;
+      }
+      gain[k] = g;
+    }
+  }
+  return gain;
+}
+
 }  // namespace gyrocal

@@ -1,5 +1,6 @@
 #include "gyrocal/reduce/reducer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -104,10 +105,8 @@ struct Reducer::State {
   void measure(const RecordSample& s) {
     Run& r = *run;
     if (s.time_s < r.t_start + plan.settle_s) return;
-    if (r.measuring && s.time_s > r.t_first + r.planned_duration - 0.5 * (s.time_s - t_prev) + 1e-9 &&
-        r.n > 0) {
-      return;  // past the planned dwell: the plan says how long a dwell is
-    }
+    // The plan says how long a dwell is: its measured part is [t_first, t_first + planned duration).
+    if (r.measuring && s.time_s >= r.t_first + r.planned_duration - 1e-9) return;
     if (!r.measuring) {
       r.measuring = true;
       r.t_first = s.time_s;
@@ -290,10 +289,13 @@ Reduction Reducer::finish() {
       if (d.samples > st.dwells[it->second].samples) it->second = static_cast<int>(i);
     }
   }
+  std::vector<int> in_time_order;
+  for (const auto& [key, i] : chosen) in_time_order.push_back(i);
+  std::sort(in_time_order.begin(), in_time_order.end());
   std::map<int, int> renumber;
-  for (const auto& [key, i] : chosen) {
+  for (int i : in_time_order) {
     renumber[i] = static_cast<int>(out.dwells.size());
-    out.dwells.push_back(st.dwells[i]);
+    out.dwells.push_back(st.dwells[static_cast<std::size_t>(i)]);
   }
   std::vector<std::string> missing;
   for (const Position& p : test_positions(st.plan)) {

@@ -57,6 +57,10 @@ class DwellAccumulator {
   /// The reduced values of column `column`, evaluated at the dwell's mid-time.
   DwellValues finish(int column) const;
 
+  /// Per gamma: the variance of the reduced value per unit variance of white noise on each sample,
+  /// i.e. sum_i a_i^2 for the operator value = sum_i a_i y_i (b' (Phi' Phi)^-1 b for the harmonic fit).
+  std::vector<double> white_noise_gain() const;
+
   std::size_t samples() const { return samples_; }
   double first_time_s() const { return t_first_; }
   double last_time_s() const { return t_last_; }

@@ -1,0 +1,34 @@
+#pragma once
+// Before a test is run: the reduction a record of the plan will give, its noise-free outputs for a given
+// truth, and the standard errors the configured noise predicts. `gyrocal plan`, the sensitivity study and
+// the fast Monte Carlo stand on this, with the same reduction operator as a real calibration.
+#include <vector>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/channels.hpp"
+
+namespace gyrocal {
+
+/// The dwells and positions a perfect record of the scenario's test gives (from its timeline: each
+/// measurement interval's samples and the constant-rate lines of its joints); gyro outputs are zero.
+Reduction planned_reduction(const Scenario& scenario, const ReduceOptions& options = {});
+
+/// Standard deviation of one sample's white rate noise, deg/h: N[deg/sqrt(h)] * 60 * sqrt(fs[Hz]).
+double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_hz);
+
+/// Set each position's mean_deg_h to its noise-free reduced output for `truth`:
+/// reduce(omega_I exact) + sum_j truth_j reduce(x_j exact).
+void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
+                            const DriftCoefficients& truth);
+
+/// Set each position's std_err_deg_h to what white rate noise (the angle random walk) predicts through the
+/// reduction operator. Bias instability and rate random walk are not in the prediction.
+void set_predicted_std_errors(Reduction& reduction, const std::vector<PositionChannels>& channels,
+                              const GyroNoise& noise, double sample_rate_hz);
+
+/// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
+/// (least squares, full compensation, noise-free outputs of the configured truth).
+CalibrationResult predict_calibration(const Scenario& scenario, const CalibrationOptions& options);
+
+}  // namespace gyrocal
