@@ -27,8 +27,10 @@ ensure_packages() {
   fi
 }
 
+# libjs-chart.js is inlined into the HTML report; chromium runs the report's browser test (docs/report.md).
 GYROCAL_BUILD_PACKAGES=(g++ cmake make libeigen3-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev)
+                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev
+                        libjs-chart.js chromium)
 
 # build_gyrocal DIR [CMAKE ARGS...]: configure and build into DIR (Release unless told otherwise).
 build_gyrocal() {

@@ -1,0 +1,40 @@
+#pragma once
+// The self-contained HTML report of a result (docs/report.md): tables and plots of every section of a
+// result file that is present, in one HTML file that opens with no network. The plots are drawn by
+// Chart.js (Debian's libjs-chart.js), whose bundle is compiled into gyrocal and inlined into the page.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace gyrocal {
+
+struct HtmlReportOptions {
+  /// Shown as the page title and the first heading.
+  std::string title = "gyrocal calibration report";
+  /// Where the result came from (usually its file name), shown in the header; empty = not shown.
+  std::string source;
+  /// Date and time shown in the header; empty = now, UTC, ISO 8601.
+  std::string created;
+  /// When not null, receives one sentence per section that is present but could not be read
+  /// (that section then shows the same sentence instead of its tables and plots).
+  std::vector<std::string>* problems = nullptr;
+};
+
+/// Renders the HTML report of `result` (a JSON object with any of the sections of docs/report.md:
+/// coefficients, truth, comparison, combinations, alternatives, warnings, positions, sensitivity,
+/// montecarlo, plan). Sections that are absent are left out. Every string from `result` is escaped.
+/// Throws gyrocal::Error if `result` is not a JSON object.
+std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options = {});
+
+/// The names of the sections of `result` that the report shows, in report order (empty if none).
+std::vector<std::string> report_sections_present(const nlohmann::json& result);
+
+/// The plotting library's bundle as inlined into every report (Chart.js, from libjs-chart.js).
+std::string_view embedded_plot_library();
+
+/// This gyrocal's version, as shown in the report's header.
+std::string_view gyrocal_version();
+
+}  // namespace gyrocal
