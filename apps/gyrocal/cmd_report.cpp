@@ -1,13 +1,91 @@
-// gyrocal report (INTERFACE.md). Placeholder until its issue lands.
+// gyrocal report RESULT.json --html FILE: the self-contained HTML report of a result (docs/report.md).
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include "cli.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/report/html_report.hpp"
 
 namespace gyrocal::cli {
+namespace {
+
+/// The first bytes of every report (html_report.cpp); an existing file that starts with them is an
+/// earlier report and may be replaced without --force.
+constexpr std::string_view kReportMarker = "<!DOCTYPE html>\n<!-- gyrocal-report:";
+
+nlohmann::json read_result(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("cannot open the result file {}.", path));
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) throw Error(fmt::format("cannot read the result file {}.", path));
+  const std::string text = bytes.str();
+  try {
+    nlohmann::json result = nlohmann::json::parse(text);
+    if (!result.is_object())
+      throw Error(fmt::format("{} holds a JSON {}, not an object: a gyrocal result is a JSON object.", path,
+                              result.type_name()));
+    return result;
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.byte counts from 1 and points just past the offending character.
+    const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+    std::size_t line = 1, column = 1;
+    for (std::size_t k = 0; k < end; ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    std::string reason = e.what();
+    if (const auto colon = reason.find(": "); colon != std::string::npos) reason = reason.substr(colon + 2);
+    throw Error(fmt::format("{} is not valid JSON: line {}, column {}: {}.", path, line, column, reason));
+  }
+}
+
+bool is_earlier_report(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::string head(kReportMarker.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return in.gcount() == static_cast<std::streamsize>(head.size()) && head == kReportMarker;
+}
+
+}  // namespace
 
 void register_report(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("report", "(not yet available)");
-  sub->allow_extras();
-  sub->callback([] { throw Error("'gyrocal report' is not available yet in this version."); });
+  struct Options {
+    std::string result, html;
+    bool force = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub =
+      app.add_subcommand("report", "Write a self-contained HTML report with plots of a result file");
+  sub->add_option("RESULT", opt->result, "Result file (JSON) written by gyrocal")->required();
+  sub->add_option("--html", opt->html, "Write the report to FILE ('-' = standard output)")->required();
+  sub->add_flag("--force", opt->force, "Replace an existing file that is not an earlier gyrocal report");
+  sub->callback([opt] {
+    refuse_to_overwrite_input(opt->html, opt->result);
+    const nlohmann::json result = read_result(opt->result);
+    if (report_sections_present(result).empty())
+      throw Error(fmt::format(
+          "{} contains none of the sections of a gyrocal result (coefficients, positions, sensitivity, "
+          "montecarlo, plan, ...).",
+          opt->result));
+    std::vector<std::string> problems;
+    HtmlReportOptions options;
+    options.source = opt->result;
+    options.problems = &problems;
+    const std::string html = render_html_report(result, options);
+    for (const auto& p : problems) fmt::print(stderr, "gyrocal: warning: {}: {}\n", opt->result, p);
+    // A report is derived from its result and cheap to write again: an earlier report is replaced,
+    // any other existing file only with --force (docs/report.md).
+    write_output(opt->html, html, opt->force || is_earlier_report(opt->html));
+  });
 }
 
 }  // namespace gyrocal::cli
