@@ -1,13 +1,47 @@
-// gyrocal calibrate (INTERFACE.md). Placeholder until its issue lands.
+// gyrocal calibrate RECORD: reduce a record and identify the drift coefficients.
+#include <fmt/format.h>
+
 #include "cli.hpp"
-#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/result/calibration_json.hpp"
+#include "tables.hpp"
 
 namespace gyrocal::cli {
 
 void register_calibrate(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("calibrate", "(not yet available)");
-  sub->allow_extras();
-  sub->callback([] { throw Error("'gyrocal calibrate' is not available yet in this version."); });
+  struct Options {
+    std::string record, config, json, method = "least-squares", compensation = "full", reduction = "harmonic";
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
+  sub->add_option("RECORD", opt->record, "Test record (CSV, INTERFACE.md)")->required();
+  sub->add_option("--config", opt->config,
+                  "Configuration file (TOML): the machine, site and plan of the test");
+  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+      ->check(CLI::IsMember({"closed-form", "least-squares"}));
+  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
+      ->check(CLI::IsMember({"none", "seed", "full"}));
+  sub->add_option("--reduction", opt->reduction,
+                  "harmonic (default: harmonic fit in gamma with drift) or window (mean around each gamma)")
+      ->check(CLI::IsMember({"harmonic", "window"}));
+  sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  sub->callback([opt] {
+    refuse_to_overwrite_input(opt->json, opt->record);
+    refuse_to_overwrite_input(opt->json, opt->config);
+    const Scenario s = load_configuration(opt->config);
+    CalibrationOptions options;
+    options.method = parse_method(opt->method);
+    options.compensation = parse_compensation(opt->compensation);
+    options.reduce.method =
+        opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
+    const CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options);
+    if (!opt->json.empty()) {
+      nlohmann::json j = calibration_to_json(r);
+      j["record"] = opt->record;
+      write_output(opt->json, j.dump(2) + "\n", true);
+    }
+    if (opt->json != "-") fmt::print("{}", result_table(r));
+  });
 }
 
 }  // namespace gyrocal::cli

@@ -1,9 +1,18 @@
-// gyrocal demo: the main job on the default scenario.
+// gyrocal demo: the main job on the default scenario — simulate the 16-position test, calibrate it with and
+// without compensation, print the truth beside the estimates, write DIR/record.csv, DIR/result.json and
+// DIR/report.html.
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "cli.hpp"
-#include "gyrocal/model/instant.hpp"
-#include "gyrocal/plan/positions.hpp"
+#include "gyrocal/core/atomic_file.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/model/nominal.hpp"
+#include "gyrocal/report/html_report.hpp"
+#include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+#include "tables.hpp"
 
 namespace gyrocal::cli {
 
@@ -13,28 +22,61 @@ void register_demo(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("demo", "The main job on the built-in default scenario");
-  sub->add_option("--out", opt->out, "Directory for the demo's files");
-  sub->callback([] {
+  sub->add_option("--out", opt->out, "Directory for record.csv, result.json and report.html (replaced)");
+  sub->callback([opt] {
     const Scenario s = default_scenario();
-    const CentrifugeModel model = s.model();
-    fmt::print("gyrocal demo: the 16 positions of the default scenario (MODEL.md sections 7 and 11),\n");
+    const std::filesystem::path dir(opt->out);
+    std::filesystem::create_directories(dir);
+    const std::string record = (dir / "record.csv").string();
+
     fmt::print(
-        "exact inputs (MODEL.md section 4) beside the seed's nominal ones (section 5), revolution 0.\n\n");
-    fmt::print("{:>3} {:>6} {:>6}  {:>16} {:>16}  {:>12} {:>12}  {:>12} {:>12}  {:>12} {:>12}\n", "k", "beta",
-               "gamma", "omega_I exact", "nominal", "a_I exact", "nominal", "a_O exact", "nominal",
-               "a_S exact", "nominal");
-    fmt::print("{:>3} {:>6} {:>6}  {:>16} {:>16}  {:>12} {:>12}  {:>12} {:>12}  {:>12} {:>12}\n", "", "deg",
-               "deg", "deg/h", "deg/h", "g", "g", "g", "g", "g", "g");
-    for (const Position& p : test_positions(s.test)) {
-      const InstantInputs in = inputs_at_gamma(model, p.rate_rad_s, p.beta_rad, p.gamma_rad, 0);
-      fmt::print(
-          "{:>3} {:>6.0f} {:>6.0f}  {:>16.9f} {:>16.9f}  {:>12.7f} {:>12.7f}  {:>12.7f} {:>12.7f}  {:>12.7f} "
-          "{:>12.7f}\n",
-          p.index, p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg,
-          in.exact.rate_rad_s.x() * kRadPerSecToDegPerHour, in.nominal.omega_I_rad_s * kRadPerSecToDegPerHour,
-          in.exact.specific_force_g.x(), in.nominal.a_I_g, in.exact.specific_force_g.y(), in.nominal.a_O_g,
-          in.exact.specific_force_g.z(), in.nominal.a_S_g);
+        "gyrocal demo: the default scenario of MODEL.md section 11 (R0 {} m, {} rad/s, Ar {:.3f} g).\n",
+        s.centrifuge.radius_m, s.centrifuge.rate_rad_s,
+        radial_level_g(s.site, s.centrifuge.radius_m, s.centrifuge.rate_rad_s));
+    AtomicOutputFile file(record, /*overwrite=*/true);
+    const SimulationSummary sim = simulate_record(s, SimulationOptions{}, file.stream());
+    file.commit();
+    fmt::print("simulated {} samples ({:.0f} s of test) into {}\n\n", sim.samples, sim.duration_s, record);
+
+    struct Run {
+      std::string label;
+      Method method;
+      Compensation compensation;
+    };
+    const std::vector<Run> runs = {{"closed form, none", Method::kClosedForm, Compensation::kNone},
+                                   {"closed form, seed", Method::kClosedForm, Compensation::kSeed},
+                                   {"closed form, full", Method::kClosedForm, Compensation::kFull},
+                                   {"least squares, full", Method::kLeastSquares, Compensation::kFull}};
+    std::vector<std::string> labels;
+    std::vector<CalibrationResult> results;
+    for (const Run& run : runs) {
+      CalibrationOptions options;
+      options.method = run.method;
+      options.compensation = run.compensation;
+      labels.push_back(run.label);
+      results.push_back(calibrate_record(record, s.model(), s.test, options));
     }
+    fmt::print("{}\n", comparison_table(labels, results, &s.gyro));
+    const CalibrationResult& main = results.back();
+    fmt::print("{}\n", main.BriefReport());
+    for (const std::string& w : main.warnings) fmt::print("- {}\n", w);
+
+    nlohmann::json j = calibration_to_json(main);
+    j["record"] = record;
+    j["truth"] = coefficients_to_json(s.gyro);
+    j["plan"] = plan_to_json(s.test);
+    j["comparison"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < results.size(); ++i)
+      j["comparison"].push_back(
+          {{"label", labels[i]}, {"coefficients", calibration_to_json(results[i])["coefficients"]}});
+    const std::string result_path = (dir / "result.json").string();
+    write_output(result_path, j.dump(2) + "\n", true);
+    HtmlReportOptions report;
+    report.title = "gyrocal demo: the default scenario";
+    report.source = result_path;
+    const std::string report_path = (dir / "report.html").string();
+    write_output(report_path, render_html_report(j, report), true);
+    fmt::print("\nwrote {}, {} and {}\n", record, result_path, report_path);
   });
 }
 

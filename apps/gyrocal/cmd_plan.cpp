@@ -1,13 +1,47 @@
-// gyrocal plan (INTERFACE.md). Placeholder until its issue lands.
+// gyrocal plan: identifiability and predicted uncertainty of the configured test, before running it.
+#include <fmt/format.h>
+
 #include "cli.hpp"
-#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/predict.hpp"
+#include "gyrocal/result/calibration_json.hpp"
+#include "tables.hpp"
 
 namespace gyrocal::cli {
 
 void register_plan(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("plan", "(not yet available)");
-  sub->allow_extras();
-  sub->callback([] { throw Error("'gyrocal plan' is not available yet in this version."); });
+  struct Options {
+    std::string config, json, method = "least-squares", compensation = "full";
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "plan", "Identifiability and predicted uncertainty of the configured test, before running it");
+  sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
+  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+      ->check(CLI::IsMember({"closed-form", "least-squares"}));
+  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
+      ->check(CLI::IsMember({"none", "seed", "full"}));
+  sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
+  sub->callback([opt] {
+    refuse_to_overwrite_input(opt->json, opt->config);
+    const Scenario s = load_configuration(opt->config);
+    CalibrationOptions options;
+    options.method = parse_method(opt->method);
+    options.compensation = parse_compensation(opt->compensation);
+    const CalibrationResult r = predict_calibration(s, options);
+    if (!opt->json.empty()) {
+      nlohmann::json j = calibration_to_json(r);
+      j["plan"] = plan_to_json(s.test);
+      write_output(opt->json, j.dump(2) + "\n", true);
+    }
+    if (opt->json == "-") return;
+    fmt::print("The configured test: {} positions, {} revolutions per dwell at {} Hz.\n", r.positions.size(),
+               s.test.revolutions, s.test.sample_rate_hz);
+    fmt::print(
+        "Predicted from the configured noise (angle random walk {} deg/sqrt(h)); estimates are the "
+        "configured truth.\n\n",
+        s.noise.angle_random_walk_deg_rt_h);
+    fmt::print("{}", result_table(r));
+  });
 }
 
 }  // namespace gyrocal::cli

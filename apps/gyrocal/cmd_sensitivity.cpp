@@ -1,13 +1,100 @@
-// gyrocal sensitivity (INTERFACE.md). Placeholder until its issue lands.
+// gyrocal sensitivity: the seed's error study (MODEL.md section 10, INTERFACE.md).
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "cli.hpp"
-#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/result/sensitivity_json.hpp"
 
 namespace gyrocal::cli {
+namespace {
+
+constexpr const char* kCompensationNames[3] = {"none", "seed", "full"};
+
+std::string magnitude(const SensitivityRow& row) {
+  return fmt::format("{:.3g} {}{}", row.value, row.term.unit, row.typical ? " *" : "");
+}
+
+std::string row_label(const SensitivityRow& row) {
+  return row.term.harmonic > 0 ? fmt::format("{} h{}", row.term.error, row.term.harmonic) : row.term.error;
+}
+
+/// Per compensation: the closed forms' shifts in units of their noise std, '.' below the threshold.
+std::string sensitivity_table(const SensitivityResult& r) {
+  std::string s = fmt::format(
+      "Each machine error alone (MODEL.md section 10): shift = estimate(error) - estimate(no error), exact "
+      "(noise-free).\nCells: shift / sigma, sigma = the estimate's predicted noise std; '.' = below {} sigma "
+      "(does not matter). * = typical magnitude (zero in the configuration).\n",
+      r.threshold);
+  s += "\nsigma:";
+  for (const std::string& name : r.closed_form_names)
+    s += fmt::format("  {} {:.2g}", name, r.closed_form_noise_std.at(name));
+  s += "\n";
+  for (std::size_t c = 0; c < 3; ++c) {
+    s += fmt::format("\nclosed forms, compensation {}\n{:<30}{:>18}", kCompensationNames[c], "machine error",
+                     "magnitude");
+    for (const std::string& name : r.closed_form_names) s += fmt::format("{:>9}", name.substr(0, 8));
+    s += "\n";
+    for (const SensitivityRow& row : r.rows) {
+      s += fmt::format("{:<30}{:>18}", row_label(row), magnitude(row));
+      const auto& matters = row.closed_form_matters[c];
+      for (const std::string& name : r.closed_form_names) {
+        const auto it = row.closed_form[c].find(name);
+        const bool m = std::find(matters.begin(), matters.end(), name) != matters.end();
+        const double sigma = r.closed_form_noise_std.at(name);
+        if (it == row.closed_form[c].end() || !m)
+          s += fmt::format("{:>9}", ".");
+        else if (sigma > 0)
+          s += fmt::format("{:>9.3g}", it->second / sigma);
+        else
+          s += fmt::format("{:>9.2e}", it->second);
+      }
+      s += "\n";
+    }
+  }
+  s += fmt::format("\nleast squares: estimates shifted by more than {} sigma\n", r.threshold);
+  for (const SensitivityRow& row : r.rows) {
+    std::string line;
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::string names;
+      for (const std::string& n : row.least_squares_matters[c]) names += (names.empty() ? "" : " ") + n;
+      line += fmt::format("  {}: {:<28}", kCompensationNames[c], names.empty() ? "-" : names);
+    }
+    s += fmt::format("{:<30}{:>18}{}\n", row_label(row), magnitude(row), line);
+  }
+  return s;
+}
+
+}  // namespace
 
 void register_sensitivity(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("sensitivity", "(not yet available)");
-  sub->allow_extras();
-  sub->callback([] { throw Error("'gyrocal sensitivity' is not available yet in this version."); });
+  struct Options {
+    std::string config, json;
+    double threshold = 0.1;
+    int threads = 0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "sensitivity", "The seed's study: the shift of every estimate per machine error, with each compensation");
+  sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
+  sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  sub->add_option("--threshold", opt->threshold,
+                  "An estimate is affected when its shift exceeds this many noise std; default 0.1")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
+      ->check(CLI::NonNegativeNumber);
+  sub->callback([opt] {
+    refuse_to_overwrite_input(opt->json, opt->config);
+    const Scenario scenario = load_configuration(opt->config);
+    SensitivityOptions options;
+    options.threshold = opt->threshold;
+    options.threads = opt->threads;
+    const SensitivityResult result = sensitivity_study(scenario, options);
+    if (!opt->json.empty()) write_output(opt->json, sensitivity_to_json(result).dump(2) + "\n", true);
+    if (opt->json != "-") fmt::print("{}", sensitivity_table(result));
+  });
 }
 
 }  // namespace gyrocal::cli

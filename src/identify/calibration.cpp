@@ -104,8 +104,14 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   for (const std::string& w : sol.warnings) r.warnings.push_back("least squares: " + w);
   if (sol.rank == n) return;
 
-  for (Eigen::Index k = 0; k < sol.null_space.cols(); ++k)
-    r.unidentifiable.push_back(describe_combination(sol.null_space.col(k), sol.names));
+  for (Eigen::Index k = 0; k < sol.null_space.cols(); ++k) {
+    // Written without the ~1e-9 parts that exact regressors add: they say nothing to the reader.
+    Eigen::VectorXd v = sol.null_space.col(k);
+    const double largest = v.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (std::abs(v[i]) < 1e-6 * largest) v[i] = 0.0;
+    r.unidentifiable.push_back(describe_combination(v, sol.names));
+  }
   // The identifiable combinations of MODEL.md section 8 where the plan is the single-speed one; each is made
   // exactly estimable by removing its (tiny) part along the numerically unidentifiable directions.
   const double ar = r.g_level;
@@ -213,6 +219,13 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
     closed_form_identify(reduction, channels, model, options, r);
   } else {
     least_squares_identify(reduction, channels, options, r);
+    // The closed form's second expressions are a useful cross-check whenever the plan holds the 16 positions.
+    if (!sixteen_positions(reduction.positions).empty()) {
+      CalibrationResult cf;
+      cf.g_level = r.g_level;
+      closed_form_identify(reduction, channels, model, options, cf);
+      r.alternatives = cf.alternatives;
+    }
   }
   return r;
 }
