@@ -101,7 +101,12 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     if (sol.identifiable[c]) r.coefficients[c] = {sol.estimate[ci], sol.std[ci], true};
   }
   for (Eigen::Index i = 0; i < m; ++i) r.residuals_deg_h.push_back(sol.residuals[i]);
-  for (const std::string& w : sol.warnings) r.warnings.push_back("least squares: " + w);
+  for (const std::string& w : sol.warnings) {
+    // Identifiability is said once, below, in the coefficients' terms.
+    if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
+      continue;
+    r.warnings.push_back("least squares: " + w);
+  }
   if (sol.rank == n) return;
 
   for (Eigen::Index k = 0; k < sol.null_space.cols(); ++k) {
