@@ -28,9 +28,11 @@ ensure_packages() {
 }
 
 # libjs-chart.js is inlined into the HTML report; chromium runs the report's browser test (docs/report.md).
+# What the build needs (libjs-chart.js: the plotting library the HTML report inlines).
 GYROCAL_BUILD_PACKAGES=(g++ cmake make libeigen3-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev
-                        libjs-chart.js chromium)
+                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev libjs-chart.js)
+# What the tests need beyond the build: a headless browser that opens the report.
+GYROCAL_TEST_PACKAGES=(chromium)
 
 # build_gyrocal DIR [CMAKE ARGS...]: configure and build into DIR (Release unless told otherwise).
 build_gyrocal() {
