@@ -12,7 +12,7 @@
 namespace gyrocal {
 namespace {
 
-constexpr std::uint64_t kProgressEverySamples = std::uint64_t{1} << 16;
+constexpr std::uint64_t kProgressEverySamples = 4096;
 
 /// An encoder's reading of an angle (rad): degrees in [0, 360).
 double encoder_deg(double angle_rad) {
@@ -35,8 +35,10 @@ std::string list(const std::vector<double>& values, double scale) {
   return s + "]";
 }
 
+/// The simulation loop; `sink` is a template parameter so that the record writer's call is direct.
+template <typename Sink>
 SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed,
-                      const SimulationOptions& options, const SampleSink& sink) {
+                      const SimulationOptions& options, Sink&& sink) {
   const CentrifugeModel model = scenario.model();
   const double fs = scenario.test.sample_rate_hz;
   GyroNoiseGenerator noise(scenario.noise, fs, seed);

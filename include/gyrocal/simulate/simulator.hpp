@@ -19,7 +19,7 @@ namespace gyrocal {
 
 struct SimulationOptions {
   std::optional<std::uint64_t> seed;  ///< the noise's seed; default: the scenario's test.seed
-  /// Called with the fraction of samples done, in [0, 1]: every 2^16 samples and once at the end with 1.
+  /// Called with the fraction of samples done, in [0, 1]: every 4096 samples and once at the end with 1.
   std::function<void(double fraction)> progress;
 };
 
