@@ -18,7 +18,8 @@ std::string magnitude(const SensitivityRow& row) {
 }
 
 std::string row_label(const SensitivityRow& row) {
-  return row.term.harmonic > 0 ? fmt::format("{} h{}", row.term.error, row.term.harmonic) : row.term.error;
+  if (row.term.harmonic == 0) return row.term.error;
+  return fmt::format("{} h{} @{:g}", row.term.error, row.term.harmonic, row.term.phase_rad * kRadToDeg);
 }
 
 /// Per compensation: the closed forms' shifts in units of their noise std, '.' below the threshold.
@@ -77,7 +78,8 @@ void register_sensitivity(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
-      "sensitivity", "The seed's study: the shift of every estimate per machine error, with each compensation");
+      "sensitivity",
+      "The seed's study: the shift of every estimate per machine error, with each compensation");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_option("--threshold", opt->threshold,

@@ -1,0 +1,87 @@
+#pragma once
+// The seed's error study (MODEL.md section 10): each machine error of section 3 alone, and the shift it
+// causes in every estimate, without and with compensation. Shifts are exact: noise-free reduced outputs of
+// the exact model through the same reduction and identification as a real calibration (identify/predict.hpp),
+// not a statistical simulation.
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/calibration.hpp"
+
+namespace gyrocal {
+
+/// One machine error of MODEL.md section 3 as a single number: a scalar field of CentrifugeErrors, one
+/// harmonic of a harmonic series, or one component of a vector field.
+struct MachineErrorTerm {
+  std::string error;       ///< [centrifuge.errors] key without its unit suffix; a vector's component appended
+                           ///< (mount_misalignment_I, lever_arm_S)
+  int harmonic = 0;        ///< harmonic number for a series term, 0 for a constant error
+  double phase_rad = 0.0;  ///< phase of the harmonic term, rad (0 for a constant error)
+  std::string unit;        ///< the configuration's unit of the value: arcsec, m, rad/s, m/(rad/s)^2
+  double unit_to_si = 1.0;  ///< value_in_unit * unit_to_si = SI value (rad, m, rad/s, m/(rad/s)^2)
+  double typical_si = 0.0;  ///< the typical magnitude used where the configuration has none, SI
+
+  /// Add `amount_si` (SI) of this error to `errors`: to the scalar or vector component, or, for a harmonic,
+  /// a term (harmonic, amount_si, phase_rad) appended to the series (a sum of cosines, so adding is linear).
+  void add_to(CentrifugeErrors& errors, double amount_si) const;
+  /// Budget and table label: error, with "_h<n>" appended for a harmonic and "@<phase>deg" for a non-zero
+  /// phase (counter_wobble_y_h2@70deg).
+  std::string label() const;
+
+  int field = 0;      ///< internal: which CentrifugeErrors field
+  int component = 0;  ///< internal: vector component 0..2
+};
+
+/// Every machine error of `errors` that is not zero, one term each (each harmonic term of a series, each
+/// vector component), with its magnitude in SI: for the Monte Carlo, `errors` holds standard uncertainties.
+std::vector<std::pair<MachineErrorTerm, double>> nonzero_error_terms(const CentrifugeErrors& errors);
+
+/// The rows of the sensitivity study: every field of CentrifugeErrors; a series gives its configured
+/// harmonics, plus harmonics 1 and 2 where not configured, each at phase 0 and 90 deg; a vector gives three
+/// components. With each term its magnitude (SI):
+/// the configured one where it is not zero, else the term's typical magnitude (docs/sensitivity.md).
+std::vector<std::pair<MachineErrorTerm, double>> sensitivity_terms(const CentrifugeErrors& configured);
+
+struct SensitivityOptions {
+  CalibrationOptions calibration;  ///< reduction and solver options; method and compensation are set per run
+  /// An estimate "matters" for an error when |shift| > threshold * its predicted noise std. Default 0.1.
+  double threshold = 0.1;
+  int threads = 0;  ///< worker threads; 0 = hardware concurrency. Results do not depend on it.
+};
+
+/// Shifts of one error for one compensation: estimate name -> shift in the estimate's unit.
+using ShiftMap = std::map<std::string, double>;
+
+struct SensitivityRow {
+  MachineErrorTerm term;
+  double value = 0.0;    ///< magnitude used, in term.unit
+  bool typical = false;  ///< true when the configuration has zero and the typical magnitude was used
+  /// Closed forms (primary dI dO dS dIS dIO dOS, alternatives dI_1g dO_1g dS_1g dIS_b, the three
+  /// combinations), per compensation none, seed, full (index = Compensation).
+  std::array<ShiftMap, 3> closed_form;
+  /// Least squares: identifiable coefficients and combinations, per compensation. A combination's shift is
+  /// that of its estimation error (estimate - true value of the combination least squares estimates).
+  std::array<ShiftMap, 3> least_squares;
+  /// Names whose |shift| > threshold * noise std, per compensation, in the estimates' order.
+  std::array<std::vector<std::string>, 3> closed_form_matters, least_squares_matters;
+};
+
+struct SensitivityResult {
+  std::vector<SensitivityRow> rows;
+  std::vector<std::string> closed_form_names;    ///< in display order
+  std::vector<std::string> least_squares_names;  ///< in display order
+  std::map<std::string, std::string> units;      ///< estimate name -> unit
+  /// Predicted noise std of each estimate (white rate noise through the plan), closed form and least squares.
+  std::map<std::string, double> closed_form_noise_std, least_squares_noise_std;
+  double threshold = 0.1;
+};
+
+/// The study on `scenario`: its test, truth, noise and site; the base case has no machine error, each row
+/// one error alone, identified with compensation none, seed and full (the compensation told that error).
+/// Throws Error if the plan lacks the 16 positions of MODEL.md section 7 (the closed forms need them).
+SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options = {});
+
+}  // namespace gyrocal

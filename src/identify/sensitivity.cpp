@@ -1,0 +1,308 @@
+#include "gyrocal/identify/sensitivity.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/predict.hpp"
+
+namespace gyrocal {
+namespace {
+
+enum class Kind { kScalar, kSeries, kVector };
+
+/// A field of CentrifugeErrors: its [centrifuge.errors] key without unit, unit, typical magnitude.
+struct Field {
+  const char* key;
+  const char* unit;
+  double unit_to_si;
+  double typical_si;
+  Kind kind;
+  double CentrifugeErrors::*scalar = nullptr;
+  HarmonicSeries CentrifugeErrors::*series = nullptr;
+  Eigen::Vector3d CentrifugeErrors::*vector = nullptr;
+};
+
+using E = CentrifugeErrors;
+constexpr double kArcsec = kArcsecToRad;
+
+// Typical magnitudes (docs/sensitivity.md): 1 arcsec for angles and wobbles, 1 um runout, 10 um radius
+// error, 1e-7 m/(rad/s)^2 stretch (10 um at 9.9 rad/s), 1e-6 rad/s rate mismatch, 1 mm lever arm.
+const Field kFields[] = {
+    {"base_tilt_x", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::base_tilt_x_rad},
+    {"base_tilt_y", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::base_tilt_y_rad},
+    {"main_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::main_perpendicularity_x_rad},
+    {"main_perpendicularity_y", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::main_perpendicularity_y_rad},
+    {"main_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::main_wobble_x_rad},
+    {"main_wobble_y", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::main_wobble_y_rad},
+    {"main_runout_x", "m", 1.0, 1e-6, Kind::kSeries, nullptr, &E::main_runout_x_m},
+    {"main_runout_y", "m", 1.0, 1e-6, Kind::kSeries, nullptr, &E::main_runout_y_m},
+    {"radius_error", "m", 1.0, 1e-5, Kind::kScalar, &E::radius_error_m},
+    {"radius_stretch", "m/(rad/s)^2", 1.0, 1e-7, Kind::kScalar, &E::radius_stretch_m_per_rad2_s2},
+    {"counter_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar,
+     &E::counter_perpendicularity_x_rad},
+    {"counter_perpendicularity_y", "arcsec", kArcsec, kArcsec, Kind::kScalar,
+     &E::counter_perpendicularity_y_rad},
+    {"counter_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::counter_wobble_x_rad},
+    {"counter_wobble_y", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::counter_wobble_y_rad},
+    {"counter_rate_mismatch", "rad/s", 1.0, 1e-6, Kind::kScalar, &E::counter_rate_mismatch_rad_s},
+    {"position_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar,
+     &E::position_perpendicularity_x_rad},
+    {"position_perpendicularity_z", "arcsec", kArcsec, kArcsec, Kind::kScalar,
+     &E::position_perpendicularity_z_rad},
+    {"position_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::position_wobble_x_rad},
+    {"position_wobble_z", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::position_wobble_z_rad},
+    {"position_angle_error", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::position_angle_error_rad},
+    {"mount_misalignment", "arcsec", kArcsec, kArcsec, Kind::kVector, nullptr, nullptr,
+     &E::mount_misalignment_rad},
+    {"lever_arm", "m", 1.0, 1e-3, Kind::kVector, nullptr, nullptr, &E::lever_arm_m},
+};
+constexpr const char* kAxes[3] = {"I", "O", "S"};
+
+MachineErrorTerm make_term(int field, int harmonic, double phase_rad, int component) {
+  const Field& f = kFields[field];
+  MachineErrorTerm t;
+  t.field = field;
+  t.error = f.kind == Kind::kVector ? std::string(f.key) + "_" + kAxes[component] : f.key;
+  t.harmonic = harmonic;
+  t.phase_rad = phase_rad;
+  t.component = component;
+  t.unit = f.unit;
+  t.unit_to_si = f.unit_to_si;
+  t.typical_si = f.typical_si;
+  return t;
+}
+
+/// The terms of one field of `errors`, each with its value (SI); `all` adds zero scalars and components and
+/// harmonics 1 and 2 of a series where they are not configured.
+void field_terms(int fi, const CentrifugeErrors& errors, bool all,
+                 std::vector<std::pair<MachineErrorTerm, double>>& out) {
+  const Field& f = kFields[fi];
+  switch (f.kind) {
+    case Kind::kScalar: {
+      const double v = errors.*f.scalar;
+      if (v != 0.0 || all) out.emplace_back(make_term(fi, 0, 0.0, 0), v);
+      break;
+    }
+    case Kind::kVector:
+      for (int c = 0; c < 3; ++c) {
+        const double v = (errors.*f.vector)[c];
+        if (v != 0.0 || all) out.emplace_back(make_term(fi, 0, 0.0, c), v);
+      }
+      break;
+    case Kind::kSeries: {
+      std::vector<std::pair<int, double>> seen;
+      for (const HarmonicTerm& h : (errors.*f.series).terms) {
+        if (h.amplitude == 0.0) continue;
+        out.emplace_back(make_term(fi, h.harmonic, h.phase_rad, 0), h.amplitude);
+        seen.emplace_back(h.harmonic, h.phase_rad);
+      }
+      // Harmonics 1 and 2 in both quadratures where not configured: at the 16 positions a wobble may act
+      // through its cosine or its sine part alone.
+      if (all)
+        for (int n : {1, 2})
+          for (double phase : {0.0, kPi / 2})
+            if (std::find(seen.begin(), seen.end(), std::pair(n, phase)) == seen.end())
+              out.emplace_back(make_term(fi, n, phase, 0), 0.0);
+      break;
+    }
+  }
+}
+
+/// Run f(0..n-1) on `threads` threads; the first exception is rethrown here.
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& f) {
+  const auto workers = static_cast<std::size_t>(
+      std::clamp(threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()), 1,
+                 static_cast<int>(std::max<std::size_t>(n, 1))));
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex mutex;
+  const auto work = [&] {
+    for (std::size_t i; (i = next++) < n;) {
+      try {
+        f(i);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = n;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t k = 1; k < workers; ++k) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+/// Estimate name -> (value, std) of a calibration: closed form's primary, alternatives and combinations, or
+/// least squares' identifiable coefficients and combinations. A combination's value is given less its true
+/// value for the combination actually estimated (NamedEstimate::coefficients): least squares' estimable
+/// combination moves with the machine's errors (they change the regressors), and its shift must not count
+/// that change of definition.
+std::vector<std::pair<std::string, std::pair<double, double>>> estimates(const CalibrationResult& r,
+                                                                         const DriftCoefficients& truth) {
+  std::vector<std::pair<std::string, std::pair<double, double>>> out;
+  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    if (r.coefficients[k].identifiable)
+      out.push_back({std::string(kCoefficientNames[k]), {r.coefficients[k].value, r.coefficients[k].std}});
+  if (r.method == Method::kClosedForm)
+    for (const NamedEstimate& e : r.alternatives) out.push_back({e.name, {e.value, e.std}});
+  for (const NamedEstimate& e : r.combinations) {
+    double true_value = 0.0;
+    for (std::size_t k = 0; k < e.coefficients.size() && k < kNumCoefficients; ++k)
+      true_value += e.coefficients[k] * truth.values[k];
+    out.push_back({e.name, {e.value - true_value, e.std}});
+  }
+  return out;
+}
+
+/// The noise-free reduced test of `s` with predicted standard errors, and its model channels.
+struct PlannedTest {
+  Reduction reduction;
+  std::vector<PositionChannels> channels;
+};
+PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
+  PlannedTest p;
+  p.reduction = planned_reduction(s, ro);
+  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
+  set_noise_free_outputs(p.reduction, p.channels, s.gyro);
+  set_predicted_std_errors(p.reduction, p.channels, s.noise, s.test.sample_rate_hz);
+  return p;
+}
+
+constexpr Compensation kCompensations[3] = {Compensation::kNone, Compensation::kSeed, Compensation::kFull};
+
+/// The six calibrations of one scenario: [method][compensation], method 0 closed form, 1 least squares.
+using SixCalibrations = std::array<std::array<CalibrationResult, 3>, 2>;
+SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base) {
+  const PlannedTest p = planned_test(s, base.reduce);
+  const CentrifugeModel model = s.model();
+  SixCalibrations out;
+  for (int m = 0; m < 2; ++m)
+    for (int c = 0; c < 3; ++c) {
+      CalibrationOptions o = base;
+      o.method = m == 0 ? Method::kClosedForm : Method::kLeastSquares;
+      o.compensation = kCompensations[c];
+      out[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] =
+          identify(p.reduction, p.channels, model, s.test, o);
+    }
+  return out;
+}
+
+}  // namespace
+
+void MachineErrorTerm::add_to(CentrifugeErrors& errors, double amount_si) const {
+  const Field& f = kFields[field];
+  switch (f.kind) {
+    case Kind::kScalar:
+      errors.*f.scalar += amount_si;
+      break;
+    case Kind::kVector:
+      (errors.*f.vector)[component] += amount_si;
+      break;
+    case Kind::kSeries:
+      (errors.*f.series).terms.push_back({harmonic, amount_si, phase_rad});
+      break;
+  }
+}
+
+std::string MachineErrorTerm::label() const {
+  if (harmonic == 0) return error;
+  std::string s = error + "_h" + std::to_string(harmonic);
+  if (phase_rad != 0.0) s += fmt::format("@{:g}deg", phase_rad * kRadToDeg);
+  return s;
+}
+
+std::vector<std::pair<MachineErrorTerm, double>> nonzero_error_terms(const CentrifugeErrors& errors) {
+  std::vector<std::pair<MachineErrorTerm, double>> out;
+  for (int f = 0; f < static_cast<int>(std::size(kFields)); ++f) field_terms(f, errors, false, out);
+  return out;
+}
+
+std::vector<std::pair<MachineErrorTerm, double>> sensitivity_terms(const CentrifugeErrors& configured) {
+  std::vector<std::pair<MachineErrorTerm, double>> out;
+  for (int f = 0; f < static_cast<int>(std::size(kFields)); ++f) field_terms(f, configured, true, out);
+  return out;
+}
+
+SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options) {
+  if (!(options.threshold > 0.0)) throw Error("sensitivity: the threshold must be positive.");
+  Scenario base = scenario;
+  base.errors = CentrifugeErrors{};
+  if (sixteen_positions(planned_reduction(base, options.calibration.reduce).positions).empty())
+    throw Error(
+        "the sensitivity study needs the 16 positions of MODEL.md section 7 (beta and gamma in {0, 90, 180, "
+        "270} deg at one spinning rate) for its closed forms; this plan does not have them.");
+
+  const std::vector<std::pair<MachineErrorTerm, double>> terms = sensitivity_terms(scenario.errors);
+  SensitivityResult result;
+  result.threshold = options.threshold;
+  result.rows.resize(terms.size());
+  // Item 0 is the base case (no machine error), items 1.. the rows; every item is independent.
+  std::vector<SixCalibrations> runs(terms.size() + 1);
+  parallel_for(terms.size() + 1, options.threads, [&](std::size_t i) {
+    Scenario s = base;
+    if (i > 0) {
+      const auto& [term, value] = terms[i - 1];
+      term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
+    }
+    runs[i] = calibrate_six(s, options.calibration);
+  });
+
+  for (int m = 0; m < 2; ++m) {
+    // Names, units and noise std from the base case with full compensation.
+    const CalibrationResult& r0 = runs[0][static_cast<std::size_t>(m)][2];
+    auto& names = m == 0 ? result.closed_form_names : result.least_squares_names;
+    auto& noise = m == 0 ? result.closed_form_noise_std : result.least_squares_noise_std;
+    for (const auto& [name, vs] : estimates(r0, scenario.gyro)) {
+      names.push_back(name);
+      noise[name] = vs.second;
+    }
+    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+      result.units[std::string(kCoefficientNames[k])] = std::string(kCoefficientUnits[k]);
+    for (const NamedEstimate& e : r0.alternatives) result.units[e.name] = e.unit;
+    for (const NamedEstimate& e : r0.combinations) result.units[e.name] = e.unit;
+  }
+
+  const bool noisy = scenario.noise.angle_random_walk_deg_rt_h > 0;
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    SensitivityRow& row = result.rows[i];
+    const auto& [term, value] = terms[i];
+    row.term = term;
+    row.typical = value == 0.0;
+    row.value = (row.typical ? term.typical_si : value) / term.unit_to_si;
+    for (int m = 0; m < 2; ++m) {
+      const auto& noise = m == 0 ? result.closed_form_noise_std : result.least_squares_noise_std;
+      for (std::size_t c = 0; c < 3; ++c) {
+        ShiftMap& shift = m == 0 ? row.closed_form[c] : row.least_squares[c];
+        auto& matters = m == 0 ? row.closed_form_matters[c] : row.least_squares_matters[c];
+        const auto base_estimates = estimates(runs[0][static_cast<std::size_t>(m)][c], scenario.gyro);
+        const auto row_estimates = estimates(runs[i + 1][static_cast<std::size_t>(m)][c], scenario.gyro);
+        for (const auto& [name, vs] : row_estimates) {
+          for (const auto& [name0, vs0] : base_estimates) {
+            if (name0 != name) continue;
+            const double d = vs.first - vs0.first;
+            shift[name] = d;
+            // Judged against the predicted noise; with no white noise configured, against 1e-6 (the
+            // estimates' units) so that rounding is not reported.
+            const auto it = noise.find(name);
+            const double sigma =
+                noisy && it != noise.end() && it->second > 0 ? it->second : 1e-6 / options.threshold;
+            if (std::abs(d) > options.threshold * sigma) matters.push_back(name);
+          }
+        }
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace gyrocal

@@ -1,0 +1,43 @@
+#include "gyrocal/result/sensitivity_json.hpp"
+
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+
+nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
+  static constexpr const char* kCompensationNames[3] = {"none", "seed", "full"};
+  nlohmann::json rows = nlohmann::json::array();
+  for (const SensitivityRow& row : r.rows) {
+    nlohmann::json j = {{"error", row.term.error},
+                        {"harmonic", row.term.harmonic},
+                        {"phase_deg", row.term.phase_rad * kRadToDeg},
+                        {"value", row.value},
+                        {"unit", row.term.unit},
+                        {"typical", row.typical}};
+    for (std::size_t c = 0; c < 3; ++c) {
+      const char* comp = kCompensationNames[c];
+      j["shift"][comp] = nlohmann::json::object();
+      for (const std::string& name : r.closed_form_names)
+        if (const auto it = row.closed_form[c].find(name); it != row.closed_form[c].end())
+          j["shift"][comp][name] = it->second;
+      j["least_squares"][comp] = nlohmann::json::object();
+      for (const std::string& name : r.least_squares_names)
+        if (const auto it = row.least_squares[c].find(name); it != row.least_squares[c].end())
+          j["least_squares"][comp][name] = it->second;
+      j["matters"][comp] = row.closed_form_matters[c];
+      j["least_squares_matters"][comp] = row.least_squares_matters[c];
+    }
+    rows.push_back(std::move(j));
+  }
+  nlohmann::json out = {{"rows", rows}, {"threshold", r.threshold}};
+  out["noise_std"] = nlohmann::json::object();
+  for (const std::string& name : r.closed_form_names)
+    out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  out["least_squares_noise_std"] = nlohmann::json::object();
+  for (const std::string& name : r.least_squares_names)
+    out["least_squares_noise_std"][name] = r.least_squares_noise_std.at(name);
+  out["units"] = r.units;
+  return out;
+}
+
+}  // namespace gyrocal

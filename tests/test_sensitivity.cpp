@@ -1,0 +1,177 @@
+// The seed's error study (MODEL.md sections 8 and 10) on the default scenario: which machine error shifts
+// which estimate, without and with compensation, exactly (noise-free).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/model/nominal.hpp"
+#include "gyrocal/result/sensitivity_json.hpp"
+
+namespace gyrocal {
+namespace {
+
+constexpr std::size_t kNone = 0, kSeed = 1, kFull = 2;
+
+bool sanitized() {
+  return std::getenv("GYROCAL_SANITIZED") != nullptr;
+}
+
+Scenario study_scenario() {
+  Scenario s = default_scenario();
+  if (sanitized()) s.test.revolutions = 20;  // shifts are exact at any length; the test only runs faster
+  return s;
+}
+
+const SensitivityResult& default_study() {
+  static const SensitivityResult r = sensitivity_study(study_scenario());
+  return r;
+}
+
+/// The row of `error`, harmonic and phase (deg).
+const SensitivityRow& row(const std::string& error, int harmonic = 0, double phase_deg = 0.0) {
+  for (const SensitivityRow& r : default_study().rows)
+    if (r.term.error == error && r.term.harmonic == harmonic &&
+        std::abs(r.term.phase_rad * kRadToDeg - phase_deg) < 1e-9)
+      return r;
+  throw std::runtime_error("no row " + error);
+}
+
+double shift(const SensitivityRow& r, std::size_t compensation, const std::string& name) {
+  return r.closed_form[compensation].at(name);
+}
+
+const char* const kPrimaryUnaffected[] = {"dO", "dS", "dIS", "dIO"};
+
+TEST(Sensitivity, EveryMachineErrorHasItsRows) {
+  const SensitivityResult& r = default_study();
+  // 12 scalars, 2 vectors x 3 components, 8 series x (harmonics 1, 2 at 0 and 90 deg), and the configured
+  // terms: the counter wobbles' second harmonics at 20 and 70 deg add a row each, the main wobble's first
+  // harmonic at 0 deg takes the place of its typical row.
+  EXPECT_EQ(r.rows.size(), 12u + 6u + 8u * 4u + 2u);
+  EXPECT_EQ(row("counter_wobble_x", 2, 20.0).value, 1.0);  // configured: its magnitude and phase
+  EXPECT_FALSE(row("counter_wobble_x", 2, 20.0).typical);
+  EXPECT_EQ(row("counter_perpendicularity_y").value, -2.0);
+  EXPECT_TRUE(row("base_tilt_x").typical);
+  EXPECT_EQ(row("lever_arm_O").term.unit, "m");
+}
+
+TEST(Sensitivity, SeedsFindingWithoutCompensation) {
+  // Counter-platform perpendicularity shifts dI (through k1, its y part) and dOS (k2, its x part) by
+  // thousands of noise sigmas and leaves the other primary closed forms alone.
+  const SensitivityRow& px = row("counter_perpendicularity_x");
+  const SensitivityRow& py = row("counter_perpendicularity_y");
+  const auto& sigma = default_study().closed_form_noise_std;
+  EXPECT_GT(std::abs(shift(px, kNone, "dOS")), 1000 * sigma.at("dOS"));
+  EXPECT_GT(std::abs(shift(py, kNone, "dI")), 1000 * sigma.at("dI"));
+  for (const SensitivityRow* r : {&px, &py, &row("counter_rate_mismatch")})
+    for (const char* name : kPrimaryUnaffected) EXPECT_LT(std::abs(shift(*r, kNone, name)), 1e-4) << name;
+  // Delta omega enters omega_I as delta_omega * sin(beta) (MODEL.md section 5): the 1 g form of dI, which
+  // subtracts Omega_U, absorbs all of it; the centrifuge forms (positions at beta = 0, 180) see none.
+  const SensitivityRow& dw = row("counter_rate_mismatch");
+  EXPECT_NEAR(shift(dw, kNone, "dI_1g"), 2e-6 * kRadPerSecToDegPerHour, 1e-4);
+  EXPECT_LT(std::abs(shift(dw, kNone, "dI")), 1e-4);
+  EXPECT_LT(std::abs(shift(dw, kNone, "dOS")), 1e-4);
+  EXPECT_NE(std::find(px.closed_form_matters[kNone].begin(), px.closed_form_matters[kNone].end(), "dOS"),
+            px.closed_form_matters[kNone].end());
+}
+
+TEST(Sensitivity, PerpendicularityShiftAgreesWithTheFirstOrderClosedForm) {
+  // MODEL.md section 8: dOS = -[(W3 - W4) - (W7 - W8) + 4 k2 w] / (4 Ar). Uncompensated, the outputs carry
+  // -k2 w, k2 w, k2 w, -k2 w at positions 3, 4, 7, 8 (section 7), so the estimate moves by k2 w / Ar, with
+  // k2 = count_perp_x. Likewise dI = [(W1 - W2) - (W5 - W6) - 4 k1 w] / (-4 Ar) moves by -k1 w / Ar with
+  // k1 = -count_perp_y.
+  const Scenario s = study_scenario();
+  const double w = s.test.rates_rad_s[0];
+  const double ar = radial_level_g(s.site, s.centrifuge.radius_m, w);
+  const double k2 = 3.0 * kArcsecToRad, k1 = 2.0 * kArcsecToRad;
+  const double dos = k2 * w * kRadPerSecToDegPerHour / ar, di = -k1 * w * kRadPerSecToDegPerHour / ar;
+  EXPECT_NEAR(shift(row("counter_perpendicularity_x"), kNone, "dOS"), dos, 0.01 * std::abs(dos));
+  EXPECT_NEAR(shift(row("counter_perpendicularity_y"), kNone, "dI"), di, 0.01 * std::abs(di));
+}
+
+TEST(Sensitivity, SeedCompensationIsExactForPerpendicularityAndRateMismatchNotForWobble) {
+  for (const char* error :
+       {"counter_perpendicularity_x", "counter_perpendicularity_y", "counter_rate_mismatch"})
+    for (const char* name : {"dI", "dOS"})
+      EXPECT_LT(std::abs(shift(row(error), kSeed, name)), 1e-4) << error << " " << name;
+  EXPECT_LT(std::abs(shift(row("counter_rate_mismatch"), kSeed, "dI_1g")), 1e-4);
+  // A wobble's own rate n a w (MODEL.md section 5) is not in the seed's terms: the configured second
+  // harmonics still shift dI or dOS, by hundreds of sigmas (MODEL.md section 8's -0.18 and -1.38).
+  EXPECT_GT(std::abs(shift(row("counter_wobble_x", 2, 20.0), kSeed, "dI")), 0.1);
+  EXPECT_GT(std::abs(shift(row("counter_wobble_y", 2, 70.0), kSeed, "dOS")), 0.1);
+}
+
+TEST(Sensitivity, FullCompensationRemovesEveryShift) {
+  for (const SensitivityRow& r : default_study().rows) {
+    for (const auto& [name, v] : r.closed_form[kFull]) EXPECT_LT(std::abs(v), 1e-4) << r.term.label() << name;
+    for (const auto& [name, v] : r.least_squares[kFull])
+      EXPECT_LT(std::abs(v), 1e-6) << r.term.label() << name;
+    EXPECT_TRUE(r.least_squares_matters[kFull].empty()) << r.term.label();
+  }
+}
+
+TEST(Sensitivity, FirstHarmonicMainWobbleActsLikeACounterPerpendicularity) {
+  // MODEL.md section 10: per arcsec, a first-harmonic main-axis wobble about x shifts dOS (cosine part) or
+  // dI (sine part) as much as the counter platform's perpendicularity does, and the seed's compensation,
+  // which knows only the counter platform, leaves it.
+  const double dos_per_arcsec = shift(row("counter_perpendicularity_x"), kNone, "dOS") / 3.0;
+  const double di_per_arcsec = shift(row("counter_perpendicularity_y"), kNone, "dI") / -2.0;
+  const SensitivityRow& cosine = row("main_wobble_x", 1, 0.0);  // configured, 0.5 arcsec
+  const SensitivityRow& sine = row("main_wobble_x", 1, 90.0);   // typical, 1 arcsec
+  EXPECT_NEAR(shift(cosine, kNone, "dOS") / cosine.value, dos_per_arcsec, 0.02 * std::abs(dos_per_arcsec));
+  EXPECT_NEAR(std::abs(shift(sine, kNone, "dI") / sine.value), std::abs(di_per_arcsec),
+              0.02 * std::abs(di_per_arcsec));
+  EXPECT_GT(std::abs(shift(cosine, kSeed, "dOS")), 0.1);
+  for (const char* name : kPrimaryUnaffected) EXPECT_LT(std::abs(shift(cosine, kNone, name)), 1e-4) << name;
+}
+
+TEST(Sensitivity, FirstHarmonicCounterWobbleShiftsTheOneGFormOfDS) {
+  // MODEL.md section 10: k1 = -count_wobble_y(psi_r) with psi_r = -gamma makes k1 cos(gamma) w a constant,
+  // which dS_1g = [(W1 + W2) - (W5 + W6) - 4 Omega_N] / 4 takes for a drift; the seed's terms remove it.
+  const SensitivityRow& r = row("counter_wobble_y", 1, 0.0);
+  const auto& sigma = default_study().closed_form_noise_std;
+  EXPECT_GT(std::abs(shift(r, kNone, "dS_1g")), 100 * sigma.at("dS_1g"));
+  EXPECT_LT(std::abs(shift(r, kSeed, "dS_1g")), 1e-3);
+  for (const char* name : {"dI", "dO", "dS", "dIS", "dIO", "dOS"})
+    EXPECT_LT(std::abs(shift(r, kNone, name)), 1e-4) << name;
+}
+
+TEST(Sensitivity, JsonHasTheInterfaceKeys) {
+  const nlohmann::json j = sensitivity_to_json(default_study());
+  ASSERT_TRUE(j["rows"].is_array());
+  const nlohmann::json& first = j["rows"][0];
+  for (const char* key : {"error", "harmonic", "value", "unit", "shift", "least_squares"})
+    EXPECT_TRUE(first.contains(key)) << key;
+  for (const char* comp : {"none", "seed", "full"})
+    for (const char* name : {"dI", "dO", "dS", "dIS", "dIO", "dOS", "dI_1g", "dO_1g", "dS_1g", "dIS_b",
+                             "dII-dSS", "dOO-dSS", "dF+(1+Ar^2)dSS"})
+      EXPECT_TRUE(first["shift"][comp].contains(name)) << comp << " " << name;
+  EXPECT_EQ(first["error"], "base_tilt_x");  // the key without its unit suffix
+  EXPECT_EQ(first["harmonic"], 0);
+  EXPECT_TRUE(j["noise_std"].contains("dOS"));
+}
+
+TEST(Sensitivity, ResultDoesNotDependOnTheNumberOfThreads) {
+  Scenario s = default_scenario();
+  s.test.revolutions = 5;
+  s.test.sample_rate_hz = 50;
+  SensitivityOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const SensitivityResult a = sensitivity_study(s, one), b = sensitivity_study(s, two);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  for (std::size_t i = 0; i < a.rows.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) {
+      EXPECT_EQ(a.rows[i].closed_form[c], b.rows[i].closed_form[c]);
+      EXPECT_EQ(a.rows[i].least_squares[c], b.rows[i].least_squares[c]);
+    }
+}
+
+}  // namespace
+}  // namespace gyrocal
