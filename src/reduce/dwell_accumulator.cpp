@@ -282,4 +282,20 @@ std::vector<double> DwellAccumulator::white_noise_gain() const {
   return gain;
 }
 
+Eigen::MatrixXd DwellAccumulator::white_noise_covariance() const {
+  const auto ng = static_cast<Eigen::Index>(gammas_.size());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(ng, ng);
+  if (samples_ > 0 && !static_ && options_.method == ReduceOptions::Method::kHarmonicFit) {
+    const double t_mid = (0.5 * (t_first_ + t_last_) - t_first_) / duration_s_ - 0.5;
+    const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
+    Eigen::MatrixXd b(basis_size(), ng);
+    for (Eigen::Index k = 0; k < ng; ++k) basis(gammas_[static_cast<std::size_t>(k)], t_mid, b.col(k).data());
+    cov = b.transpose() * full.ldlt().solve(b);
+  } else {
+    const std::vector<double> gain = white_noise_gain();
+    for (Eigen::Index k = 0; k < ng; ++k) cov(k, k) = gain[static_cast<std::size_t>(k)];
+  }
+  return cov;
+}
+
 }  // namespace gyrocal

@@ -60,6 +60,10 @@ class DwellAccumulator {
   /// Per gamma: the variance of the reduced value per unit variance of white noise on each sample,
   /// i.e. sum_i a_i^2 for the operator value = sum_i a_i y_i (b' (Phi' Phi)^-1 b for the harmonic fit).
   std::vector<double> white_noise_gain() const;
+  /// gamma x gamma: the covariance of the reduced values per unit variance of white noise on each sample,
+  /// whose diagonal is white_noise_gain(). The harmonic fit's values at different gammas share its
+  /// coefficients, so they are correlated; the window mean's are not.
+  Eigen::MatrixXd white_noise_covariance() const;
 
   std::size_t samples() const { return samples_; }
   double first_time_s() const { return t_first_; }
