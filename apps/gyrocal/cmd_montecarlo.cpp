@@ -1,13 +1,104 @@
-// gyrocal montecarlo (INTERFACE.md). Placeholder until its issue lands.
+// gyrocal montecarlo: uncertainty budget over random machine errors and noise (INTERFACE.md).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include <fmt/format.h>
+
 #include "cli.hpp"
-#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/montecarlo.hpp"
+#include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal::cli {
+namespace {
+
+/// A progress bar on standard error, redrawn when the whole percentage changes.
+class ProgressBar {
+ public:
+  void operator()(double fraction) {
+    const int percent = static_cast<int>(fraction * 100.0);
+    if (percent == percent_) return;
+    percent_ = percent;
+    constexpr int kWidth = 40;
+    const int filled = percent * kWidth / 100;
+    fmt::print(stderr, "\rMonte Carlo [{:#<{}}{:<{}}] {:3}%", "", filled, "", kWidth - filled, percent);
+    if (percent == 100) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  int percent_ = -1;
+};
+
+std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
+  std::string s = fmt::format(
+      "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, which knows the configured "
+      "errors only.\nError = estimate - truth. Predicted: the linearised model (mean = noise-free error "
+      "at the configured errors).\n\n",
+      r.trials, to_string(r.mode), r.seed, seconds, to_string(r.method), to_string(r.compensation));
+  s += fmt::format("{:<16}{:>13}{:>13}{:>13}{:>13}  {:<10} {}\n", "estimate", "mean error", "std",
+                   "pred. mean", "pred. std", "unit", "largest shares of the variance");
+  for (const EstimateDistribution& e : r.estimates) {
+    std::vector<std::size_t> order(r.sources.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return e.budget[a] > e.budget[b]; });
+    std::string shares;
+    for (std::size_t k = 0; k < std::min<std::size_t>(3, order.size()); ++k)
+      if (e.budget[order[k]] >= 0.005)
+        shares += fmt::format("{}{} {:.0f}%", shares.empty() ? "" : ", ", r.sources[order[k]],
+                              100.0 * e.budget[order[k]]);
+    s += fmt::format("{:<16}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}  {:<10} {}\n", e.name, e.mean, e.std,
+                     e.predicted_mean, e.predicted_std, e.unit, shares);
+  }
+  s += "\nsources:";
+  for (std::size_t k = 0; k < r.sources.size(); ++k)
+    s += fmt::format("  {} {:g} {}", r.sources[k], r.source_std[k], r.source_units[k]);
+  return s + "\n";
+}
+
+}  // namespace
 
 void register_montecarlo(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("montecarlo", "(not yet available)");
-  sub->allow_extras();
-  sub->callback([] { throw Error("'gyrocal montecarlo' is not available yet in this version."); });
+  struct Options {
+    std::string config, json, method = "least-squares", compensation = "full";
+    long long trials = 0;
+    std::uint64_t seed = 0;
+    bool samples = false;
+    int threads = 0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "montecarlo", "Uncertainty budget over random machine errors ([uncertainty]) and noise");
+  sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
+  sub->add_option("--trials", opt->trials, "Number of trials")->required()->check(CLI::Range(2LL, 1LL << 40));
+  CLI::Option* seed = sub->add_option("--seed", opt->seed, "Random seed; default: [test] seed");
+  sub->add_flag("--samples", opt->samples,
+                "Run the whole time-series pipeline per trial (slow; checks the fast linearised mode)");
+  sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--method", opt->method, "closed-form or least-squares (default)");
+  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)");
+  sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  sub->callback([opt, seed] {
+    refuse_to_overwrite_input(opt->json, opt->config);
+    const Scenario scenario = load_configuration(opt->config);
+    MonteCarloOptions options;
+    options.trials = opt->trials;
+    options.seed = seed->count() ? opt->seed : scenario.test.seed;
+    options.mode = opt->samples ? MonteCarloMode::kSamples : MonteCarloMode::kFast;
+    options.threads = opt->threads;
+    options.calibration.method = parse_method(opt->method);
+    options.calibration.compensation = parse_compensation(opt->compensation);
+    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar();
+    const auto start = std::chrono::steady_clock::now();
+    const MonteCarloResult result = monte_carlo(scenario, options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!opt->json.empty()) write_output(opt->json, montecarlo_to_json(result).dump(2) + "\n", true);
+    if (opt->json != "-") fmt::print("{}", montecarlo_table(result, seconds));
+  });
 }
 
 }  // namespace gyrocal::cli

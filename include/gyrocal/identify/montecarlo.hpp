@@ -1,0 +1,100 @@
+#pragma once
+// Monte Carlo uncertainty budget (issue 5): machine errors drawn from their standard uncertainties
+// ([uncertainty]), gyro noise, and the calibration run each trial with a compensation that knows only the
+// configured errors. The result is the distribution of each estimate's error and the share of each source
+// in its variance.
+//
+// Two modes. Fast: the reduced outputs are linear in the drawn errors and the noise, W = W0 + J*delta + n,
+// with J from central differences of the exact noise-free engine (identify/predict.hpp) and n the white
+// noise through the reduction operator (with its correlation between the gammas of one dwell); the
+// identification is an affine map of W (precomputed from identify itself), so a trial is one small
+// matrix-vector product. Samples: the whole time-series pipeline per trial (simulate with the drawn errors,
+// reduce, channels of the configured model, identify), to check the fast mode.
+//
+// Trial k draws from RandomSource(seed, k) alone, and statistics are combined in trial order, so the same
+// seed gives the same result whatever the number of threads.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/sensitivity.hpp"
+
+namespace gyrocal {
+
+enum class MonteCarloMode { kFast, kSamples };
+std::string to_string(MonteCarloMode mode);  ///< "fast" or "samples"
+
+struct MonteCarloOptions {
+  long long trials = 10000;  ///< number of trials (>= 2)
+  std::uint64_t seed = 1;    ///< trial k draws from RandomSource(seed, k)
+  MonteCarloMode mode = MonteCarloMode::kFast;
+  int threads = 0;                 ///< worker threads; 0 = hardware concurrency
+  CalibrationOptions calibration;  ///< method (default least squares), compensation (default full)
+  int histogram_bins = 30;         ///< bins between the smallest and largest error
+  /// Called on the calling thread with the fraction of trials done, in [0, 1], about ten times a second
+  /// and once with 1 at the end. May be empty.
+  std::function<void(double fraction)> progress;
+
+  bool IsValid(std::string* error) const;
+};
+
+/// An error source: one [uncertainty] entry (a scalar, a harmonic term, a vector component).
+struct MonteCarloSource {
+  MachineErrorTerm term;
+  double std_si = 0.0;  ///< its standard uncertainty, SI
+};
+
+/// The fast mode's linear model of one scenario and calibration: estimate error = bias + G * xi, xi standard
+/// normal: first one per source (scaled by its uncertainty), then one per reduced position (noise).
+struct MonteCarloModel {
+  Scenario scenario;
+  CalibrationOptions calibration;
+  std::vector<MonteCarloSource> sources;
+  std::vector<std::string> names;  ///< the estimates: identifiable coefficients, alternatives, combinations
+  std::vector<std::string> units;
+  std::vector<double> truth;  ///< true value of each estimate (a combination's, for its coefficients)
+  std::vector<double> bias;   ///< noise-free error of each estimate at the configured errors
+  int positions = 0;          ///< reduced positions (noise columns)
+  std::vector<double> gain;   ///< G, row-major, names.size() x (sources.size() + positions)
+  std::size_t columns() const { return sources.size() + static_cast<std::size_t>(positions); }
+};
+
+/// Linearise the scenario (about 2 evaluations of the exact model over the plan per source, in parallel).
+/// Throws Error for options the calibration refuses.
+MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOptions& options);
+
+struct EstimateDistribution {
+  std::string name, unit;
+  double truth = 0.0;            ///< true value (what the error is measured from)
+  double mean = 0.0, std = 0.0;  ///< of the error estimate - truth, over the trials
+  double predicted_mean = 0.0;   ///< the linear model's: the noise-free error at the configured errors
+  double predicted_std = 0.0;    ///< the linear model's: sqrt of the budget's total variance
+  std::vector<double> edges;     ///< histogram_bins + 1 edges, in the estimate's unit
+  std::vector<long long> counts;
+  /// Share of each source's variance in the predicted total, in MonteCarloResult::sources order; sums to 1.
+  std::vector<double> budget;
+};
+
+struct MonteCarloResult {
+  long long trials = 0;
+  MonteCarloMode mode = MonteCarloMode::kFast;
+  std::uint64_t seed = 0;
+  Method method = Method::kLeastSquares;
+  Compensation compensation = Compensation::kFull;
+  std::vector<std::string> sources;  ///< "noise", then each uncertainty entry's label
+  std::vector<double>
+      source_std;  ///< the uncertainty in its configuration unit (noise: the ARW, deg/sqrt(h))
+  std::vector<std::string> source_units;
+  std::vector<EstimateDistribution> estimates;
+};
+
+/// Run the trials on a prepared model (mode as in options; the samples mode uses model.scenario).
+MonteCarloResult run_monte_carlo(const MonteCarloModel& model, const MonteCarloOptions& options);
+
+/// prepare_monte_carlo and run_monte_carlo.
+MonteCarloResult monte_carlo(const Scenario& scenario, const MonteCarloOptions& options);
+
+}  // namespace gyrocal

@@ -1,0 +1,416 @@
+#include "gyrocal/identify/montecarlo.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/random.hpp"
+#include "gyrocal/identify/predict.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace gyrocal {
+namespace {
+
+int worker_count(int threads, std::size_t items) {
+  const int hw = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return std::clamp(threads > 0 ? threads : hw, 1, static_cast<int>(std::max<std::size_t>(items, 1)));
+}
+
+/// Run f(0..n-1) on worker threads while the calling thread reports progress (done(), n); the first
+/// exception is rethrown here.
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& f,
+                  const std::function<void()>& on_tick = {}) {
+  const int workers = worker_count(threads, n);
+  std::atomic<std::size_t> next{0};
+  std::atomic<int> running{workers};
+  std::exception_ptr failure;
+  std::mutex mutex;
+  const auto work = [&] {
+    for (std::size_t i; (i = next++) < n;) {
+      try {
+        f(i);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = n;
+      }
+    }
+    --running;
+  };
+  std::vector<std::thread> pool;
+  for (int k = 0; k < workers; ++k) pool.emplace_back(work);
+  while (on_tick && running > 0) {
+    on_tick();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+/// The estimates of a calibration, as errors: (value - true value) per name, in `names` order; an estimate
+/// missing from `r` is NaN. Fills names, units, truth when `names` is empty.
+std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoefficients& truth,
+                                    std::vector<std::string>& names, std::vector<std::string>* units,
+                                    std::vector<double>* true_values) {
+  std::vector<std::pair<std::string, double>> value, true_value;
+  std::vector<std::string> unit;
+  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    if (r.coefficients[k].identifiable) {
+      value.emplace_back(std::string(kCoefficientNames[k]), r.coefficients[k].value);
+      true_value.emplace_back(std::string(kCoefficientNames[k]), truth.values[k]);
+      unit.emplace_back(kCoefficientUnits[k]);
+    }
+  if (r.method == Method::kClosedForm) {
+    // The 1 g forms estimate the same coefficients as the primary ones (MODEL.md section 8).
+    const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
+                                                      {"dO_1g", Coefficient::dO},
+                                                      {"dS_1g", Coefficient::dS},
+                                                      {"dIS_b", Coefficient::dIS}};
+    for (const NamedEstimate& e : r.alternatives)
+      for (const auto& [n, c] : of)
+        if (e.name == n) {
+          value.emplace_back(e.name, e.value);
+          true_value.emplace_back(e.name, truth[c]);
+          unit.push_back(e.unit);
+        }
+  }
+  for (const NamedEstimate& e : r.combinations) {
+    double t = 0.0;
+    for (std::size_t k = 0; k < e.coefficients.size() && k < kNumCoefficients; ++k)
+      t += e.coefficients[k] * truth.values[k];
+    value.emplace_back(e.name, e.value);
+    true_value.emplace_back(e.name, t);
+    unit.push_back(e.unit);
+  }
+  if (names.empty()) {
+    for (const auto& v : value) names.push_back(v.first);
+    if (units) *units = unit;
+    if (true_values)
+      for (const auto& t : true_value) true_values->push_back(t.second);
+  }
+  std::vector<double> out(names.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    for (std::size_t j = 0; j < value.size(); ++j)
+      if (value[j].first == names[i]) out[i] = value[j].second - true_value[j].second;
+  return out;
+}
+
+/// Noise-free reduced outputs (deg/h) of scenario s's test, in plan order.
+Eigen::VectorXd noise_free_outputs(const Scenario& s, const ReduceOptions& ro) {
+  Reduction r = planned_reduction(s, ro);
+  set_noise_free_outputs(r, reduce_model_channels(r, s.model(), ro), s.gyro);
+  Eigen::VectorXd w(static_cast<Eigen::Index>(r.positions.size()));
+  for (std::size_t i = 0; i < r.positions.size(); ++i)
+    w[static_cast<Eigen::Index>(i)] = r.positions[i].mean_deg_h;
+  return w;
+}
+
+/// Covariance (deg/h)^2 of the reduced positions under white rate noise: the reduction operator's
+/// covariance within each dwell (the harmonic fit correlates the gammas of one dwell), zero across dwells.
+Eigen::MatrixXd white_noise_covariance(const Reduction& r, const ReduceOptions& ro, double sample_std_deg_h) {
+  const auto n = static_cast<Eigen::Index>(r.positions.size());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> per_dwell;
+  for (const Dwell& d : r.dwells) {
+    // The samples exactly as reduce_model_channels feeds them to the same operator.
+    DwellAccumulator acc(ro, d.gammas_rad, d.is_static, 1, d.planned_duration_s, false);
+    const double zero = 0.0;
+    for (std::size_t i = 0; i < d.samples; ++i) {
+      const double t = d.time_of_sample(i);
+      acc.add(t, -d.counter.at(t, d.first_time_s), &zero);
+    }
+    per_dwell.push_back(acc.white_noise_covariance());
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const ReducedPosition& a = r.positions[static_cast<std::size_t>(i)];
+      const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
+      if (a.dwell == b.dwell)
+        cov(i, j) = per_dwell[static_cast<std::size_t>(a.dwell)](a.gamma_slot, b.gamma_slot) *
+                    sample_std_deg_h * sample_std_deg_h;
+    }
+  return cov;
+}
+
+/// Mean, M2 (sum of squared deviations), min, max of a chunk of trials, per estimate.
+struct ChunkStats {
+  std::vector<double> mean, m2, lo, hi;
+  long long n = 0;
+};
+
+}  // namespace
+
+std::string to_string(MonteCarloMode mode) {
+  return mode == MonteCarloMode::kFast ? "fast" : "samples";
+}
+
+bool MonteCarloOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (trials < 2)
+    e = "at least 2 trials are needed";
+  else if (histogram_bins < 1)
+    e = "histogram_bins must be at least 1";
+  else if (threads < 0)
+    e = "threads must not be negative";
+  else if (!calibration.IsValid(&e))
+    e = "calibration: " + e;
+  if (e.empty()) return true;
+  if (error) *error = e;
+  return false;
+}
+
+MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw Error("Monte Carlo options: " + error + ".");
+  MonteCarloModel m;
+  m.scenario = scenario;
+  m.calibration = options.calibration;
+  for (const auto& [term, u] : nonzero_error_terms(scenario.uncertainty)) m.sources.push_back({term, u});
+  const ReduceOptions& ro = options.calibration.reduce;
+
+  // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
+  Reduction r0 = planned_reduction(scenario, ro);
+  const CentrifugeModel model0 = scenario.model();
+  const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
+  set_noise_free_outputs(r0, ch0, scenario.gyro);
+  set_predicted_std_errors(r0, ch0, scenario.noise, scenario.test.sample_rate_hz);
+  const auto np = static_cast<Eigen::Index>(r0.positions.size());
+  m.positions = static_cast<int>(np);
+
+  // The identification is affine in the outputs W: errors = bias + M (W - W0).
+  const auto identify_at = [&](const Eigen::VectorXd& dw) {
+    Reduction r = r0;
+    for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean_deg_h += dw[i];
+    return identify(r, ch0, model0, scenario.test, options.calibration);
+  };
+  m.bias =
+      estimate_errors(identify_at(Eigen::VectorXd::Zero(np)), scenario.gyro, m.names, &m.units, &m.truth);
+  const auto ne = static_cast<Eigen::Index>(m.names.size());
+  Eigen::MatrixXd map(ne, np);
+  for (Eigen::Index k = 0; k < np; ++k) {
+    const std::vector<double> e =
+        estimate_errors(identify_at(Eigen::VectorXd::Unit(np, k)), scenario.gyro, m.names, nullptr, nullptr);
+    for (Eigen::Index i = 0; i < ne; ++i)
+      map(i, k) = e[static_cast<std::size_t>(i)] - m.bias[static_cast<std::size_t>(i)];
+  }
+
+  // Each source's effect on W at one standard uncertainty: (W(e0 + u) - W(e0 - u)) / 2, the drawn machine
+  // reduced on its own plan (its encoders), exact to second order.
+  const auto ns = static_cast<Eigen::Index>(m.sources.size());
+  Eigen::MatrixXd ju(np, ns);
+  parallel_for(static_cast<std::size_t>(ns), options.threads, [&](std::size_t s) {
+    Scenario plus = scenario, minus = scenario;
+    m.sources[s].term.add_to(plus.errors, m.sources[s].std_si);
+    m.sources[s].term.add_to(minus.errors, -m.sources[s].std_si);
+    const Eigen::VectorXd wp = noise_free_outputs(plus, ro), wm = noise_free_outputs(minus, ro);
+    if (wp.size() != np || wm.size() != np) throw Error("Monte Carlo: a drawn machine changes the plan.");
+    ju.col(static_cast<Eigen::Index>(s)) = 0.5 * (wp - wm);
+  });
+
+  // White rate noise through the reduction, as a Cholesky factor: n = L xi.
+  const double sigma = white_noise_sample_std_deg_h(scenario.noise, scenario.test.sample_rate_hz);
+  Eigen::MatrixXd chol = Eigen::MatrixXd::Zero(np, np);
+  if (sigma > 0) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(white_noise_covariance(r0, ro, sigma));
+    if (llt.info() != Eigen::Success)
+      throw Error("Monte Carlo: the noise covariance is not positive definite.");
+    chol = llt.matrixL();
+  }
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> g(ne, ns + np);
+  g.leftCols(ns) = map * ju;
+  g.rightCols(np) = map * chol;
+  m.gain.assign(g.data(), g.data() + g.size());
+  return m;
+}
+
+MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw Error("Monte Carlo options: " + error + ".");
+  const std::size_t ne = m.names.size(), nc = m.columns(), ns = m.sources.size();
+  const bool fast = options.mode == MonteCarloMode::kFast;
+  const auto trials = static_cast<std::size_t>(options.trials);
+
+  // The samples mode's fixed parts: the configured model the calibration knows.
+  const CentrifugeModel model0 = m.scenario.model();
+
+  // Trial k's estimate errors into out[0..ne).
+  const auto trial = [&](std::size_t k, double* out) {
+    RandomSource rng(options.seed, k);
+    if (fast) {
+      double xi[256];
+      std::vector<double> big;
+      double* x = xi;
+      if (nc > 256) {
+        big.resize(nc);
+        x = big.data();
+      }
+      for (std::size_t c = 0; c < nc; ++c) x[c] = rng.normal();
+      for (std::size_t i = 0; i < ne; ++i) {
+        const double* row = m.gain.data() + i * nc;
+        double v = m.bias[i];
+        for (std::size_t c = 0; c < nc; ++c) v += row[c] * x[c];
+        out[i] = v;
+      }
+      return;
+    }
+    // The same draws of the machine errors as the fast mode, then the whole pipeline.
+    Scenario s = m.scenario;
+    for (std::size_t c = 0; c < ns; ++c)
+      m.sources[c].term.add_to(s.errors, m.sources[c].std_si * rng.normal());
+    Reducer reducer(s.test, m.calibration.reduce, "Monte Carlo trial", s.centrifuge.rate_rad_s);
+    SimulationOptions so;
+    so.seed = rng.next_u64();
+    simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
+    const Reduction r = reducer.finish();
+    const auto channels = reduce_model_channels(r, model0, m.calibration.reduce);
+    std::vector<std::string> names = m.names;
+    const std::vector<double> e = estimate_errors(identify(r, channels, model0, s.test, m.calibration),
+                                                  m.scenario.gyro, names, nullptr, nullptr);
+    std::copy(e.begin(), e.end(), out);
+  };
+
+  // Chunks of trials in a fixed partition: statistics are combined in chunk order, so they do not depend
+  // on which thread ran which chunk.
+  const std::size_t chunk = fast ? 4096 : 8;
+  const std::size_t chunks = (trials + chunk - 1) / chunk;
+  std::vector<ChunkStats> stats(chunks);
+  std::vector<double> stored(fast ? 0 : trials * ne);
+  std::atomic<std::size_t> done{0};
+  const double passes = fast ? 2.0 : 1.0;
+  const auto tick = [&] {
+    if (options.progress)
+      options.progress(
+          std::min(1.0, static_cast<double>(done.load()) / (passes * static_cast<double>(trials))));
+  };
+  parallel_for(
+      chunks, options.threads,
+      [&](std::size_t c) {
+        const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
+        std::vector<double> values((end - begin) * ne);
+        for (std::size_t k = begin; k < end; ++k) trial(k, values.data() + (k - begin) * ne);
+        ChunkStats& st = stats[c];
+        st.n = static_cast<long long>(end - begin);
+        st.mean.assign(ne, 0.0);
+        st.m2.assign(ne, 0.0);
+        st.lo.assign(ne, std::numeric_limits<double>::infinity());
+        st.hi.assign(ne, -std::numeric_limits<double>::infinity());
+        for (std::size_t i = 0; i < ne; ++i) {
+          for (std::size_t k = 0; k < end - begin; ++k) st.mean[i] += values[k * ne + i];
+          st.mean[i] /= static_cast<double>(st.n);
+          for (std::size_t k = 0; k < end - begin; ++k) {
+            const double v = values[k * ne + i];
+            st.m2[i] += (v - st.mean[i]) * (v - st.mean[i]);
+            st.lo[i] = std::min(st.lo[i], v);
+            st.hi[i] = std::max(st.hi[i], v);
+          }
+        }
+        if (!fast)
+          std::copy(values.begin(), values.end(), stored.begin() + static_cast<std::ptrdiff_t>(begin * ne));
+        done += end - begin;
+      },
+      tick);
+
+  MonteCarloResult result;
+  result.trials = options.trials;
+  result.mode = options.mode;
+  result.seed = options.seed;
+  result.method = m.calibration.method;
+  result.compensation = m.calibration.compensation;
+  result.sources.push_back("noise");
+  result.source_std.push_back(m.scenario.noise.angle_random_walk_deg_rt_h);
+  result.source_units.push_back("deg/sqrt(h)");
+  for (const MonteCarloSource& s : m.sources) {
+    result.sources.push_back(s.term.label());
+    result.source_std.push_back(s.std_si / s.term.unit_to_si);
+    result.source_units.push_back(s.term.unit);
+  }
+  const int bins = options.histogram_bins;
+  for (std::size_t i = 0; i < ne; ++i) {
+    EstimateDistribution d;
+    d.name = m.names[i];
+    d.unit = m.units[i];
+    d.truth = m.truth[i];
+    d.predicted_mean = m.bias[i];
+    // Chan et al.'s pairwise update, chunk by chunk in order.
+    double n = 0, mean = 0, m2 = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const ChunkStats& st : stats) {
+      const auto nb = static_cast<double>(st.n);
+      const double delta = st.mean[i] - mean, total = n + nb;
+      mean += delta * nb / total;
+      m2 += st.m2[i] + delta * delta * n * nb / total;
+      n = total;
+      lo = std::min(lo, st.lo[i]);
+      hi = std::max(hi, st.hi[i]);
+    }
+    d.mean = mean;
+    d.std = std::sqrt(m2 / (n - 1));
+    if (!(hi > lo)) {
+      const double pad = std::max(std::abs(lo) * 1e-6, 1e-12);
+      lo -= pad;
+      hi += pad;
+    }
+    for (int b = 0; b <= bins; ++b) d.edges.push_back(lo + (hi - lo) * b / bins);
+    d.counts.assign(static_cast<std::size_t>(bins), 0);
+    // The budget: each column's variance through G; a source's share is its columns' part of the total.
+    std::vector<double> var(ns + 1, 0.0);
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double gc = m.gain[i * nc + c];
+      var[c < ns ? c + 1 : 0] += gc * gc;
+    }
+    double total = 0;
+    for (double v : var) total += v;
+    d.predicted_std = std::sqrt(total);
+    for (double v : var) d.budget.push_back(total > 0 ? v / total : 0.0);
+    result.estimates.push_back(std::move(d));
+  }
+
+  // Histograms: integer counts, so the order of summation does not matter. The fast mode draws its trials
+  // again rather than keeping them.
+  const auto bin_of = [&](std::size_t i, double v) {
+    const EstimateDistribution& d = result.estimates[i];
+    const double x = (v - d.edges.front()) / (d.edges.back() - d.edges.front()) * bins;
+    return static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(x)), 0, bins - 1));
+  };
+  if (fast) {
+    std::vector<std::vector<long long>> counts(chunks);
+    parallel_for(
+        chunks, options.threads,
+        [&](std::size_t c) {
+          const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
+          counts[c].assign(ne * static_cast<std::size_t>(bins), 0);
+          std::vector<double> v(ne);
+          for (std::size_t k = begin; k < end; ++k) {
+            trial(k, v.data());
+            for (std::size_t i = 0; i < ne; ++i)
+              ++counts[c][i * static_cast<std::size_t>(bins) + bin_of(i, v[i])];
+          }
+          done += end - begin;
+        },
+        tick);
+    for (const auto& cc : counts)
+      for (std::size_t i = 0; i < ne; ++i)
+        for (int b = 0; b < bins; ++b)
+          result.estimates[i].counts[static_cast<std::size_t>(b)] +=
+              cc[i * static_cast<std::size_t>(bins) + static_cast<std::size_t>(b)];
+  } else {
+    for (std::size_t k = 0; k < trials; ++k)
+      for (std::size_t i = 0; i < ne; ++i) ++result.estimates[i].counts[bin_of(i, stored[k * ne + i])];
+  }
+  if (options.progress) options.progress(1.0);
+  return result;
+}
+
+MonteCarloResult monte_carlo(const Scenario& scenario, const MonteCarloOptions& options) {
+  return run_monte_carlo(prepare_monte_carlo(scenario, options), options);
+}
+
+}  // namespace gyrocal

@@ -1,0 +1,31 @@
+#include "gyrocal/result/montecarlo_json.hpp"
+
+namespace gyrocal {
+
+nlohmann::json montecarlo_to_json(const MonteCarloResult& r) {
+  nlohmann::json j = {{"trials", r.trials},
+                      {"mode", to_string(r.mode)},
+                      {"seed", r.seed},
+                      {"method", to_string(r.method)},
+                      {"compensation", to_string(r.compensation)}};
+  j["coefficients"] = nlohmann::json::object();
+  j["budget"] = nlohmann::json::object();
+  for (const EstimateDistribution& e : r.estimates) {
+    j["coefficients"][e.name] = {{"mean", e.mean},
+                                 {"std", e.std},
+                                 {"unit", e.unit},
+                                 {"truth", e.truth},
+                                 {"predicted_mean", e.predicted_mean},
+                                 {"predicted_std", e.predicted_std},
+                                 {"histogram", {{"edges", e.edges}, {"counts", e.counts}}}};
+    nlohmann::json budget = nlohmann::json::object();
+    for (std::size_t s = 0; s < r.sources.size(); ++s) budget[r.sources[s]] = e.budget[s];
+    j["budget"][e.name] = budget;
+  }
+  j["sources"] = nlohmann::json::array();
+  for (std::size_t s = 0; s < r.sources.size(); ++s)
+    j["sources"].push_back({{"name", r.sources[s]}, {"std", r.source_std[s]}, {"unit", r.source_units[s]}});
+  return j;
+}
+
+}  // namespace gyrocal
