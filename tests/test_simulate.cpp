@@ -218,7 +218,8 @@ TEST(Simulate, RecordIsValidWithItsMetadata) {
   }
 }
 
-// The command line: the default test as a valid record, --force, and never over its own configuration.
+// The command line: the default test as a valid record; a configured test, --force, and never over its own
+// configuration.
 class SimulateCommand : public testing::Test {
  protected:
   void SetUp() override {
@@ -257,13 +258,6 @@ TEST_F(SimulateCommand, WritesTheDefaultTestAsAValidRecord) {
   const Scenario s = default_scenario();
   EXPECT_EQ(rows.size(), sample_count(make_timeline(s.test, s.model()), s.test.sample_rate_hz));
   EXPECT_NE(out.find(std::to_string(rows.size()) + " samples"), std::string::npos) << out;
-  // The same test again is refused unless --force, and the file is left as it was.
-  const std::string before = read(record);
-  EXPECT_NE(run("simulate --seed 7 --out " + record.string()), 0);
-  EXPECT_NE(read(dir_ / "stderr.txt").find("--force"), std::string::npos);
-  EXPECT_EQ(read(record), before);
-  ASSERT_EQ(run("simulate --seed 7 --force --out " + record.string()), 0);
-  EXPECT_NE(read(record), before);
   EXPECT_EQ(std::vector<fs::path>(fs::directory_iterator(dir_), {}).size(), 3u);  // no temporary left
 }
 
@@ -280,6 +274,15 @@ TEST_F(SimulateCommand, UsesTheConfigurationAndNeverOverwritesIt) {
   std::map<std::string, std::string> meta(reader.metadata().begin(), reader.metadata().end());
   EXPECT_EQ(meta["rates_rad_s"], "[0]");
   EXPECT_EQ(meta["sample_rate_hz"], "20");
+  // The same record again is refused unless --force, and the file is left as it was.
+  const std::string before = read(record);
+  const std::string other_seed =
+      "simulate --seed 7 --config " + config.string() + " --out " + record.string();
+  EXPECT_NE(run(other_seed), 0);
+  EXPECT_NE(read(dir_ / "stderr.txt").find("--force"), std::string::npos);
+  EXPECT_EQ(read(record), before);
+  ASSERT_EQ(run(other_seed + " --force"), 0);
+  EXPECT_NE(read(record), before);
 }
 
 }  // namespace
