@@ -244,7 +244,7 @@ TEST(Predict, PredictedStandardErrorsMatchTheScatterOfANoisyRecord) {
   s.test.revolutions = sanitized() ? 40 : 200;
   const Pipeline noisy = run(s, 7);
   Reduction planned = planned_reduction(s);
-  set_predicted_std_errors(planned, noisy.channels, s.noise, s.test.sample_rate_hz);
+  set_predicted_std_errors(planned, s.noise, s.test.sample_rate_hz);
   // Each measured standard error has ~revolutions-2 degrees of freedom; their mean ratio to the prediction
   // over the 16 positions is 1 within a few per cent.
   double ratio = 0;

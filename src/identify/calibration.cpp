@@ -4,6 +4,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <Eigen/Cholesky>
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/closed_form.hpp"
@@ -28,6 +29,28 @@ std::vector<std::string> coefficient_names() {
   return {kCoefficientNames.begin(), kCoefficientNames.end()};
 }
 
+/// Covariance (deg/h)^2 of the reduced positions: within a dwell from its values' covariance (one fit
+/// correlates its gammas), zero across dwells; standard errors alone where no covariance was computed. floor^2
+/// is added to every variance, so that a noise-free record (whose measured covariance is rounding) still
+/// weights a fit.
+Eigen::MatrixXd position_covariance(const Reduction& r, double floor) {
+  const auto m = static_cast<Eigen::Index>(r.positions.size());
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(m, m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const ReducedPosition& a = r.positions[static_cast<std::size_t>(i)];
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
+      if (a.dwell != b.dwell) continue;
+      const Eigen::MatrixXd& dc = r.dwells[static_cast<std::size_t>(a.dwell)].gyro.covariance;
+      const double v =
+          dc.size() ? dc(a.gamma_slot, b.gamma_slot) : (i == j ? a.std_err_deg_h * a.std_err_deg_h : 0.0);
+      c(i, j) = std::isfinite(v) ? v : 0.0;
+    }
+  }
+  c.diagonal().array() += floor * floor;
+  return c;
+}
+
 void closed_form_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                           const CentrifugeModel& model, const CalibrationOptions& options,
                           CalibrationResult& r) {
@@ -36,14 +59,17 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     throw Error(
         "the closed forms need the 16 positions of MODEL.md section 7 (beta and gamma in {0, 90, 180, "
         "270} deg at one spinning rate); this plan does not have them: use --method least-squares.");
-  std::array<double, 16> w{}, se{};
+  std::array<double, 16> w{};
+  const Eigen::MatrixXd all = position_covariance(reduction, 0.0);
+  Eigen::Matrix<double, 16, 16> se;
   for (std::size_t k = 0; k < 16; ++k) {
     const auto i = static_cast<std::size_t>(k16[k]);
     const PositionChannels& ch = channels[i];
     // Compensation: remove what the machine adds beyond a perfect one (MODEL.md section 8).
     w[k] =
         reduction.positions[i].mean_deg_h - (ch.omega_deg_h(options.compensation) - ch.omega_nominal_deg_h);
-    se[k] = reduction.positions[i].std_err_deg_h;
+    for (std::size_t l = 0; l < 16; ++l)
+      se(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(l)) = all(k16[k], k16[l]);
   }
   const Site& site = model.site();
   const double we = site.earth_rate_rad_s * kRadPerSecToDegPerHour;
@@ -73,21 +99,27 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
                             const CalibrationOptions& options, CalibrationResult& r) {
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
   const auto n = static_cast<Eigen::Index>(kNumCoefficients);
-  LeastSquaresProblem problem;
-  problem.design.resize(m, n);
-  problem.observations.resize(m);
-  problem.weights.resize(m);
-  problem.names = coefficient_names();
+  // Generalised least squares: the positions of one dwell are correlated, so rows and observations are
+  // whitened by the Cholesky factor of their covariance and solved with unit (known) weights.
+  Eigen::MatrixXd design(m, n);
+  Eigen::VectorXd observations(m);
   for (Eigen::Index i = 0; i < m; ++i) {
     const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
     const PositionChannels& ch = channels[static_cast<std::size_t>(i)];
     const auto& x = ch.regressors(options.compensation);
-    for (Eigen::Index j = 0; j < n; ++j) problem.design(i, j) = x[static_cast<std::size_t>(j)];
-    problem.observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
-    const double se = std::isfinite(p.std_err_deg_h) ? std::max(p.std_err_deg_h, options.min_std_err_deg_h)
-                                                     : options.min_std_err_deg_h;
-    problem.weights[i] = 1.0 / (se * se);
+    for (Eigen::Index j = 0; j < n; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
+    observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
   }
+  const Eigen::LLT<Eigen::MatrixXd> llt(position_covariance(reduction, options.min_std_err_deg_h));
+  if (llt.info() != Eigen::Success)
+    throw Error(
+        "the covariance of the reduced positions is not positive definite; the record's standard errors "
+        "cannot weight a least-squares fit.");
+  LeastSquaresProblem problem;
+  problem.design = llt.matrixL().solve(design);
+  problem.observations = llt.matrixL().solve(observations);
+  problem.weights = Eigen::VectorXd::Ones(m);
+  problem.names = coefficient_names();
   LeastSquaresOptions ls = options.least_squares;
   ls.rank_tolerance = std::max(ls.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
   ls.estimable_tolerance = std::max(ls.estimable_tolerance, options.estimable_tolerance);
@@ -100,7 +132,9 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     const auto ci = static_cast<Eigen::Index>(c);
     if (sol.identifiable[c]) r.coefficients[c] = {sol.estimate[ci], sol.std[ci], true};
   }
-  for (Eigen::Index i = 0; i < m; ++i) r.residuals_deg_h.push_back(sol.residuals[i]);
+  // Residuals in deg/h, not in whitened units.
+  const Eigen::VectorXd residuals = observations - design * sol.estimate;
+  for (Eigen::Index i = 0; i < m; ++i) r.residuals_deg_h.push_back(residuals[i]);
   for (const std::string& w : sol.warnings) {
     // Identifiability is said once, below, in the coefficients' terms.
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)

@@ -9,7 +9,6 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
   // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors.
   constexpr int kColumns = 3 + 2 * static_cast<int>(kNumCoefficients);
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
-  std::vector<std::vector<double>> gains(reduction.dwells.size());
   for (std::size_t di = 0; di < reduction.dwells.size(); ++di) {
     const Dwell& d = reduction.dwells[di];
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
@@ -37,7 +36,6 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       acc.add(t, -j.counter_angle_rad, v);
     }
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
-    gains[di] = acc.white_noise_gain();
   }
   std::vector<PositionChannels> out;
   for (const ReducedPosition& p : reduction.positions) {
@@ -46,7 +44,6 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       return cols[static_cast<std::size_t>(c)].value[static_cast<std::size_t>(p.gamma_slot)];
     };
     PositionChannels ch;
-    ch.white_noise_gain = gains[static_cast<std::size_t>(p.dwell)][static_cast<std::size_t>(p.gamma_slot)];
     ch.omega_exact_deg_h = at(0);
     ch.omega_nominal_deg_h = at(1);
     ch.omega_seed_deg_h = at(2);

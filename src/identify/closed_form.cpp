@@ -1,5 +1,6 @@
 #include "gyrocal/identify/closed_form.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gyrocal {
@@ -10,10 +11,9 @@ double LinearForm::value(const std::array<double, 16>& w) const {
   return v;
 }
 
-double LinearForm::std(const std::array<double, 16>& std_err) const {
-  double var = 0.0;
-  for (std::size_t k = 0; k < 16; ++k) var += weights[k] * weights[k] * std_err[k] * std_err[k];
-  return std::sqrt(var);
+double LinearForm::std(const Eigen::Matrix<double, 16, 16>& covariance) const {
+  const Eigen::Map<const Eigen::Matrix<double, 16, 1>> w(weights.data());
+  return std::sqrt(std::max(w.dot(covariance * w), 0.0));
 }
 
 namespace {

@@ -114,33 +114,6 @@ Eigen::VectorXd noise_free_outputs(const Scenario& s, const ReduceOptions& ro) {
   return w;
 }
 
-/// Covariance (deg/h)^2 of the reduced positions under white rate noise: the reduction operator's
-/// covariance within each dwell (the harmonic fit correlates the gammas of one dwell), zero across dwells.
-Eigen::MatrixXd white_noise_covariance(const Reduction& r, const ReduceOptions& ro, double sample_std_deg_h) {
-  const auto n = static_cast<Eigen::Index>(r.positions.size());
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
-  std::vector<Eigen::MatrixXd> per_dwell;
-  for (const Dwell& d : r.dwells) {
-    // The samples exactly as reduce_model_channels feeds them to the same operator.
-    DwellAccumulator acc(ro, d.gammas_rad, d.is_static, 1, d.planned_duration_s, false);
-    const double zero = 0.0;
-    for (std::size_t i = 0; i < d.samples; ++i) {
-      const double t = d.time_of_sample(i);
-      acc.add(t, -d.counter.at(t, d.first_time_s), &zero);
-    }
-    per_dwell.push_back(acc.white_noise_covariance());
-  }
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const ReducedPosition& a = r.positions[static_cast<std::size_t>(i)];
-      const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
-      if (a.dwell == b.dwell)
-        cov(i, j) = per_dwell[static_cast<std::size_t>(a.dwell)](a.gamma_slot, b.gamma_slot) *
-                    sample_std_deg_h * sample_std_deg_h;
-    }
-  return cov;
-}
-
 /// Mean, M2 (sum of squared deviations), min, max of a chunk of trials, per estimate.
 struct ChunkStats {
   std::vector<double> mean, m2, lo, hi;
@@ -182,7 +155,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const CentrifugeModel model0 = scenario.model();
   const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
   set_noise_free_outputs(r0, ch0, scenario.gyro);
-  set_predicted_std_errors(r0, ch0, scenario.noise, scenario.test.sample_rate_hz);
+  set_predicted_std_errors(r0, scenario.noise, scenario.test.sample_rate_hz, ro);
   const auto np = static_cast<Eigen::Index>(r0.positions.size());
   m.positions = static_cast<int>(np);
 
@@ -220,7 +193,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const double sigma = white_noise_sample_std_deg_h(scenario.noise, scenario.test.sample_rate_hz);
   Eigen::MatrixXd chol = Eigen::MatrixXd::Zero(np, np);
   if (sigma > 0) {
-    const Eigen::LLT<Eigen::MatrixXd> llt(white_noise_covariance(r0, ro, sigma));
+    const Eigen::LLT<Eigen::MatrixXd> llt(predicted_position_covariance(r0, ro, sigma));
     if (llt.info() != Eigen::Success)
       throw Error("Monte Carlo: the noise covariance is not positive definite.");
     chol = llt.matrixL();

@@ -69,11 +69,53 @@ void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& c
   }
 }
 
-void set_predicted_std_errors(Reduction& r, const std::vector<PositionChannels>& channels,
-                              const GyroNoise& noise, double sample_rate_hz) {
-  const double sigma = white_noise_sample_std_deg_h(noise, sample_rate_hz);
-  for (std::size_t i = 0; i < r.positions.size(); ++i)
-    r.positions[i].std_err_deg_h = sigma * std::sqrt(channels[i].white_noise_gain);
+Eigen::MatrixXd predicted_position_covariance(const Reduction& r, const ReduceOptions& options,
+                                              double sample_std_deg_h) {
+  const auto n = static_cast<Eigen::Index>(r.positions.size());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> per_dwell;
+  for (const Dwell& d : r.dwells) {
+    // Every sample of the dwell, as the gyro output is reduced.
+    DwellAccumulator acc(options, d.gammas_rad, d.is_static, 1, d.planned_duration_s, false);
+    const double zero = 0.0;
+    for (std::size_t i = 0; i < d.samples; ++i) {
+      const double t = d.time_of_sample(i);
+      acc.add(t, -d.counter.at(t, d.first_time_s), &zero);
+    }
+    per_dwell.push_back(acc.white_noise_covariance() * (sample_std_deg_h * sample_std_deg_h));
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const ReducedPosition& a = r.positions[static_cast<std::size_t>(i)];
+      const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
+      if (a.dwell == b.dwell)
+        cov(i, j) = per_dwell[static_cast<std::size_t>(a.dwell)](a.gamma_slot, b.gamma_slot);
+    }
+  return cov;
+}
+
+void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sample_rate_hz,
+                              const ReduceOptions& options) {
+  const Eigen::MatrixXd cov =
+      predicted_position_covariance(r, options, white_noise_sample_std_deg_h(noise, sample_rate_hz));
+  for (Dwell& d : r.dwells) {
+    const auto ng = static_cast<Eigen::Index>(d.gammas_rad.size());
+    d.gyro.covariance = Eigen::MatrixXd::Zero(ng, ng);
+  }
+  for (std::size_t i = 0; i < r.positions.size(); ++i) {
+    ReducedPosition& a = r.positions[i];
+    a.std_err_deg_h = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    for (std::size_t j = 0; j < r.positions.size(); ++j) {
+      const ReducedPosition& b = r.positions[j];
+      if (a.dwell == b.dwell)
+        r.dwells[static_cast<std::size_t>(a.dwell)].gyro.covariance(a.gamma_slot, b.gamma_slot) =
+            cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+    }
+  }
+  for (Dwell& d : r.dwells)
+    for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
+      d.gyro.std_err[k] =
+          std::sqrt(d.gyro.covariance(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
 }
 
 CalibrationResult predict_calibration(const Scenario& s, const CalibrationOptions& options) {
@@ -81,7 +123,7 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   const CentrifugeModel model = s.model();
   const std::vector<PositionChannels> channels = reduce_model_channels(r, model, options.reduce);
   set_noise_free_outputs(r, channels, s.gyro);
-  set_predicted_std_errors(r, channels, s.noise, s.test.sample_rate_hz);
+  set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz, options.reduce);
   CalibrationResult result = identify(r, channels, model, s.test, options);
   if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0)
     result.warnings.push_back(

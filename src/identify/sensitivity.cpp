@@ -174,7 +174,7 @@ PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
   p.reduction = planned_reduction(s, ro);
   p.channels = reduce_model_channels(p.reduction, s.model(), ro);
   set_noise_free_outputs(p.reduction, p.channels, s.gyro);
-  set_predicted_std_errors(p.reduction, p.channels, s.noise, s.test.sample_rate_hz);
+  set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz);
   return p;
 }
 

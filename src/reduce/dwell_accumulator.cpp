@@ -41,7 +41,7 @@ DwellAccumulator::DwellAccumulator(const ReduceOptions& options, std::vector<dou
       columns_(columns),
       duration_s_(planned_duration_s),
       with_std_err_(with_std_err),
-      trend_(gammas_.size()) {
+      trend_() {
   const int n = basis_size();
   const auto ng = static_cast<Eigen::Index>(gammas_.size());
   if (static_) {
@@ -94,7 +94,7 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
     if (!with_std_err_) return;
     const int batch = static_cast<int>(std::floor((t - t_first_) / (duration_s_ / options_.static_batches)));
     if (batch != batch_index_ && batch_n_ > 0) {
-      batches_.add(0.0, batch_sum_ / static_cast<double>(batch_n_));
+      batches_.add(0.0, Eigen::VectorXd::Constant(1, batch_sum_ / static_cast<double>(batch_n_)));
       batch_sum_ = 0.0;
       batch_n_ = 0;
     }
@@ -156,28 +156,62 @@ void DwellAccumulator::close_revolution() {
       const Eigen::MatrixXd full = rev_normal_.selfadjointView<Eigen::Lower>();
       const Eigen::VectorXd x = full.ldlt().solve(rev_rhs_);
       const double t_mean = rev_time_sum_ / static_cast<double>(rev_samples_);
+      Eigen::VectorXd values(static_cast<Eigen::Index>(gammas_.size()));
       for (std::size_t k = 0; k < gammas_.size(); ++k) {
         double b[32];
         basis(gammas_[k], 0.0, b);
         double v = 0.0;
         for (int i = 0; i < nr; ++i) v += b[i] * x[i];
-        trend_[k].add(t_mean, v);
+        values[static_cast<Eigen::Index>(k)] = v;
       }
+      trend_.add(t_mean, values);
     }
     rev_normal_.setZero();
     rev_rhs_.setZero();
     rev_samples_ = 0;
     rev_time_sum_ = 0.0;
   } else {
-    for (std::size_t k = 0; k < gammas_.size(); ++k) {
-      const auto kk = static_cast<Eigen::Index>(k);
-      if (rev_window_n_[kk] > 0)
-        trend_[k].add(rev_window_t_[kk] / rev_window_n_[kk], rev_window_sum_[kk] / rev_window_n_[kk]);
+    // A revolution counts when it passed through every window.
+    if ((rev_window_n_.array() > 0).all()) {
+      const double t_mean = rev_window_t_.sum() / rev_window_n_.sum();
+      trend_.add(t_mean, rev_window_sum_.cwiseQuotient(rev_window_n_));
     }
     rev_window_sum_.setZero();
     rev_window_n_.setZero();
     rev_window_t_.setZero();
   }
+}
+
+void DwellAccumulator::RevolutionSums::add(double ti, const Eigen::VectorXd& vi) {
+  if (v.size() == 0) {
+    v0 = vi;
+    v = tv = Eigen::VectorXd::Zero(vi.size());
+    vv = Eigen::MatrixXd::Zero(vi.size(), vi.size());
+  }
+  const Eigen::VectorXd d = vi - v0;
+  n += 1;
+  t += ti;
+  tt += ti * ti;
+  v += d;
+  tv += ti * d;
+  vv += d * d.transpose();
+}
+
+Eigen::MatrixXd DwellAccumulator::RevolutionSums::covariance_at(double t_mid, bool drift) const {
+  // Residual cross products of straight-line fits in time (deviations from the means without drift),
+  // divided by the degrees of freedom, times the variance factor of the line's value at t_mid.
+  const double dof = n - (drift ? 2.0 : 1.0);
+  if (v.size() == 0 || dof < 1.0) return Eigen::MatrixXd::Constant(v.size(), v.size(), kNaN);
+  const double tbar = t / n;
+  const Eigen::VectorXd vbar = v / n;
+  const double stt = tt - n * tbar * tbar;
+  const Eigen::MatrixXd svv = vv - n * vbar * vbar.transpose();
+  const Eigen::VectorXd stv = tv - n * tbar * vbar;
+  const bool line = drift && stt > 0;
+  const Eigen::MatrixXd residual = line ? Eigen::MatrixXd(svv - stv * stv.transpose() / stt) : svv;
+  const double lever = line ? (t_mid - tbar) * (t_mid - tbar) / stt : 0.0;
+  const Eigen::MatrixXd c = residual / dof * (1.0 / n + lever);
+  return 0.5 * (c + c.transpose());
 }
 
 DwellValues DwellAccumulator::finish(int column) const {
@@ -189,28 +223,30 @@ DwellValues DwellAccumulator::finish(int column) const {
   if (samples_ == 0) return out;
   const double t_mid = (0.5 * (t_first_ + t_last_) - t_first_) / duration_s_ - 0.5;
 
-  // Standard error of the value at t_mid from per-revolution (or batch) values: the scatter about their
-  // straight line in time (about their mean without drift), as the line's prediction at t_mid.
-  const auto std_err_of = [&](const TrendSums& s, bool drift) {
-    const double n = s.n;
-    const double dof = n - (drift ? 2.0 : 1.0);
-    if (dof < 1.0) return kNaN;
-    const double tbar = s.t / n, vbar = s.v / n;
-    const double stt = s.tt - n * tbar * tbar, svv = s.vv - n * vbar * vbar, stv = s.tv - n * tbar * vbar;
-    const double ss = drift && stt > 0 ? svv - stv * stv / stt : svv;
-    const double var = std::max(ss, 0.0) / dof;
-    const double lever = drift && stt > 0 ? (t_mid - tbar) * (t_mid - tbar) / stt : 0.0;
-    return std::sqrt(var * (1.0 / n + lever));
+  // Standard errors and covariance of the values at t_mid. The covariance's shape is the reduction
+  // operator's (exact for white noise: one fit correlates the gammas of a dwell); its level is the scatter
+  // between revolutions (or batches), pooled over the dwell's gammas: a 4 x 4 covariance estimated from a few
+  // revolutions would weight a generalised least-squares fit worse than none.
+  const auto set_covariance = [&](const RevolutionSums& sums, bool drift) {
+    const Eigen::MatrixXd measured = sums.covariance_at(t_mid, drift);
+    out.revolutions = static_cast<int>(sums.n);
+    if (measured.size() == 0 || !measured.allFinite()) return;
+    const Eigen::MatrixXd shape = white_noise_covariance();
+    const double level = (measured.diagonal().array() / shape.diagonal().array()).mean();
+    out.covariance = level * shape;
+    for (std::size_t k = 0; k < ng; ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      out.std_err[k] = std::sqrt(out.covariance(kk, kk));
+    }
   };
 
   if (static_) {
     out.value[0] = static_sum_[column] / static_cast<double>(samples_);
     out.samples[0] = samples_;
     if (with_std_err_ && column == 0) {
-      TrendSums b = batches_;
-      if (batch_n_ > 0) b.add(0.0, batch_sum_ / static_cast<double>(batch_n_));
-      out.std_err[0] = std_err_of(b, false);
-      out.revolutions = static_cast<int>(b.n);
+      RevolutionSums b = batches_;
+      if (batch_n_ > 0) b.add(0.0, Eigen::VectorXd::Constant(1, batch_sum_ / static_cast<double>(batch_n_)));
+      set_covariance(b, false);
     }
     return out;
   }
@@ -244,10 +280,7 @@ DwellValues DwellAccumulator::finish(int column) const {
       out.samples[k] = static_cast<std::size_t>(nk);
     }
   }
-  if (with_std_err_ && column == 0) {
-    for (std::size_t k = 0; k < ng; ++k) out.std_err[k] = std_err_of(trend_[k], options_.linear_drift);
-    out.revolutions = static_cast<int>(trend_.empty() ? 0 : trend_[0].n);
-  }
+  if (with_std_err_ && column == 0) set_covariance(trend_, options_.linear_drift);
   return out;
 }
 

@@ -25,8 +25,6 @@ struct PositionChannels {
   double omega_seed_deg_h = 0.0;     ///< omega_I of section 5 with the seed's k1, k2, dw, deg/h
   std::array<double, kNumCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
   std::array<double, kNumCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
-  /// Variance of the reduced value per unit variance of white noise on each sample (the reduction's gain).
-  double white_noise_gain = 0.0;
 
   /// The omega_I the compensation assumes, deg/h.
   double omega_deg_h(Compensation c) const {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace gyrocal {
 
 /// value = constant + sum_k weights[k] * W_{k+1}.
@@ -16,8 +18,8 @@ struct LinearForm {
   double constant = 0.0;
 
   double value(const std::array<double, 16>& w) const;
-  /// Standard uncertainty from independent standard errors of the W's.
-  double std(const std::array<double, 16>& std_err) const;
+  /// Standard uncertainty from the covariance of W1..W16 (deg/h)^2: sqrt(w' C w).
+  double std(const Eigen::Matrix<double, 16, 16>& covariance) const;
 };
 
 /// The closed forms at radial level Ar (g) with the Earth rate's North and Up parts Omega_N, Omega_U

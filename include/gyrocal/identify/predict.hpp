@@ -22,10 +22,16 @@ double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_h
 void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
                             const DriftCoefficients& truth);
 
-/// Set each position's std_err_deg_h to what white rate noise (the angle random walk) predicts through the
-/// reduction operator. Bias instability and rate random walk are not in the prediction.
-void set_predicted_std_errors(Reduction& reduction, const std::vector<PositionChannels>& channels,
-                              const GyroNoise& noise, double sample_rate_hz);
+/// Covariance (deg/h)^2 of the reduced positions under white rate noise of `sample_std_deg_h` per sample: the
+/// reduction operator's covariance within each dwell (one fit correlates the gammas of one dwell), zero
+/// across dwells; positions in the order of reduction.positions.
+Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const ReduceOptions& options,
+                                              double sample_std_deg_h);
+
+/// Set each dwell's covariance and each position's std_err_deg_h to what white rate noise (the angle random
+/// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it.
+void set_predicted_std_errors(Reduction& reduction, const GyroNoise& noise, double sample_rate_hz,
+                              const ReduceOptions& options = {});
 
 /// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
 /// (least squares, full compensation, noise-free outputs of the configured truth).

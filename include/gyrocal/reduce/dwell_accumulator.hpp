@@ -34,8 +34,13 @@ struct ReduceOptions {
 /// The result of reducing one dwell for one column of values.
 struct DwellValues {
   std::vector<double> value;  ///< per gamma, in the values' unit
-  std::vector<double>
-      std_err;  ///< per gamma: from the scatter between revolutions (or batches); NaN if unknown
+  /// Per gamma: the square root of the covariance's diagonal; NaN if unknown.
+  std::vector<double> std_err;
+  /// Covariance (unit^2) of the values at the gammas of this dwell: they come from one fit, so they are
+  /// correlated (-1/7 for a harmonic fit of order 3 under white noise). Its shape is the reduction
+  /// operator's, its level the scatter between revolutions (or batches) pooled over the gammas. Empty when
+  /// not computed.
+  Eigen::MatrixXd covariance;
   std::vector<std::size_t> samples;  ///< per gamma: samples that entered
   int revolutions = 0;               ///< complete revolutions (or batches) the standard error comes from
 };
@@ -101,25 +106,25 @@ class DwellAccumulator {
   Eigen::MatrixXd window_tsum_;                                            // gamma x columns: sum of t*value
   Eigen::Vector<double, Eigen::Dynamic> window_n_, window_t_, window_tt_;  // per gamma
   Eigen::VectorXd rev_window_sum_, rev_window_n_, rev_window_t_;           // per gamma, column 0
-  // Per-revolution (or batch) values of column 0 per gamma, as sums for a straight-line fit in time.
-  struct TrendSums {
-    double n = 0, t = 0, tt = 0, v = 0, tv = 0, vv = 0;
-    void add(double ti, double vi) {
-      n += 1;
-      t += ti;
-      tt += ti * ti;
-      v += vi;
-      tv += ti * vi;
-      vv += vi * vi;
-    }
+  // Per-revolution (or batch) values of column 0 at every gamma, as sums for straight-line fits in time
+  // and their cross products.
+  struct RevolutionSums {
+    double n = 0, t = 0, tt = 0;
+    Eigen::VectorXd v0;     // the first values: sums are of deviations from them (no cancellation)
+    Eigen::VectorXd v, tv;  // sums of (v - v0) and t (v - v0)
+    Eigen::MatrixXd vv;
+    void add(double ti, const Eigen::VectorXd& vi);
+    /// Covariance of the lines' predictions at t_mid (of the means without drift); NaN without enough
+    /// revolutions.
+    Eigen::MatrixXd covariance_at(double t_mid, bool drift) const;
   };
-  std::vector<TrendSums> trend_;
+  RevolutionSums trend_;
   // Static hold: sums per column, and batch means of column 0.
   Eigen::VectorXd static_sum_;
   double batch_sum_ = 0.0;
   std::size_t batch_n_ = 0;
   int batch_index_ = 0;
-  TrendSums batches_;
+  RevolutionSums batches_;
 };
 
 }  // namespace gyrocal
