@@ -13,7 +13,15 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     const Dwell& d = reduction.dwells[di];
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
     double v[kColumns];
-    for (std::size_t i = 0; i < d.samples; ++i) {
+    // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always.
+    std::size_t stride = 1;
+    if (options.model_samples_per_revolution > 0 && d.samples > 1) {
+      const double per_period = d.is_static ? static_cast<double>(d.samples) / 64.0
+                                            : 2.0 * kPi / std::abs(d.main.rate_rad_s) / d.sample_interval_s /
+                                                  static_cast<double>(options.model_samples_per_revolution);
+      stride = static_cast<std::size_t>(std::max(1.0, std::floor(per_period)));
+    }
+    const auto add_sample = [&](std::size_t i) {
       const double t = d.time_of_sample(i);
       // The joints on the dwell's constant-rate lines fitted to the encoders.
       JointState j;
@@ -34,7 +42,9 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
         v[3 + kNumCoefficients + k] = rn[k];
       }
       acc.add(t, -j.counter_angle_rad, v);
-    }
+    };
+    for (std::size_t i = 0; i + 1 < d.samples; i += stride) add_sample(i);
+    if (d.samples > 0) add_sample(d.samples - 1);
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
   }
   std::vector<PositionChannels> out;

@@ -30,6 +30,9 @@ bool ReduceOptions::IsValid(std::string* error) const {
   if (!(rate_tolerance > 0.0 && rate_tolerance < 0.5)) return fail("rate_tolerance must be in (0, 0.5)");
   if (!(static_rate_tolerance_rad_s > 0.0)) return fail("static_rate_tolerance_rad_s must be positive");
   if (static_batches < 2) return fail("static_batches must be at least 2");
+  if (model_samples_per_revolution < 0 ||
+      (model_samples_per_revolution > 0 && model_samples_per_revolution < 16))
+    return fail("model_samples_per_revolution must be 0 (every sample) or at least 16");
   return true;
 }
 
@@ -110,19 +113,29 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   revolution_ = rev;
 
   if (options_.method == ReduceOptions::Method::kHarmonicFit) {
+    // The hot loop of a calibration: raw column-major storage, lower triangles only.
     double b[32];
     basis(gamma, ts, b);
     const int n = basis_size();
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j <= i; ++j) normal_(i, j) += b[i] * b[j];
-      for (int c = 0; c < columns_; ++c) rhs_(i, c) += b[i] * values[c];
+    double* __restrict normal = normal_.data();
+    for (int j = 0; j < n; ++j) {
+      const double bj = b[j];
+      for (int i = j; i < n; ++i) normal[i + j * n] += b[i] * bj;
+    }
+    double* __restrict rhs = rhs_.data();
+    for (int c = 0; c < columns_; ++c) {
+      const double v = values[c];
+      for (int i = 0; i < n; ++i) rhs[i + c * n] += b[i] * v;
     }
     if (with_std_err_) {
       const int nr = 2 * options_.harmonic_order + 1;
-      for (int i = 0; i < nr; ++i) {
-        for (int j = 0; j <= i; ++j) rev_normal_(i, j) += b[i] * b[j];
-        rev_rhs_[i] += b[i] * values[0];
+      double* __restrict rev_n = rev_normal_.data();
+      for (int j = 0; j < nr; ++j) {
+        const double bj = b[j];
+        for (int i = j; i < nr; ++i) rev_n[i + j * nr] += b[i] * bj;
       }
+      double* __restrict rev_rhs = rev_rhs_.data();
+      for (int i = 0; i < nr; ++i) rev_rhs[i] += b[i] * values[0];
       ++rev_samples_;
       rev_time_sum_ += ts;
     }

@@ -26,6 +26,10 @@ struct ReduceOptions {
   double rate_tolerance = 1e-3;  ///< relative to the planned rate: a spinning dwell's sample-to-sample rate
   double static_rate_tolerance_rad_s = 0.01;  ///< below this the main axis (or platform) counts as stopped
   int static_batches = 16;                    ///< a static hold's standard error from this many batch means
+  /// The model's channels (identify/channels.hpp) are smooth in gamma (harmonics up to ~6), so they are
+  /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
+  /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0: every sample.
+  int model_samples_per_revolution = 32;
 
   /// True when every option is in range; otherwise false with a sentence in *error.
   bool IsValid(std::string* error) const;
