@@ -1,6 +1,6 @@
 // gyrocal demo: the main job on the default scenario — simulate the 16-position test, calibrate it with and
-// without compensation, print the truth beside the estimates, write DIR/record.csv, DIR/result.json and
-// DIR/report.html.
+// without compensation, print the truth beside the estimates, run the error study and a Monte Carlo budget,
+// write DIR/record.csv, DIR/result.json and DIR/report.html.
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -8,9 +8,13 @@
 #include "cli.hpp"
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/montecarlo.hpp"
+#include "gyrocal/identify/sensitivity.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/montecarlo_json.hpp"
+#include "gyrocal/result/sensitivity_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "tables.hpp"
 
@@ -24,7 +28,7 @@ void register_demo(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("demo", "The main job on the built-in default scenario");
   sub->add_option("--out", opt->out, "Directory for record.csv, result.json and report.html (replaced)");
   sub->callback([opt] {
-    const Scenario s = default_scenario();
+    const Scenario s = demo_scenario();
     const std::filesystem::path dir(opt->out);
     std::filesystem::create_directories(dir);
     const std::string record = (dir / "record.csv").string();
@@ -69,6 +73,17 @@ void register_demo(CLI::App& app) {
     for (std::size_t i = 0; i < results.size(); ++i)
       j["comparison"].push_back(
           {{"label", labels[i]}, {"coefficients", calibration_to_json(results[i])["coefficients"]}});
+    // The seed's error study and the uncertainty budget (10% uncertainty on each configured error).
+    fmt::print("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
+    const SensitivityResult sensitivity = sensitivity_study(s);
+    j["sensitivity"] = sensitivity_to_json(sensitivity);
+    MonteCarloOptions mc;
+    mc.trials = 100000;
+    const MonteCarloResult budget = monte_carlo(s, mc);
+    j["montecarlo"] = montecarlo_to_json(budget);
+    fmt::print("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
+               budget.trials, to_string(budget.mode));
+
     const std::string result_path = (dir / "result.json").string();
     write_output(result_path, j.dump(2) + "\n", true);
     HtmlReportOptions report;

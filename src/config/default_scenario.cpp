@@ -1,5 +1,7 @@
 #include "gyrocal/config/scenario.hpp"
 
+#include <cmath>
+
 namespace gyrocal {
 
 Scenario default_scenario() {
@@ -27,6 +29,24 @@ Scenario default_scenario() {
   d[Coefficient::dOS] = -0.015;
 
   s.noise.angle_random_walk_deg_rt_h = 0.002;
+  return s;
+}
+
+Scenario demo_scenario() {
+  Scenario s = default_scenario();
+  CentrifugeErrors& u = s.uncertainty;
+  const CentrifugeErrors& e = s.errors;
+  const auto tenth = [](const HarmonicSeries& h) {
+    HarmonicSeries out = h;
+    for (HarmonicTerm& t : out.terms) t.amplitude *= 0.1;
+    return out;
+  };
+  u.counter_perpendicularity_x_rad = 0.1 * std::abs(e.counter_perpendicularity_x_rad);
+  u.counter_perpendicularity_y_rad = 0.1 * std::abs(e.counter_perpendicularity_y_rad);
+  u.counter_wobble_x_rad = tenth(e.counter_wobble_x_rad);
+  u.counter_wobble_y_rad = tenth(e.counter_wobble_y_rad);
+  u.counter_rate_mismatch_rad_s = 0.1 * std::abs(e.counter_rate_mismatch_rad_s);
+  u.main_wobble_x_rad = tenth(e.main_wobble_x_rad);
   return s;
 }
 

@@ -27,4 +27,8 @@ struct Scenario {
 /// The default scenario of MODEL.md section 11.
 Scenario default_scenario();
 
+/// What `gyrocal demo` runs: the default scenario, with a standard uncertainty of 10% of each configured
+/// machine error in [uncertainty] (MODEL.md gives none; only the Monte Carlo budget uses them).
+Scenario demo_scenario();
+
 }  // namespace gyrocal
