@@ -1,7 +1,10 @@
 #include "cli.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+
+#include <fmt/format.h>
 
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/atomic_file.hpp"
@@ -26,6 +29,17 @@ void refuse_to_overwrite_input(const std::string& output, const std::string& inp
   std::error_code ec;
   if (std::filesystem::equivalent(output, input, ec))
     throw Error("refusing to write " + output + ": it is the input " + input + ".");
+}
+
+void ProgressBar::operator()(double fraction) {
+  const int percent = static_cast<int>(fraction * 100.0);
+  if (percent == percent_) return;
+  percent_ = percent;
+  constexpr int kWidth = 40;
+  const int filled = percent * kWidth / 100;
+  fmt::print(stderr, "\r{} [{:#<{}}{:<{}}] {:3}%", label_, "", filled, "", kWidth - filled, percent);
+  if (percent == 100) fmt::print(stderr, "\n");
+  std::fflush(stderr);
 }
 
 }  // namespace gyrocal::cli

@@ -20,6 +20,18 @@ void write_output(const std::string& path, std::string_view content, bool overwr
 /// Refuse an output path that names one of the inputs (no input is ever overwritten).
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
 
+/// A progress bar on standard error ("label [####    ]  42%"), redrawn when the whole percentage changes.
+/// Commands install it only when standard error is a terminal.
+class ProgressBar {
+ public:
+  explicit ProgressBar(std::string label) : label_(std::move(label)) {}
+  void operator()(double fraction);
+
+ private:
+  std::string label_;
+  int percent_ = -1;
+};
+
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);
 void register_inputs(CLI::App& app);

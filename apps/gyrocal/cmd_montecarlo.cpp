@@ -14,24 +14,6 @@
 namespace gyrocal::cli {
 namespace {
 
-/// A progress bar on standard error, redrawn when the whole percentage changes.
-class ProgressBar {
- public:
-  void operator()(double fraction) {
-    const int percent = static_cast<int>(fraction * 100.0);
-    if (percent == percent_) return;
-    percent_ = percent;
-    constexpr int kWidth = 40;
-    const int filled = percent * kWidth / 100;
-    fmt::print(stderr, "\rMonte Carlo [{:#<{}}{:<{}}] {:3}%", "", filled, "", kWidth - filled, percent);
-    if (percent == 100) fmt::print(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  int percent_ = -1;
-};
-
 std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
   std::string s = fmt::format(
       "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, which knows the configured "
@@ -92,7 +74,7 @@ void register_montecarlo(CLI::App& app) {
     options.threads = opt->threads;
     options.calibration.method = parse_method(opt->method);
     options.calibration.compensation = parse_compensation(opt->compensation);
-    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar();
+    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

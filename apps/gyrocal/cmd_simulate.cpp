@@ -15,24 +15,6 @@
 namespace gyrocal::cli {
 namespace {
 
-/// A progress bar on standard error, redrawn when the whole percentage changes.
-class ProgressBar {
- public:
-  void operator()(double fraction) {
-    const int percent = static_cast<int>(fraction * 100.0);
-    if (percent == percent_) return;
-    percent_ = percent;
-    constexpr int kWidth = 40;
-    const int filled = percent * kWidth / 100;
-    fmt::print(stderr, "\rsimulating [{:#<{}}{:<{}}] {:3}%", "", filled, "", kWidth - filled, percent);
-    if (percent == 100) fmt::print(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  int percent_ = -1;
-};
-
 std::string size_text(std::uintmax_t bytes) {
   if (bytes >= 1000000) return fmt::format("{:.1f} MB", static_cast<double>(bytes) / 1e6);
   if (bytes >= 1000) return fmt::format("{:.1f} kB", static_cast<double>(bytes) / 1e3);
@@ -58,7 +40,7 @@ void register_simulate(CLI::App& app) {
     const Scenario scenario = load_configuration(opt->config);
     SimulationOptions options;
     if (seed->count()) options.seed = opt->seed;
-    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar();
+    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("simulating");
 
     AtomicOutputFile file(opt->out, opt->force);
     const SimulationSummary summary = simulate_record(scenario, options, file.stream());

@@ -4,13 +4,7 @@
 #include <cmath>
 #include <limits>
 
-// Bit-for-bit reproducibility: forbid fusing a*b+c into one FMA, which rounds once instead of twice (GCC
-// fuses by default in C++ whenever the target has FMA).
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
-#endif
+// Bit-for-bit reproducibility needs no fused multiply-add: the build sets -ffp-contract=off (CMakeLists.txt).
 
 namespace gyrocal {
 

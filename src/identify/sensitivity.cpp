@@ -1,4 +1,5 @@
 #include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/core/parallel.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -114,32 +115,6 @@ void field_terms(int fi, const CentrifugeErrors& errors, bool all,
       break;
     }
   }
-}
-
-/// Run f(0..n-1) on `threads` threads; the first exception is rethrown here.
-void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& f) {
-  const auto workers = static_cast<std::size_t>(
-      std::clamp(threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()), 1,
-                 static_cast<int>(std::max<std::size_t>(n, 1))));
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::mutex mutex;
-  const auto work = [&] {
-    for (std::size_t i; (i = next++) < n;) {
-      try {
-        f(i);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = n;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t k = 1; k < workers; ++k) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
 }
 
 /// Estimate name -> (value, std) of a calibration: closed form's primary, alternatives and combinations, or

@@ -7,12 +7,7 @@
 
 #include "gyrocal/core/error.hpp"
 
-// Bit-for-bit reproducibility (see core/random.hpp): no fused multiply-add.
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
-#endif
+// Bit-for-bit reproducibility needs no fused multiply-add: the build sets -ffp-contract=off (CMakeLists.txt).
 
 namespace gyrocal {
 
