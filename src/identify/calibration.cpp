@@ -30,9 +30,9 @@ std::vector<std::string> coefficient_names() {
 }
 
 /// Covariance (deg/h)^2 of the reduced positions: within a dwell from its values' covariance (one fit
-/// correlates its gammas), zero across dwells; standard errors alone where no covariance was computed. floor^2
-/// is added to every variance, so that a noise-free record (whose measured covariance is rounding) still
-/// weights a fit.
+/// correlates its gammas), zero across dwells; standard errors alone where no covariance was computed.
+/// floor^2 is added to every variance, so that a noise-free record (whose measured covariance is rounding)
+/// still weights a fit.
 Eigen::MatrixXd position_covariance(const Reduction& r, double floor) {
   const auto m = static_cast<Eigen::Index>(r.positions.size());
   Eigen::MatrixXd c = Eigen::MatrixXd::Zero(m, m);
