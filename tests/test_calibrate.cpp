@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/predict.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -209,6 +210,75 @@ TEST(Calibrate, UncertaintiesAreHonest) {
     EXPECT_GT(sd, 0.85) << name;
     EXPECT_LT(sd, 1.15) << name;
     EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(trials)) << name;  // unbiased (4 sigma)
+  }
+}
+
+TEST(Calibrate, WindowMeansReduceAsExactlyAsTheHarmonicFit) {
+  // The window mean is another linear operator; the model's channels go through the same one, so a noise-free
+  // record is still identified exactly.
+  Scenario s = noise_free_default();
+  s.test.revolutions = 10;
+  ReduceOptions ro;
+  ro.method = ReduceOptions::Method::kWindowMean;
+  const Pipeline p = run(s, 1, ro);
+  CalibrationOptions o;
+  o.reduce = ro;
+  const CalibrationResult ls = identify(p.reduction, p.channels, s.model(), s.test, o);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    if (ls.coefficients[k].identifiable) {
+      EXPECT_NEAR(ls.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];
+    }
+  EXPECT_EQ(ls.rank, 9);
+}
+
+bool mentions(const std::vector<std::string>& warnings, const std::string& text) {
+  for (const std::string& w : warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(Reduce, ADwellShorterThanPlannedIsReported) {
+  Scenario recorded = noise_free_default();
+  recorded.test.revolutions = 8;
+  Scenario planned = recorded;
+  planned.test.revolutions = 12;
+  Reducer reducer(planned.test, ReduceOptions{}, "short.csv", 9.9);
+  simulate(recorded, SimulationOptions{}, [&](const RecordSample& x) { reducer.push(x); });
+  const Reduction r = reducer.finish();
+  EXPECT_TRUE(mentions(r.warnings, "of the")) << (r.warnings.empty() ? "" : r.warnings[0]);
+  EXPECT_TRUE(mentions(r.warnings, "planned"));
+}
+
+TEST(Reduce, ARateThatWandersIsReported) {
+  Scenario s = noise_free_default();
+  s.test.revolutions = 12;
+  Reducer reducer(s.test, ReduceOptions{}, "wandering.csv", 9.9);
+  // The main axis lags and leads its constant-rate line by 0.2 deg with a 20 s period (a rate that wanders by
+  // 6e-5 rad/s, inside the steady tolerance, so the dwells are still found).
+  simulate(s, SimulationOptions{}, [&](const RecordSample& x) {
+    RecordSample y = x;
+    y.main_angle_deg = std::fmod(x.main_angle_deg + 0.2 * std::sin(2 * kPi * x.time_s / 20.0) + 360.0, 360.0);
+    reducer.push(y);
+  });
+  const Reduction r = reducer.finish();
+  EXPECT_TRUE(mentions(r.warnings, "wanders")) << (r.warnings.empty() ? "" : r.warnings[0]);
+}
+
+TEST(Reduce, ABadPlanMatchIsAnErrorNamingThePositions) {
+  Scenario recorded = noise_free_default();
+  recorded.test.revolutions = 4;
+  recorded.test.beta_rad = {0.0, kPi, kPi / 2};
+  Scenario planned = recorded;
+  planned.test.beta_rad = {0.0, kPi, kPi / 2, 3 * kPi / 2};
+  Reducer reducer(planned.test, ReduceOptions{}, "partial.csv", 9.9);
+  simulate(recorded, SimulationOptions{}, [&](const RecordSample& x) { reducer.push(x); });
+  try {
+    reducer.finish();
+    FAIL() << "a missing beta must be an error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("partial.csv"), std::string::npos) << m;
+    EXPECT_NE(m.find("13 (rate 9.9 rad/s, beta 270 deg"), std::string::npos) << m;
   }
 }
 

@@ -13,9 +13,12 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     const Dwell& d = reduction.dwells[di];
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
     double v[kColumns];
-    // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always.
+    // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always: for the harmonic
+    // fit and a static hold's mean, which see the channels' smooth shape; a window holds a few samples only,
+    // so window means take every sample.
     std::size_t stride = 1;
-    if (options.model_samples_per_revolution > 0 && d.samples > 1) {
+    const bool smooth_operator = d.is_static || options.method == ReduceOptions::Method::kHarmonicFit;
+    if (smooth_operator && options.model_samples_per_revolution > 0 && d.samples > 1) {
       const double per_period = d.is_static ? static_cast<double>(d.samples) / 64.0
                                             : 2.0 * kPi / std::abs(d.main.rate_rad_s) / d.sample_interval_s /
                                                   static_cast<double>(options.model_samples_per_revolution);
