@@ -71,7 +71,7 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoeff
 
 /// Noise-free reduced outputs (deg/h) of scenario s's test, in plan order.
 Eigen::VectorXd noise_free_outputs(const Scenario& s, const ReduceOptions& ro) {
-  Reduction r = planned_reduction(s, ro);
+  Reduction r = planned_reduction(s);
   set_noise_free_outputs(r, reduce_model_channels(r, s.model(), ro), s.gyro);
   Eigen::VectorXd w(static_cast<Eigen::Index>(r.positions.size()));
   for (std::size_t i = 0; i < r.positions.size(); ++i)
@@ -116,7 +116,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const ReduceOptions& ro = options.calibration.reduce;
 
   // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
-  Reduction r0 = planned_reduction(scenario, ro);
+  Reduction r0 = planned_reduction(scenario);
   const CentrifugeModel model0 = scenario.model();
   const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
   set_noise_free_outputs(r0, ch0, scenario.gyro);

@@ -7,7 +7,7 @@
 
 namespace gyrocal {
 
-Reduction planned_reduction(const Scenario& s, const ReduceOptions& options) {
+Reduction planned_reduction(const Scenario& s) {
   const CentrifugeModel model = s.model();
   const Timeline timeline = make_timeline(s.test, model);
   const double fs = s.test.sample_rate_hz, dt = 1.0 / fs;
@@ -33,7 +33,6 @@ Reduction planned_reduction(const Scenario& s, const ReduceOptions& options) {
     d.gyro.samples.assign(d.gammas_rad.size(), d.samples);
     out.dwells.push_back(d);
   }
-  (void)options;
   for (const Position& p : test_positions(s.test)) {
     for (std::size_t di = 0; di < out.dwells.size(); ++di) {
       const Dwell& d = out.dwells[di];
@@ -119,7 +118,7 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
 }
 
 CalibrationResult predict_calibration(const Scenario& s, const CalibrationOptions& options) {
-  Reduction r = planned_reduction(s, options.reduce);
+  Reduction r = planned_reduction(s);
   const CentrifugeModel model = s.model();
   const std::vector<PositionChannels> channels = reduce_model_channels(r, model, options.reduce);
   set_noise_free_outputs(r, channels, s.gyro);

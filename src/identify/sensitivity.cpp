@@ -146,7 +146,7 @@ struct PlannedTest {
 };
 PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
   PlannedTest p;
-  p.reduction = planned_reduction(s, ro);
+  p.reduction = planned_reduction(s);
   p.channels = reduce_model_channels(p.reduction, s.model(), ro);
   set_noise_free_outputs(p.reduction, p.channels, s.gyro);
   set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz);
@@ -212,7 +212,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   if (!(options.threshold > 0.0)) throw Error("sensitivity: the threshold must be positive.");
   Scenario base = scenario;
   base.errors = CentrifugeErrors{};
-  if (sixteen_positions(planned_reduction(base, options.calibration.reduce).positions).empty())
+  if (sixteen_positions(planned_reduction(base).positions).empty())
     throw Error(
         "the sensitivity study needs the 16 positions of MODEL.md section 7 (beta and gamma in {0, 90, 180, "
         "270} deg at one spinning rate) for its closed forms; this plan does not have them.");

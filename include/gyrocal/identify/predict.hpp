@@ -12,7 +12,7 @@ namespace gyrocal {
 
 /// The dwells and positions a perfect record of the scenario's test gives (from its timeline: each
 /// measurement interval's samples and the constant-rate lines of its joints); gyro outputs are zero.
-Reduction planned_reduction(const Scenario& scenario, const ReduceOptions& options = {});
+Reduction planned_reduction(const Scenario& scenario);
 
 /// Standard deviation of one sample's white rate noise, deg/h: N[deg/sqrt(h)] * 60 * sqrt(fs[Hz]).
 double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_hz);
