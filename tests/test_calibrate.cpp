@@ -37,7 +37,7 @@ CalibrationResult calibrate(const Scenario& s, const Pipeline& p, Method m, Comp
   CalibrationOptions o;
   o.method = m;
   o.compensation = c;
-  return identify(p.reduction, p.channels, s.model(), s.test, o);
+  return identify(p.reduction, p.channels, s.model(), o);
 }
 
 bool sanitized() {
@@ -189,7 +189,7 @@ TEST(Calibrate, UncertaintiesAreHonest) {
     for (Method m : {Method::kLeastSquares, Method::kClosedForm}) {
       CalibrationOptions o;
       o.method = m;
-      const CalibrationResult r = identify(red, channels, s.model(), s.test, o);
+      const CalibrationResult r = identify(red, channels, s.model(), o);
       const std::string tag = m == Method::kLeastSquares ? "ls " : "cf ";
       for (std::size_t k = 0; k < kNumCoefficients; ++k)
         if (r.coefficients[k].identifiable)
@@ -223,7 +223,7 @@ TEST(Calibrate, WindowMeansReduceAsExactlyAsTheHarmonicFit) {
   const Pipeline p = run(s, 1, ro);
   CalibrationOptions o;
   o.reduce = ro;
-  const CalibrationResult ls = identify(p.reduction, p.channels, s.model(), s.test, o);
+  const CalibrationResult ls = identify(p.reduction, p.channels, s.model(), o);
   for (std::size_t k = 0; k < kNumCoefficients; ++k)
     if (ls.coefficients[k].identifiable) {
       EXPECT_NEAR(ls.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];

@@ -63,8 +63,8 @@ TEST(Sensitivity, EveryMachineErrorHasItsRows) {
 
 TEST(Sensitivity, SeedsFindingWithoutCompensation) {
   // Counter-platform perpendicularity shifts dI (through k1, its y part) and dOS (k2, its x part) by hundreds
-  // of noise sigmas (thousands with the default plan; the sanitizer build studies a shorter one) and leaves the
-  // other primary closed forms alone.
+  // of noise sigmas (thousands with the default plan; the sanitizer build studies a shorter one) and leaves
+  // the other primary closed forms alone.
   const SensitivityRow& px = row("counter_perpendicularity_x");
   const SensitivityRow& py = row("counter_perpendicularity_y");
   const auto& sigma = default_study().closed_form_noise_std;

@@ -243,8 +243,7 @@ std::vector<int> sixteen_positions(const std::vector<ReducedPosition>& positions
 }
 
 CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
-                           const CentrifugeModel& model, const TestSpec& /*plan*/,
-                           const CalibrationOptions& options) {
+                           const CentrifugeModel& model, const CalibrationOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw Error("calibration options: " + error + ".");
   CalibrationResult r;
@@ -274,7 +273,7 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
   RecordReader reader(record_path);
   const Reduction reduction = reduce_record(reader, plan, options.reduce, model.geometry().rate_rad_s);
   const std::vector<PositionChannels> channels = reduce_model_channels(reduction, model, options.reduce);
-  return identify(reduction, channels, model, plan, options);
+  return identify(reduction, channels, model, options);
 }
 
 std::string CalibrationResult::BriefReport() const {

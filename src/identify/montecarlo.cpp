@@ -128,7 +128,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const auto identify_at = [&](const Eigen::VectorXd& dw) {
     Reduction r = r0;
     for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean_deg_h += dw[i];
-    return identify(r, ch0, model0, scenario.test, options.calibration);
+    return identify(r, ch0, model0, options.calibration);
   };
   m.bias =
       estimate_errors(identify_at(Eigen::VectorXd::Zero(np)), scenario.gyro, m.names, &m.units, &m.truth);
@@ -211,7 +211,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     const Reduction r = reducer.finish();
     const auto channels = reduce_model_channels(r, model0, m.calibration.reduce);
     std::vector<std::string> names = m.names;
-    const std::vector<double> e = estimate_errors(identify(r, channels, model0, s.test, m.calibration),
+    const std::vector<double> e = estimate_errors(identify(r, channels, model0, m.calibration),
                                                   m.scenario.gyro, names, nullptr, nullptr);
     std::copy(e.begin(), e.end(), out);
   };

@@ -123,7 +123,7 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   const std::vector<PositionChannels> channels = reduce_model_channels(r, model, options.reduce);
   set_noise_free_outputs(r, channels, s.gyro);
   set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz, options.reduce);
-  CalibrationResult result = identify(r, channels, model, s.test, options);
+  CalibrationResult result = identify(r, channels, model, options);
   if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0)
     result.warnings.push_back(
         "the predicted uncertainties count the angle random walk only; bias instability "

@@ -167,7 +167,7 @@ SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base)
       o.method = m == 0 ? Method::kClosedForm : Method::kLeastSquares;
       o.compensation = kCompensations[c];
       out[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] =
-          identify(p.reduction, p.channels, model, s.test, o);
+          identify(p.reduction, p.channels, model, o);
     }
   return out;
 }

@@ -82,8 +82,7 @@ Compensation parse_compensation(const std::string& text);
 
 /// Identify from a reduction and its model channels (identify/channels.hpp).
 CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
-                           const CentrifugeModel& model, const TestSpec& plan,
-                           const CalibrationOptions& options);
+                           const CentrifugeModel& model, const CalibrationOptions& options);
 
 /// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
