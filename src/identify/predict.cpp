@@ -38,16 +38,7 @@ Reduction planned_reduction(const Scenario& s) {
       const Dwell& d = out.dwells[di];
       if (d.planned_rate_rad_s != p.rate_rad_s || d.beta_rad != p.beta_rad) continue;
       if (d.is_static && d.gammas_rad[0] != p.gamma_rad) continue;
-      ReducedPosition rp;
-      rp.index = p.index;
-      rp.rate_rad_s = p.rate_rad_s;
-      rp.beta_rad = p.beta_rad;
-      rp.gamma_rad = p.gamma_rad;
-      rp.samples = d.samples;
-      rp.dwell = static_cast<int>(di);
-      for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
-        if (d.gammas_rad[k] == p.gamma_rad) rp.gamma_slot = static_cast<int>(k);
-      out.positions.push_back(rp);
+      out.positions.push_back(reduced_position(p, d, static_cast<int>(di)));
       break;
     }
   }

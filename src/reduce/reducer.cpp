@@ -307,21 +307,7 @@ Reduction Reducer::finish() {
       continue;
     }
     const int di = renumber[it->second];
-    const Dwell& d = out.dwells[di];
-    int slot = 0;
-    for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
-      if (d.gammas_rad[k] == p.gamma_rad) slot = static_cast<int>(k);
-    ReducedPosition rp;
-    rp.index = p.index;
-    rp.rate_rad_s = p.rate_rad_s;
-    rp.beta_rad = p.beta_rad;
-    rp.gamma_rad = p.gamma_rad;
-    rp.mean_deg_h = d.gyro.value[slot];
-    rp.std_err_deg_h = d.gyro.std_err[slot];
-    rp.samples = d.gyro.samples[slot];
-    rp.dwell = di;
-    rp.gamma_slot = slot;
-    out.positions.push_back(rp);
+    out.positions.push_back(reduced_position(p, out.dwells[static_cast<std::size_t>(di)], di));
   }
   if (!missing.empty()) {
     std::string list;
@@ -351,6 +337,24 @@ Reduction Reducer::finish() {
                     "noise-free record, whose uncertainties mean nothing.",
                     st.source, zero, zero > 1 ? "s" : ""));
   return out;
+}
+
+ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_index) {
+  int slot = 0;
+  for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
+    if (d.gammas_rad[k] == p.gamma_rad) slot = static_cast<int>(k);
+  const auto k = static_cast<std::size_t>(slot);
+  ReducedPosition rp;
+  rp.index = p.index;
+  rp.rate_rad_s = p.rate_rad_s;
+  rp.beta_rad = p.beta_rad;
+  rp.gamma_rad = p.gamma_rad;
+  rp.mean_deg_h = d.gyro.value[k];
+  rp.std_err_deg_h = d.gyro.std_err[k];
+  rp.samples = d.gyro.samples[k];
+  rp.dwell = dwell_index;
+  rp.gamma_slot = slot;
+  return rp;
 }
 
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/record/record.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
@@ -56,6 +57,10 @@ struct ReducedPosition {
   int dwell = 0;       ///< index into Reduction::dwells
   int gamma_slot = 0;  ///< index into that dwell's gammas
 };
+
+/// The reduced position of plan position `p` measured by `dwell` (index `dwell_index` in the reduction): its
+/// gamma's slot in the dwell, value, standard error and sample count.
+ReducedPosition reduced_position(const Position& p, const Dwell& dwell, int dwell_index);
 
 struct Reduction {
   std::vector<Dwell> dwells;
