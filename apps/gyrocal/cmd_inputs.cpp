@@ -52,7 +52,6 @@ void register_inputs(CLI::App& app) {
                          ->needs(gamma);
   time->excludes(gamma)->excludes(rev);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
-  sub->require_option(0);
   sub->callback([opt, time, gamma] {
     if (time->count() == 0 && gamma->count() == 0)
       throw CLI::ValidationError("inputs", "give the instant with --time-s T or --gamma-deg G");
