@@ -186,7 +186,10 @@ TEST_F(Cli, SimulateThenCalibrateWritesTheResultJsonOfTheInterface) {
     const auto& di = j["coefficients"]["dI"];
     EXPECT_NEAR(di["value"].get<double>(), 0.5, 5 * di["std"].get<double>());
     std::set<std::string> names;
-    for (const auto& c : j["combinations"]) names.insert(c["name"].get<std::string>());
+    for (const auto& c : j["combinations"]) {
+      names.insert(c["name"].get<std::string>());
+      EXPECT_EQ(c["coefficients"].size(), 10u);  // the combination actually estimated (docs/interface.md)
+    }
     EXPECT_EQ(names, (std::set<std::string>{"dII-dSS", "dOO-dSS", "dF+(1+Ar^2)dSS"}));
     std::set<std::string> alts;
     for (const auto& a : j["alternatives"]) alts.insert(a["name"].get<std::string>());

@@ -11,6 +11,14 @@ nlohmann::json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
+/// {name, value, std, unit} and, for a combination, the coefficients on dF..dOS it was estimated with.
+nlohmann::json named_estimate_to_json(const NamedEstimate& c) {
+  nlohmann::json j = {
+      {"name", c.name}, {"value", number_or_null(c.value)}, {"std", number_or_null(c.std)}, {"unit", c.unit}};
+  if (!c.coefficients.empty()) j["coefficients"] = c.coefficients;
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json calibration_to_json(const CalibrationResult& r) {
@@ -26,17 +34,9 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
   }
   j["coefficients"] = coefficients;
   j["combinations"] = nlohmann::json::array();
-  for (const NamedEstimate& c : r.combinations)
-    j["combinations"].push_back({{"name", c.name},
-                                 {"value", number_or_null(c.value)},
-                                 {"std", number_or_null(c.std)},
-                                 {"unit", c.unit}});
+  for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
   j["alternatives"] = nlohmann::json::array();
-  for (const NamedEstimate& c : r.alternatives)
-    j["alternatives"].push_back({{"name", c.name},
-                                 {"value", number_or_null(c.value)},
-                                 {"std", number_or_null(c.std)},
-                                 {"unit", c.unit}});
+  for (const NamedEstimate& c : r.alternatives) j["alternatives"].push_back(named_estimate_to_json(c));
   j["positions"] = nlohmann::json::array();
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const ReducedPosition& p = r.positions[i];
