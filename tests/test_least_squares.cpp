@@ -84,7 +84,7 @@ double lre(double estimate, const Certified& certified) {
 NistSet load_nist(const std::string& name) {
   NistSet set;
   set.name = name;
-  const std::string path = std::string(GYROCAL_SHARED_DATA_DIR) + "/nist-strd/" + name + ".txt";
+  const std::string path = std::string(GYROCAL_TEST_DATA_DIR) + "/nist-strd/" + name + ".txt";
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open " + path);
   std::vector<std::vector<double>> rows;
