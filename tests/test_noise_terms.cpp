@@ -1,0 +1,195 @@
+// Noise characterisation (physics.md section 13): chi-squared quantiles against closed forms and tables, the
+// equivalent degrees of freedom against the scatter of simulated Allan variances, confidence bounds against
+// their coverage, and the IEEE 952 terms recovered from simulated records.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <numeric>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/noise_terms.hpp"
+#include "gyrocal/core/random.hpp"
+#include "gyrocal/simulate/noise.hpp"
+
+namespace gyrocal {
+namespace {
+
+bool sanitized() {
+  return std::getenv("GYROCAL_SANITIZED") != nullptr;
+}
+
+std::vector<double> generate(const GyroNoise& noise, double sample_rate_hz, std::uint64_t seed,
+                             std::size_t count, double offset_deg_h = 0.0) {
+  GyroNoiseGenerator generator(noise, sample_rate_hz, seed);
+  std::vector<double> out(count);
+  for (double& y : out) y = generator.next(offset_deg_h);
+  return out;
+}
+
+TEST(ChiSquaredQuantile, MatchesClosedFormsAndTables) {
+  // Two degrees of freedom: P(X <= x) = 1 - exp(-x/2).
+  for (double p : {1e-6, 0.1586552539, 0.5, 0.8413447461, 0.999}) {
+    EXPECT_NEAR(chi_squared_quantile(p, 2.0) / (-2.0 * std::log1p(-p)), 1.0, 1e-12) << p;
+  }
+  // One degree of freedom: X = Z^2, so P(X <= k^2) = P(|Z| <= k).
+  EXPECT_NEAR(chi_squared_quantile(std::erf(1.0 / std::sqrt(2.0)), 1.0), 1.0, 1e-12);
+  EXPECT_NEAR(chi_squared_quantile(std::erf(2.0 / std::sqrt(2.0)), 1.0), 4.0, 1e-11);
+  // Published tables (Abramowitz & Stegun 26.4): 10 degrees of freedom at 5 % and 95 %; 100 at 50 %.
+  EXPECT_NEAR(chi_squared_quantile(0.05, 10.0), 3.940299, 1e-6);
+  EXPECT_NEAR(chi_squared_quantile(0.95, 10.0), 18.307038, 1e-6);
+  EXPECT_NEAR(chi_squared_quantile(0.5, 100.0), 99.334129, 1e-6);
+  EXPECT_THROW(chi_squared_quantile(0.0, 3.0), Error);
+  EXPECT_THROW(chi_squared_quantile(0.5, -1.0), Error);
+}
+
+TEST(ConfidenceBounds, AreTheChiSquaredQuantilesOfTheVariance) {
+  // With 2 degrees of freedom the bounds are closed forms of the 15.87 % and 84.13 % quantiles.
+  const DeviationBounds b = deviation_confidence_bounds(1.0, 2.0);
+  const double tail = (1.0 - std::erf(1.0 / std::sqrt(2.0))) / 2.0;
+  EXPECT_NEAR(b.low, std::sqrt(2.0 / (-2.0 * std::log(tail))), 1e-10);
+  EXPECT_NEAR(b.high, std::sqrt(2.0 / (-2.0 * std::log1p(-tail))), 1e-10);
+  // Many degrees of freedom: the relative half-width tends to 1/sqrt(2 dof).
+  const DeviationBounds wide = deviation_confidence_bounds(1.0, 20000.0);
+  EXPECT_NEAR((wide.high - wide.low) / 2.0, 1.0 / std::sqrt(40000.0), 1e-4);
+}
+
+// The equivalent degrees of freedom say var(sigma^2 estimate) = 2 sigma^4 / dof: check that against the
+// scatter of independent simulated runs, for white rate noise and for rate random walk.
+void expect_dof_matches_scatter(const GyroNoise& noise, NoiseTerm term, std::size_t samples, int runs,
+                                const std::vector<std::size_t>& sizes) {
+  std::vector<double> sum(sizes.size(), 0.0), sum_squares(sizes.size(), 0.0);
+  for (int run = 0; run < runs; ++run) {
+    const std::vector<double> y =
+        generate(noise, 10.0, derive_stream_seed(77, static_cast<std::uint64_t>(run)), samples);
+    const AllanDeviation adev = overlapping_allan_deviation(y, 10.0, sizes);
+    for (std::size_t j = 0; j < sizes.size(); ++j) {
+      const double v = adev.deviation[j] * adev.deviation[j];
+      sum[j] += v;
+      sum_squares[j] += v * v;
+    }
+  }
+  const auto r = static_cast<double>(runs);
+  for (std::size_t j = 0; j < sizes.size(); ++j) {
+    const double mean = sum[j] / r;
+    const double variance = (sum_squares[j] - r * mean * mean) / (r - 1.0);
+    const double dof_observed = 2.0 * mean * mean / variance;
+    const double dof = allan_equivalent_dof(samples, sizes[j], term);
+    // The sample variance of `runs` values has a relative standard error of about sqrt(2 / runs) (more for
+    // skewed laws): 30 % at 400 runs is about 4 of them, and a dof off by a factor 2 fails.
+    EXPECT_NEAR(dof_observed / dof, 1.0, 0.3) << "m = " << sizes[j] << ", dof " << dof;
+  }
+}
+
+TEST(AllanDof, MatchesTheScatterOfWhiteNoise) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.01;
+  expect_dof_matches_scatter(noise, NoiseTerm::AngleRandomWalk, 2048, sanitized() ? 150 : 400,
+                             {1, 8, 64, 256});
+}
+
+TEST(AllanDof, MatchesTheScatterOfRateRandomWalk) {
+  GyroNoise noise;
+  noise.rate_random_walk_deg_h_rt_h = 1.0;
+  expect_dof_matches_scatter(noise, NoiseTerm::RateRandomWalk, 2048, sanitized() ? 150 : 400, {8, 64, 256});
+}
+
+TEST(NoiseCharacterisation, BoundsCoverTheTruthAtTheirStatedRate) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.01;
+  const double fs = 10.0;
+  const int runs = sanitized() ? 100 : 300;
+  std::vector<int> covered;
+  std::vector<double> taus;
+  for (int run = 0; run < runs; ++run) {
+    const NoiseCharacterisation c = characterise_noise(
+        generate(noise, fs, derive_stream_seed(5, static_cast<std::uint64_t>(run)), 4096), fs);
+    if (covered.empty()) {
+      covered.assign(c.allan.tau_s.size(), 0);
+      taus = c.allan.tau_s;
+    }
+    for (std::size_t j = 0; j < taus.size(); ++j) {
+      const double truth = 60.0 * noise.angle_random_walk_deg_rt_h / std::sqrt(taus[j]);
+      covered[j] += (c.adev_low[j] <= truth && truth <= c.adev_high[j]) ? 1 : 0;
+    }
+  }
+  // 68.3 % within 4 binomial standard errors. At the last point (m = N/4) the simple degrees of freedom of
+  // NIST SP 1065 are too few (about 4 where the scatter says more), so its bounds are wider than stated:
+  // measured 0.79 to 0.81. That is conservative, and is all the test asks there (docs/noise.md).
+  const double tolerance = 4.0 * std::sqrt(0.683 * 0.317 / runs);
+  for (std::size_t j = 0; j < taus.size(); ++j) {
+    const double coverage = covered[j] / static_cast<double>(runs);
+    if (j + 1 < taus.size()) {
+      EXPECT_NEAR(coverage, 0.683, tolerance) << "tau = " << taus[j] << " s";
+    } else {
+      EXPECT_GT(coverage, 0.683 - tolerance) << "tau = " << taus[j] << " s";
+    }
+  }
+}
+
+TEST(NoiseCharacterisation, RecoversWhiteNoiseAndRateRandomWalk) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.01;  // sigma = 0.6 deg/h at 1 s
+  noise.rate_random_walk_deg_h_rt_h = 1.0;  // crosses the white noise at tau = 3 * 3600 * N / K = 108 s
+  const double fs = 20.0;
+  const int runs = sanitized() ? 10 : 40;
+  std::vector<double> z_n, z_k;
+  for (int run = 0; run < runs; ++run) {
+    const NoiseCharacterisation c = characterise_noise(
+        generate(noise, fs, derive_stream_seed(9, static_cast<std::uint64_t>(run)), 80000), fs);
+    const FittedNoiseTerm& n = c.term(NoiseTerm::AngleRandomWalk);
+    const FittedNoiseTerm& k = c.term(NoiseTerm::RateRandomWalk);
+    ASSERT_TRUE(n.present && k.present);
+    z_n.push_back((n.value - noise.angle_random_walk_deg_rt_h) / n.std);
+    z_k.push_back((k.value - noise.rate_random_walk_deg_h_rt_h) / k.std);
+    EXPECT_NEAR(n.value / noise.angle_random_walk_deg_rt_h, 1.0, 0.05);
+    EXPECT_NEAR(k.value / noise.rate_random_walk_deg_h_rt_h, 1.0, 0.6);
+  }
+  auto rms = [](const std::vector<double>& z) {
+    return std::sqrt(std::inner_product(z.begin(), z.end(), z.begin(), 0.0) / static_cast<double>(z.size()));
+  };
+  // Honest, not tiny and not swollen: the rms z-score within [0.5, 1.3] (1.4 and 2.0 without the correlation
+  // factor).
+  EXPECT_GT(rms(z_n), 0.5);
+  EXPECT_LT(rms(z_n), 1.3);
+  EXPECT_GT(rms(z_k), 0.5);
+  EXPECT_LT(rms(z_k), 1.3);
+}
+
+TEST(NoiseCharacterisation, RecoversBiasInstability) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.005;
+  noise.bias_instability_deg_h = 0.05;
+  const double fs = 5.0;
+  const NoiseCharacterisation c =
+      characterise_noise(generate(noise, fs, 31, sanitized() ? 50000 : 200000), fs);
+  const FittedNoiseTerm& b = c.term(NoiseTerm::BiasInstability);
+  ASSERT_TRUE(b.present);
+  EXPECT_NEAR(b.value / noise.bias_instability_deg_h, 1.0, 0.25);
+  EXPECT_NEAR(c.term(NoiseTerm::AngleRandomWalk).value / noise.angle_random_walk_deg_rt_h, 1.0, 0.1);
+}
+
+TEST(NoiseCharacterisation, ALargeConstantOffsetChangesNothing) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.01;
+  noise.rate_random_walk_deg_h_rt_h = 1.0;
+  const std::vector<double> y = generate(noise, 20.0, 3, 40000);
+  std::vector<double> shifted = y;
+  for (double& v : shifted) v += 1e7;
+  const NoiseCharacterisation a = characterise_noise(y, 20.0);
+  const NoiseCharacterisation b = characterise_noise(shifted, 20.0);
+  for (std::size_t j = 0; j < a.allan.deviation.size(); ++j) {
+    // 1e7 deg/h carries rounding of 1e7 * 2^-53 ~ 1e-9 deg/h per sample, far below the noise of 0.6 deg/h.
+    EXPECT_NEAR(b.allan.deviation[j] / a.allan.deviation[j], 1.0, 1e-6) << j;
+  }
+  EXPECT_NEAR(b.term(NoiseTerm::AngleRandomWalk).value / a.term(NoiseTerm::AngleRandomWalk).value, 1.0, 1e-6);
+}
+
+TEST(NoiseCharacterisation, RefusesTooShortARecord) {
+  EXPECT_THROW(characterise_noise(std::vector<double>(10, 1.0), 1.0), Error);
+}
+
+}  // namespace
+}  // namespace gyrocal
