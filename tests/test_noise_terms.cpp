@@ -7,11 +7,23 @@
 #include <numeric>
 #include <vector>
 
-#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "gyrocal/analysis/record_noise.hpp"
+#include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/noise_terms.hpp"
 #include "gyrocal/core/random.hpp"
+#include "gyrocal/record/record.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
@@ -189,6 +201,92 @@ TEST(NoiseCharacterisation, ALargeConstantOffsetChangesNothing) {
 
 TEST(NoiseCharacterisation, RefusesTooShortARecord) {
   EXPECT_THROW(characterise_noise(std::vector<double>(10, 1.0), 1.0), Error);
+}
+
+// A static record in gyrocal's format: white noise plus rate random walk on a constant Earth rate, at 20 Hz,
+// with an optional hole (rows left out) to make the sampling uneven.
+void write_static_record(const std::filesystem::path& path, std::size_t rows, std::size_t hole_at = 0) {
+  GyroNoise noise;
+  noise.angle_random_walk_deg_rt_h = 0.01;
+  noise.rate_random_walk_deg_h_rt_h = 1.0;
+  GyroNoiseGenerator generator(noise, 20.0, 4);
+  std::ofstream out(path);
+  RecordWriter writer(out, {{"test", "static"}}, {});
+  RecordSample sample;
+  sample.position_angle_deg = 90.0;
+  for (std::size_t i = 0; i < rows; ++i) {
+    sample.time_s = static_cast<double>(i) / 20.0;
+    sample.gyro_deg_h = generator.next(9.5);
+    if (hole_at == 0 || i < hole_at || i >= hole_at + 3) writer.write(sample);
+  }
+  writer.finish();
+}
+
+struct Outcome {
+  int status = -1;
+  std::string out, err;
+};
+
+Outcome run_cli(const std::string& args, const std::filesystem::path& dir) {
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = std::string(GYROCAL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+  const int raw = std::system(cmd.c_str());
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+}
+
+class NoiseCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("gyrocal-noise-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(NoiseCommand, WritesTheContractsJsonAndAConfigurationSection) {
+  const auto record = dir_ / "static.csv";
+  write_static_record(record, 40000);
+  const Outcome o = run_cli("noise " + record.string() + " --json " + (dir_ / "noise.json").string(), dir_);
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::ifstream in(dir_ / "noise.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["sample_rate_hz"].get<double>(), 20.0, 1e-9);
+  EXPECT_EQ(j["samples"].get<std::size_t>(), 40000u);
+  // Every octave m = 1, 2, 4, ... <= N/4, with bounds around the deviation.
+  std::size_t m = 1;
+  for (const auto& point : j["allan"]) {
+    EXPECT_NEAR(point["tau_s"].get<double>(), static_cast<double>(m) / 20.0, 1e-9 * static_cast<double>(m));
+    EXPECT_LT(point["adev_low"].get<double>(), point["adev"].get<double>());
+    EXPECT_GT(point["adev_high"].get<double>(), point["adev"].get<double>());
+    EXPECT_EQ(point["clusters"].get<std::size_t>(), 40000u / m);
+    m *= 2;
+  }
+  EXPECT_EQ(m, 16384u);  // the last was 8192 <= 10000
+  const double n = j["terms"]["angle_random_walk_deg_rt_h"]["value"].get<double>();
+  EXPECT_NEAR(n, 0.01, 4.0 * j["terms"]["angle_random_walk_deg_rt_h"]["std"].get<double>());
+  EXPECT_TRUE(j["terms"].contains("rate_random_walk_deg_h_rt_h"));
+
+  // --toml: a section that a configuration takes as it is, with the fitted values bit for bit.
+  const Outcome t = run_cli("noise " + record.string() + " --toml", dir_);
+  ASSERT_EQ(t.status, 0) << t.err;
+  const Scenario s = parse_scenario(t.out, "noise --toml");
+  EXPECT_EQ(s.noise.angle_random_walk_deg_rt_h, n);
+}
+
+TEST_F(NoiseCommand, RefusesUnevenSamplingWithItsTime) {
+  const auto record = dir_ / "gap.csv";
+  write_static_record(record, 2000, 1000);  // rows 1000..1002 missing: 0.2 s between t = 49.95 s and 50.15 s
+  const Outcome o = run_cli("noise " + record.string(), dir_);
+  EXPECT_EQ(o.status, 1);
+  EXPECT_NE(o.err.find("uneven at t = 49.95 s"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find(record.string()), std::string::npos) << o.err;
 }
 
 }  // namespace

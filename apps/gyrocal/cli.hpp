@@ -42,5 +42,6 @@ void register_plan(CLI::App& app);
 void register_sensitivity(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 void register_report(CLI::App& app);
+void register_noise(CLI::App& app);
 
 }  // namespace gyrocal::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   gyrocal::cli::register_sensitivity(app);
   gyrocal::cli::register_montecarlo(app);
   gyrocal::cli::register_report(app);
+  gyrocal::cli::register_noise(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/model/gyro.hpp"
 
@@ -14,5 +15,8 @@ std::string result_table(const CalibrationResult& result);
 /// Several results side by side, with the truth in the first column when given.
 std::string comparison_table(const std::vector<std::string>& labels,
                              const std::vector<CalibrationResult>& results, const DriftCoefficients* truth);
+
+/// The Allan deviation with its bounds and dominant term, then the fitted terms with their uncertainties.
+std::string noise_table(const RecordNoise& result);
 
 }  // namespace gyrocal::cli

@@ -541,6 +541,10 @@ void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
 
 }  // namespace
 
+std::string toml_float(double v) {
+  return toml_number(v);
+}
+
 Scenario parse_scenario(std::string_view toml_text, const std::string& source_name) {
   const Reader reader(source_name);
   toml::table root;

@@ -34,4 +34,8 @@ Scenario load_scenario(const std::filesystem::path& path);
 /// Throws Error if test.seed exceeds the largest TOML integer (2^63 - 1).
 std::string scenario_to_toml(const Scenario& s);
 
+/// A number as a TOML float that reads back bit for bit: the shortest form, with ".0" added where it would
+/// otherwise read as an integer. Every writer of configuration text uses it.
+std::string toml_float(double v);
+
 }  // namespace gyrocal
