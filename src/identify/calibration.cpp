@@ -91,6 +91,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
       fmt::format("dF, dII, dOO, dSS: adding c to dII, dOO, dSS and -(1+Ar^2) c to dF "
                   "changes no output at one speed (MODEL.md section 8)"));
   r.rank = 9;
+  if (options.method != Method::kClosedForm) return;  // least squares borrows only the second expressions
   // Its condition, as least squares reports it for the same 16 positions (MODEL.md section 9): the
   // condition of their whitened, equilibrated design; and how much uncertainty the closed forms give away:
   // the largest ratio of a form's standard uncertainty to least squares' for the same quantity from the same
