@@ -291,6 +291,15 @@ struct Planned {
   }
 };
 
+TEST(Messages, APlanWithFewerPositionsThanCoefficientsSaysSoInItsTerms) {
+  Scenario s = scenario({"two positions", {9.9}, {0}, {0, 90}}, true);
+  const std::string message = error_of([&] { predict_calibration(s, CalibrationOptions{}); });
+  EXPECT_NE(message.find("the plan gives 2 positions for the 9 coefficients its positions excite"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("beta_deg"), std::string::npos) << message;
+}
+
 TEST(Messages, ANonFiniteReducedOutputIsNamedByItsPosition) {
   Planned p;
   p.reduction.positions[7].mean_deg_h = std::numeric_limits<double>::infinity();

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <Eigen/SVD>
 
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -233,6 +234,12 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   for (Index j = 0; j < n; ++j)
     if (out.excited[static_cast<std::size_t>(j)]) active.push_back(j);
 
+  if (whitened_design.rows() < static_cast<Index>(active.size()))
+    throw Error(
+        fmt::format("the plan gives {} position{} for the {} coefficients its positions excite; least "
+                    "squares needs at least "
+                    "as many positions: add values to [test] beta_deg, gamma_deg or rates_rad_s.",
+                    whitened_design.rows(), whitened_design.rows() == 1 ? "" : "s", active.size()));
   LeastSquaresProblem problem;
   problem.design.resize(whitened_design.rows(), static_cast<Index>(active.size()));
   for (std::size_t a = 0; a < active.size(); ++a)
