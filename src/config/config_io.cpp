@@ -446,6 +446,30 @@ std::vector<double> scaled(std::vector<double> values, double factor) {
   return values;
 }
 
+/// Refuses a value of the array `node` (read as `values`, in the file's unit) that repeats an earlier one: a
+/// plan measures each rate, beta and gamma once, and a repeat would be one dwell counted twice. Angles (deg)
+/// repeat modulo 360 within 1e-3 deg (the reducer's match of a dwell to the plan); rates within 1e-3
+/// relative (the reducer's steady-rate tolerance).
+void reject_repeats(const Reader& reader, const toml::node& node, const std::string& path,
+                    const std::vector<double>& values, bool angle) {
+  const toml::array& items = *node.as_array();
+  for (std::size_t j = 1; j < values.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      const double a = values[i], b = values[j];
+      const bool same = angle ? std::abs(std::remainder(a - b, 360.0)) <= 1e-3
+                              : std::abs(a - b) <= 1e-3 * std::max(std::abs(a), std::abs(b));
+      if (!same) continue;
+      const std::string why = angle    ? " (the same angle modulo 360 deg, within 0.001 deg)"
+                              : a == b ? ""
+                                       : " (within 1e-3 relative, too close to tell apart)";
+      reader.fail(items[j].source(), path + "[" + std::to_string(j) + "] = " + shortest(b) + " repeats " +
+                                         path + "[" + std::to_string(i) + "] = " + shortest(a) + why +
+                                         ": each value is measured once, so a repeat would count one dwell "
+                                         "twice; remove it");
+    }
+  }
+}
+
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
   section.number("sample_rate_hz", 1.0, kPositive, test.sample_rate_hz);
   if (const toml::node* node = section.find("revolutions")) {
@@ -453,13 +477,18 @@ void read_test(const Reader& reader, Section& section, TestSpec& test) {
   }
   section.number("settle_s", 1.0, kNonNegative, test.settle_s);
   if (const toml::node* node = section.find("beta_deg")) {
-    test.beta_rad = scaled(reader.numbers(*node, section.path("beta_deg"), kAnyValue, 0), kDegToRad);
+    const std::vector<double> deg = reader.numbers(*node, section.path("beta_deg"), kAnyValue, 0);
+    reject_repeats(reader, *node, section.path("beta_deg"), deg, true);
+    test.beta_rad = scaled(deg, kDegToRad);
   }
   if (const toml::node* node = section.find("gamma_deg")) {
-    test.gamma_rad = scaled(reader.numbers(*node, section.path("gamma_deg"), kAnyValue, 0), kDegToRad);
+    const std::vector<double> deg = reader.numbers(*node, section.path("gamma_deg"), kAnyValue, 0);
+    reject_repeats(reader, *node, section.path("gamma_deg"), deg, true);
+    test.gamma_rad = scaled(deg, kDegToRad);
   }
   if (const toml::node* node = section.find("rates_rad_s")) {
     test.rates_rad_s = reader.numbers(*node, section.path("rates_rad_s"), kAnyValue, 0);
+    reject_repeats(reader, *node, section.path("rates_rad_s"), test.rates_rad_s, false);
   }
   if (const toml::node* node = section.find("seed")) {
     test.seed = static_cast<std::uint64_t>(reader.integer(*node, section.path("seed"), 0, INT64_MAX));

@@ -5,9 +5,11 @@
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/closed_form.hpp"
+#include "gyrocal/identify/identifiability.hpp"
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
@@ -23,10 +25,6 @@ double first_spinning_rate(const std::vector<ReducedPosition>& positions) {
   for (const ReducedPosition& p : positions)
     if (p.rate_rad_s != 0.0) return p.rate_rad_s;
   return 0.0;
-}
-
-std::vector<std::string> coefficient_names() {
-  return {kCoefficientNames.begin(), kCoefficientNames.end()};
 }
 
 /// Covariance (deg/h)^2 of the reduced positions: within a dwell from its values' covariance (one fit
@@ -93,10 +91,128 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
       fmt::format("dF, dII, dOO, dSS: adding c to dII, dOO, dSS and -(1+Ar^2) c to dF "
                   "changes no output at one speed (MODEL.md section 8)"));
   r.rank = 9;
+  if (options.method != Method::kClosedForm) return;  // least squares borrows only the second expressions
+  // Its condition, as least squares reports it for the same 16 positions (MODEL.md section 9): the
+  // condition of their whitened, equilibrated design; and how much uncertainty the closed forms give away:
+  // the largest ratio of a form's standard uncertainty to least squares' for the same quantity from the same
+  // 16 positions and covariance (1 = nothing lost; docs/calibration.md).
+  Eigen::MatrixXd x(16, static_cast<Eigen::Index>(kNumCoefficients));
+  Eigen::MatrixXd cov16(16, 16);
+  const Eigen::MatrixXd floored = position_covariance(reduction, options.min_std_err_deg_h);
+  for (Eigen::Index k = 0; k < 16; ++k) {
+    const auto& reg =
+        channels[static_cast<std::size_t>(k16[static_cast<std::size_t>(k)])].regressors(options.compensation);
+    for (Eigen::Index j = 0; j < x.cols(); ++j) x(k, j) = reg[static_cast<std::size_t>(j)];
+    for (Eigen::Index l = 0; l < 16; ++l)
+      cov16(k, l) = floored(k16[static_cast<std::size_t>(k)], k16[static_cast<std::size_t>(l)]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(cov16);
+  if (llt.info() != Eigen::Success || !x.allFinite()) return;
+  LeastSquaresProblem problem;
+  problem.design = llt.matrixL().solve(x);
+  problem.observations = Eigen::VectorXd::Zero(16);
+  problem.weights = Eigen::VectorXd::Ones(16);
+  LeastSquaresOptions ls = options.least_squares;
+  ls.rank_tolerance = std::max(ls.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  ls.estimable_tolerance = std::max(ls.estimable_tolerance, options.estimable_tolerance);
+  const LeastSquaresSolution sol = solve_least_squares(problem, ls);
+  r.condition_number = sol.effective_condition_number;
+  const Eigen::Matrix<double, 16, 16> cov_fixed = cov16;
+  double amplification = 0.0;
+  std::string worst;
+  const auto compare = [&](const LinearForm& f, const IdentifiableCombination& best) {
+    if (!best.identifiable || !(best.std > 0)) return;
+    const double ratio = f.std(cov_fixed) / best.std;
+    if (ratio > amplification) amplification = ratio, worst = f.name;
+  };
+  for (const LinearForm& f : cf.primary) {
+    for (std::size_t c = 0; c < kNumCoefficients; ++c)
+      if (kCoefficientNames[c] == f.name) {
+        compare(f,
+                evaluate_combination(sol, Eigen::VectorXd::Unit(x.cols(), static_cast<Eigen::Index>(c)), ls));
+      }
+  }
+  for (const LinearForm& f : cf.combinations) {
+    const std::vector<double>& c = combination_coefficients.at(f.name);
+    compare(f, evaluate_combination(sol, Eigen::Map<const Eigen::VectorXd>(c.data(), x.cols()), ls));
+  }
+  r.uncertainty_amplification = amplification;
+  if (amplification > 2.0)
+    r.warnings.push_back(
+        fmt::format("closed form: the standard uncertainty of {} is {:.3g} times what least squares gets "
+                    "from the same 16 "
+                    "positions (--method least-squares).",
+                    worst, amplification));
+}
+
+/// "position 8 (rate 9.9 rad/s, beta 180 deg, gamma 270 deg; record time 812.3 s to 1013.4 s)".
+std::string describe_position(const Reduction& reduction, std::size_t i) {
+  const ReducedPosition& p = reduction.positions[i];
+  std::string where = fmt::format("position {} (rate {:g} rad/s, beta {:g} deg, gamma {:g} deg", p.index,
+                                  p.rate_rad_s, p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg);
+  if (p.dwell >= 0 && static_cast<std::size_t>(p.dwell) < reduction.dwells.size()) {
+    const Dwell& d = reduction.dwells[static_cast<std::size_t>(p.dwell)];
+    where += fmt::format("; record time {:g} s to {:g} s", d.first_time_s, d.last_time_s);
+  }
+  return where + ")";
+}
+
+/// Refuses, naming the position, a reduced value or model channel that is not finite (a record whose outputs
+/// overflow, a configuration whose levels do).
+void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
+                  const Eigen::VectorXd& observations, const std::vector<PositionChannels>& channels,
+                  Compensation compensation) {
+  for (Eigen::Index i = 0; i < design.rows(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const ReducedPosition& p = reduction.positions[k];
+    if (!std::isfinite(p.mean_deg_h))
+      throw Error(
+          fmt::format("the reduced gyro output of {} is not a finite number: the record's gyro "
+                      "outputs there are too large to average; check the record's gyro column.",
+                      describe_position(reduction, k)));
+    if (!std::isfinite(channels[k].omega_deg_h(compensation)) || !design.row(i).allFinite())
+      throw Error(
+          fmt::format("the model's input rate or specific force at {} is not finite: the configured "
+                      "radius, rate or machine errors are too large to evaluate.",
+                      describe_position(reduction, k)));
+    if (!std::isfinite(observations[i]))
+      throw Error(
+          fmt::format("the output minus the model's input rate at {} is not finite ({:g} - {:g}): "
+                      "the record's gyro output and the configuration disagree beyond a double's range.",
+                      describe_position(reduction, k), p.mean_deg_h, channels[k].omega_deg_h(compensation)));
+  }
+}
+
+/// Refuses a covariance of the reduced positions that cannot weight a fit, naming the positions at fault:
+/// two positions of the plan that are one measurement, or a dwell whose standard errors are not a covariance.
+void refuse_covariance(const Reduction& reduction) {
+  const auto& ps = reduction.positions;
+  for (std::size_t i = 0; i < ps.size(); ++i)
+    for (std::size_t j = i + 1; j < ps.size(); ++j)
+      if (ps[i].dwell == ps[j].dwell && ps[i].gamma_slot == ps[j].gamma_slot)
+        throw Error(
+            fmt::format("{} and {} are one and the same measurement (the plan repeats a rate, beta or "
+                        "gamma): they cannot "
+                        "be weighted as two; remove the repeated value from [test].",
+                        describe_position(reduction, i), describe_position(reduction, j)));
+  for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
+    const Eigen::MatrixXd& c = reduction.dwells[d].gyro.covariance;
+    if (c.size() == 0 || Eigen::LLT<Eigen::MatrixXd>(c).info() == Eigen::Success) continue;
+    for (std::size_t i = 0; i < ps.size(); ++i)
+      if (static_cast<std::size_t>(ps[i].dwell) == d)
+        throw Error(
+            fmt::format("the standard errors of the dwell holding {} do not form a covariance (not "
+                        "positive definite): the record's scatter there cannot weight a fit.",
+                        describe_position(reduction, i)));
+  }
+  throw Error(
+      "the reduced positions' standard errors do not form a covariance (not positive definite): they cannot "
+      "weight a least-squares fit.");
 }
 
 void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
-                            const CalibrationOptions& options, CalibrationResult& r) {
+                            const CentrifugeModel& model, const CalibrationOptions& options,
+                            CalibrationResult& r) {
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
   const auto n = static_cast<Eigen::Index>(kNumCoefficients);
   // Generalised least squares: the positions of one dwell are correlated, so rows and observations are
@@ -110,20 +226,21 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     for (Eigen::Index j = 0; j < n; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
     observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
   }
+  check_finite(reduction, design, observations, channels, options.compensation);
   const Eigen::LLT<Eigen::MatrixXd> llt(position_covariance(reduction, options.min_std_err_deg_h));
-  if (llt.info() != Eigen::Success)
-    throw Error(
-        "the covariance of the reduced positions is not positive definite; the record's standard errors "
-        "cannot weight a least-squares fit.");
-  LeastSquaresProblem problem;
-  problem.design = llt.matrixL().solve(design);
-  problem.observations = llt.matrixL().solve(observations);
-  problem.weights = Eigen::VectorXd::Ones(m);
-  problem.names = coefficient_names();
-  LeastSquaresOptions ls = options.least_squares;
-  ls.rank_tolerance = std::max(ls.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
-  ls.estimable_tolerance = std::max(ls.estimable_tolerance, options.estimable_tolerance);
-  const LeastSquaresSolution sol = solve_least_squares(problem, ls);
+  if (llt.info() != Eigen::Success) refuse_covariance(reduction);
+  IdentifiabilityOptions io;
+  io.least_squares = options.least_squares;
+  io.least_squares.rank_tolerance =
+      std::max(io.least_squares.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  io.least_squares.estimable_tolerance =
+      std::max(io.least_squares.estimable_tolerance, options.estimable_tolerance);
+  io.min_regressor_level = options.min_regressor_level;
+  io.named_tolerance = options.estimable_tolerance;
+  const CoefficientFit fit =
+      fit_coefficients(design, llt.matrixL().solve(design), llt.matrixL().solve(observations), r.g_level,
+                       reduction.positions, model, io);
+  const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
   r.condition_number = sol.effective_condition_number;
   r.chi2 = sol.chi2;
@@ -141,44 +258,22 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
       continue;
     r.warnings.push_back("least squares: " + w);
   }
-  if (sol.rank == n) return;
-
-  for (Eigen::Index k = 0; k < sol.null_space.cols(); ++k) {
-    // Written without the ~1e-9 parts that exact regressors add: they say nothing to the reader.
-    Eigen::VectorXd v = sol.null_space.col(k);
-    const double largest = v.cwiseAbs().maxCoeff();
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (std::abs(v[i]) < 1e-6 * largest) v[i] = 0.0;
-    r.unidentifiable.push_back(describe_combination(v, sol.names));
-  }
-  // The identifiable combinations of MODEL.md section 8 where the plan is the single-speed one; each is made
-  // exactly estimable by removing its (tiny) part along the numerically unidentifiable directions.
-  const double ar = r.g_level;
-  struct Named {
-    std::string name, unit;
-    Eigen::VectorXd c;
-  };
-  std::vector<Named> named;
-  const auto e = [n](Coefficient k) { return Eigen::VectorXd::Unit(n, static_cast<Eigen::Index>(k)); };
-  named.push_back({"dII-dSS", "deg/h/g^2", e(Coefficient::dII) - e(Coefficient::dSS)});
-  named.push_back({"dOO-dSS", "deg/h/g^2", e(Coefficient::dOO) - e(Coefficient::dSS)});
-  named.push_back({"dF+(1+Ar^2)dSS", "deg/h", e(Coefficient::dF) + (1 + ar * ar) * e(Coefficient::dSS)});
-  for (const Named& nc : named) {
-    // Project out the null space in the equilibrated coordinates (where it is orthonormal).
-    const Eigen::VectorXd scaled = nc.c.cwiseProduct(sol.column_scales);
-    const Eigen::VectorXd kept =
-        scaled - sol.scaled_null_space * (sol.scaled_null_space.transpose() * scaled);
-    if (kept.norm() < 0.9 * scaled.norm()) continue;  // not a combination this plan determines
-    const Eigen::VectorXd c = kept.cwiseQuotient(sol.column_scales);
-    const IdentifiableCombination comb = evaluate_combination(sol, c, ls, nc.name);
-    if (comb.identifiable)
-      r.combinations.push_back(
-          {nc.name, nc.unit, comb.value, comb.std, std::vector<double>(c.begin(), c.end())});
-  }
-  r.warnings.push_back(fmt::format(
-      "{} direction{} of the coefficients cannot be identified from this plan ({}); a second speed (a static "
-      "set with the main axis stopped counts) would identify them.",
-      n - sol.rank, n - sol.rank > 1 ? "s" : "", r.unidentifiable.front()));
+  if (fit.directions.empty()) return;
+  r.unidentifiable = fit.direction_texts;
+  r.combinations = fit.combinations;
+  std::string listed;
+  for (std::size_t k = 0; k < fit.direction_texts.size(); ++k)
+    listed += fmt::format("{}({}) {}", k ? "; " : "", k + 1, fit.direction_texts[k]);
+  std::string generic;
+  for (const NamedEstimate& c : fit.combinations)
+    if (c.name.rfind("combination ", 0) == 0)
+      generic += fmt::format(
+          " {} = {} is estimable instead (not one of MODEL.md section 8's).", c.name,
+          describe_combination(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), sol.names));
+  const std::size_t k = fit.directions.size();
+  r.warnings.push_back(
+      fmt::format("{} direction{} of the coefficients cannot be identified from this plan: {}. {}{}", k,
+                  k > 1 ? "s" : "", listed, fit.advice, generic));
 }
 
 }  // namespace
@@ -195,6 +290,10 @@ bool CalibrationOptions::IsValid(std::string* error) const {
   }
   if (!(min_std_err_deg_h > 0.0)) {
     if (error) *error = "min_std_err_deg_h must be positive";
+    return false;
+  }
+  if (!(min_regressor_level >= 0.0 && min_regressor_level < 1.0)) {
+    if (error) *error = "min_regressor_level must be in [0, 1)";
     return false;
   }
   if (!(max_uncertainty_ratio > 1.0)) {
@@ -256,7 +355,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   if (options.method == Method::kClosedForm) {
     closed_form_identify(reduction, channels, model, options, r);
   } else {
-    least_squares_identify(reduction, channels, options, r);
+    least_squares_identify(reduction, channels, model, options, r);
     // The closed form's second expressions are a useful cross-check whenever the plan holds the 16 positions.
     if (!sixteen_positions(reduction.positions).empty()) {
       CalibrationResult cf;
@@ -277,8 +376,13 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
 }
 
 std::string CalibrationResult::BriefReport() const {
-  return fmt::format("{} with compensation {}: Ar = {:.4f} g, rank {}/10, condition {:.3g}, {} warning{}",
-                     to_string(method), to_string(compensation), g_level, rank, condition_number,
+  const std::string amplified =
+      method == Method::kClosedForm && uncertainty_amplification > 0
+          ? fmt::format(" (std up to {:.3g} x least squares' from the same positions)",
+                        uncertainty_amplification)
+          : std::string();
+  return fmt::format("{} with compensation {}: Ar = {:.4f} g, rank {}/10, condition {:.3g}{}, {} warning{}",
+                     to_string(method), to_string(compensation), g_level, rank, condition_number, amplified,
                      warnings.size(), warnings.size() == 1 ? "" : "s");
 }
 

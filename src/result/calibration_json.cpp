@@ -56,6 +56,8 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
   j["warnings"] = r.warnings;
   j["rank"] = r.rank;
   j["condition_number"] = number_or_null(r.condition_number);
+  if (r.method == Method::kClosedForm)
+    j["uncertainty_amplification"] = number_or_null(r.uncertainty_amplification);
   j["chi2"] = number_or_null(r.chi2);
   j["dof"] = r.dof;
   j["unidentifiable"] = r.unidentifiable;

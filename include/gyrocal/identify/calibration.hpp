@@ -32,6 +32,10 @@ struct CalibrationOptions {
   /// directions, in equilibrated coordinates, is at most this. Default 1e-4: exact regressors tilt the
   /// unidentifiable direction of a single-speed plan by ~1e-6 off MODEL.md's, onto every coefficient.
   double estimable_tolerance = 1e-4;
+  /// A coefficient whose regressor stays below this fraction of the specific force (to the regressor's
+  /// power) at every position is not excited by the plan and never identifiable. Default 1e-3
+  /// (identify/identifiability.hpp).
+  double min_regressor_level = 1e-3;
 
   bool IsValid(std::string* error) const;
 };
@@ -65,7 +69,12 @@ struct CalibrationResult {
   std::vector<double> residuals_deg_h;      ///< per position: W - model at the estimate (least squares)
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
+  /// Least squares: of its whitened, equilibrated design. Closed form: the same for its 16 positions.
   double condition_number = 0.0;
+  /// Closed form only: the largest ratio of a closed form's standard uncertainty to the least-squares one
+  /// of the same quantity from the same 16 positions and covariance (>= 1; 1 = no uncertainty given away).
+  /// 0 when not computed.
+  double uncertainty_amplification = 0.0;
   double chi2 = 0.0;
   int dof = 0;
   std::vector<std::string> warnings;

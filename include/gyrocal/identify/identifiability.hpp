@@ -1,0 +1,58 @@
+#pragma once
+// What a plan identifies of the ten drift coefficients (MODEL.md sections 8 and 9), derived from the design
+// actually run: the coefficients whose regressor the plan never excites, every unidentifiable direction in a
+// canonical form, the estimable combinations (MODEL.md section 8's names only where the estimable one IS the
+// named one) and which kind of extra data would identify the rest. docs/calibration.md, "Identifiability".
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/least_squares.hpp"
+#include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+
+namespace gyrocal {
+
+/// The least-squares solution of the ten coefficients with what the plan cannot give.
+struct CoefficientFit {
+  /// In the ten coordinates dF..dOS: a coefficient whose regressor the plan does not excite is left out of
+  /// the solve and enters here as its own unidentifiable direction (estimate 0, std inf).
+  LeastSquaresSolution solution;
+  std::vector<bool> excited;                 ///< per coefficient: its regressor is not zero everywhere
+  std::vector<Eigen::VectorXd> directions;   ///< unidentifiable directions, canonical form (parameter units)
+  std::vector<std::string> direction_texts;  ///< each direction written out, with why it is unidentifiable
+  std::vector<NamedEstimate> combinations;   ///< estimable combinations of the unidentifiable coefficients
+  std::string advice;                        ///< which extra data would identify the directions
+};
+
+/// Options of fit_coefficients().
+struct IdentifiabilityOptions {
+  LeastSquaresOptions least_squares;
+  /// A coefficient is not excited when its regressor stays below this fraction of the specific force's
+  /// magnitude (to its power: |f| for a_I, |f|^2 for a_I^2 or a_I*a_O) at every position. Default 1e-3:
+  /// a machine misalignment of up to ~200 arcsec puts less than this along an axis that sees no specific
+  /// force, and what such a column "measures" is the misalignment, not the gyro.
+  double min_regressor_level = 1e-3;
+  /// A named combination is reported under its name when its part along the unidentifiable directions is
+  /// at most this fraction (equilibrated coordinates). Default 1e-4.
+  double named_tolerance = 1e-4;
+};
+
+/// regressors: m x 10, the unwhitened regressors of each position (g units); whitened_design and
+/// whitened_observations: the same rows whitened by the positions' covariance. ar: the radial level of
+/// the first spinning rate (g), for MODEL.md section 8's named combinations. positions and model: the plan
+/// actually run, for the advice.
+CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::MatrixXd& whitened_design,
+                                const Eigen::VectorXd& whitened_observations, double ar,
+                                const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
+                                const IdentifiabilityOptions& options);
+
+/// Rows brought to reduced row echelon form with pivots taken in `order` (column indices); each pivot is 1.
+/// A column whose largest remaining entry is at most `tolerance` times the largest entry of `rows` gives no
+/// pivot. Returns the non-zero rows.
+Eigen::MatrixXd reduced_row_echelon(Eigen::MatrixXd rows, const std::vector<Eigen::Index>& order,
+                                    double tolerance);
+
+}  // namespace gyrocal
