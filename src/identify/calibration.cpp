@@ -1,6 +1,8 @@
 #include "gyrocal/identify/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <fmt/format.h>
@@ -49,6 +51,65 @@ Eigen::MatrixXd position_covariance(const Reduction& r, double floor) {
   return c;
 }
 
+/// The factor that turns sqrt(g' C g) - the standard uncertainty of a linear function g'y of the reduced
+/// positions - into the standard deviation of its error when C's levels are themselves measured: each dwell's
+/// from a scatter with DwellValues::dof degrees of freedom. The Welch-Satterthwaite degrees of freedom of
+/// g'Cg, nu = (sum_d v_d)^2 / sum_d (v_d^2 / nu_d) with v_d dwell d's share of it, make the error over its
+/// standard uncertainty a Student t, whose standard deviation is sqrt(nu / (nu - 2)) (docs/calibration.md,
+/// "Degrees of freedom"). nu below 3 is taken as 3 (a factor of 1.73) and warned about by the caller. 1 for a
+/// known covariance (a prediction).
+double student_factor(const Reduction& r, const Eigen::MatrixXd& c, const Eigen::VectorXd& g, double* nu) {
+  std::vector<double> share(r.dwells.size(), 0.0);
+  for (std::size_t i = 0; i < r.positions.size(); ++i)
+    for (std::size_t j = 0; j < r.positions.size(); ++j)
+      if (r.positions[i].dwell == r.positions[j].dwell)
+        share[static_cast<std::size_t>(r.positions[i].dwell)] +=
+            g[static_cast<Eigen::Index>(i)] * c(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) *
+            g[static_cast<Eigen::Index>(j)];
+  double total = 0.0, spread = 0.0;
+  for (std::size_t d = 0; d < share.size(); ++d) {
+    total += share[d];
+    const double dof = r.dwells[d].gyro.dof;
+    if (std::isfinite(dof) && dof > 0.0) spread += share[d] * share[d] / dof;
+  }
+  *nu = std::numeric_limits<double>::infinity();
+  if (!(spread > 0.0) || !(total > 0.0)) return 1.0;
+  *nu = total * total / spread;
+  const double n = std::max(*nu, 3.0);
+  return std::sqrt(n / (n - 2.0));
+}
+
+/// A warning when an uncertainty rests on fewer than 3 degrees of freedom (its widening is then capped).
+void warn_few_dof(double nu, const std::string& name, CalibrationResult& r) {
+  if (nu < 3.0)
+    r.warnings.push_back(fmt::format(
+        "the standard uncertainty of {} rests on only {:.1f} degrees of freedom of the scatter between "
+        "revolutions; it is widened as for 3 and is itself uncertain: add revolutions.",
+        name, nu));
+}
+
+/// position_covariance() with every measured dwell's level replaced by the record's: the dwells' levels
+/// (DwellValues::level) averaged with their degrees of freedom as weights. Dwells whose covariance is not
+/// measured (a prediction) keep theirs.
+Eigen::MatrixXd pooled_position_covariance(const Reduction& r, double floor) {
+  double sum = 0.0, dof = 0.0;
+  for (const Dwell& d : r.dwells)
+    if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0 && std::isfinite(d.gyro.level)) {
+      sum += d.gyro.dof * d.gyro.level;
+      dof += d.gyro.dof;
+    }
+  Reduction pooled;
+  pooled.positions = r.positions;
+  pooled.dwells = r.dwells;
+  if (dof > 0.0 && sum > 0.0) {
+    for (Dwell& d : pooled.dwells)
+      if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0 && d.gyro.level > 0.0) {
+        d.gyro.covariance *= (sum / dof) / d.gyro.level;
+      }
+  }
+  return position_covariance(pooled, floor);
+}
+
 void closed_form_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                           const CentrifugeModel& model, const CalibrationOptions& options,
                           CalibrationResult& r) {
@@ -74,19 +135,28 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   const double omega_n = we * std::cos(site.latitude_rad) * std::cos(model.geometry().heading_rad);
   const double omega_u = we * std::sin(site.latitude_rad);
   const ClosedForms cf = closed_forms(r.g_level, omega_n, omega_u);
+  // The standard uncertainty widened for the degrees of freedom of the positions' measured covariance.
+  const auto std_of = [&](const LinearForm& f) {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(all.rows());
+    for (std::size_t k = 0; k < 16; ++k) g[k16[k]] = f.weights[k];
+    double nu = 0.0;
+    const double factor = student_factor(reduction, all, g, &nu);
+    warn_few_dof(nu, f.name, r);
+    return f.std(se) * factor;
+  };
   for (const LinearForm& f : cf.primary) {
     for (std::size_t c = 0; c < kNumCoefficients; ++c)
-      if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), f.std(se), true};
+      if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), std_of(f), true};
   }
   for (const LinearForm& f : cf.alternatives)
-    r.alternatives.push_back({f.name, f.unit, f.value(w), f.std(se), {}});
+    r.alternatives.push_back({f.name, f.unit, f.value(w), std_of(f), {}});
   const double ar2 = r.g_level * r.g_level;
   const std::map<std::string, std::vector<double>> combination_coefficients = {
       {"dII-dSS", {0, 0, 0, 0, 1, 0, -1, 0, 0, 0}},
       {"dOO-dSS", {0, 0, 0, 0, 0, 1, -1, 0, 0, 0}},
       {"dF+(1+Ar^2)dSS", {1, 0, 0, 0, 0, 0, 1 + ar2, 0, 0, 0}}};
   for (const LinearForm& f : cf.combinations)
-    r.combinations.push_back({f.name, f.unit, f.value(w), f.std(se), combination_coefficients.at(f.name)});
+    r.combinations.push_back({f.name, f.unit, f.value(w), std_of(f), combination_coefficients.at(f.name)});
   r.unidentifiable.push_back(
       fmt::format("dF, dII, dOO, dSS: adding c to dII, dOO, dSS and -(1+Ar^2) c to dF "
                   "changes no output at one speed (MODEL.md section 8)"));
@@ -227,7 +297,14 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
   }
   check_finite(reduction, design, observations, channels, options.compensation);
-  const Eigen::LLT<Eigen::MatrixXd> llt(position_covariance(reduction, options.min_std_err_deg_h));
+  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
+  // The weights come from the covariance with one level for the whole record (the levels pooled over the
+  // dwells by their degrees of freedom); the uncertainties from each dwell's own level (a sandwich). A few
+  // revolutions measure a dwell's level poorly, and weights that follow those errors favour the dwells whose
+  // noise was underestimated: z-scores of 1.2..1.4 at 3..6 revolutions (docs/calibration.md, "Degrees of
+  // freedom").
+  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
   if (llt.info() != Eigen::Success) refuse_covariance(reduction);
   IdentifiabilityOptions io;
   io.least_squares = options.least_squares;
@@ -237,17 +314,30 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
       std::max(io.least_squares.estimable_tolerance, options.estimable_tolerance);
   io.min_regressor_level = options.min_regressor_level;
   io.named_tolerance = options.estimable_tolerance;
-  const CoefficientFit fit =
-      fit_coefficients(design, llt.matrixL().solve(design), llt.matrixL().solve(observations), r.g_level,
-                       reduction.positions, model, io);
+  const Eigen::MatrixXd whitened_design = llt.matrixL().solve(design);
+  const CoefficientFit fit = fit_coefficients(design, whitened_design, llt.matrixL().solve(observations),
+                                              r.g_level, reduction.positions, model, io);
   const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
   r.condition_number = sol.effective_condition_number;
   r.chi2 = sol.chi2;
   r.dof = sol.dof;
+  // The estimate is G y with G = cov X~' L^-1 (X~ = L^-1 X, whitened): a combination c'x is the linear
+  // function (G'c)'y of the positions, whose standard uncertainty is widened for the degrees of freedom of
+  // their measured covariance.
+  const Eigen::MatrixXd gain =
+      sol.covariance * whitened_design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
+  const auto sandwich_std = [&](const Eigen::VectorXd& c, const std::string& name) {
+    const Eigen::VectorXd g = gain.transpose() * c;
+    double nu = 0.0;
+    const double factor = student_factor(reduction, covariance, g, &nu);
+    warn_few_dof(nu, name, r);
+    return std::sqrt(g.dot(covariance * g)) * factor;
+  };
   for (std::size_t c = 0; c < kNumCoefficients; ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
-    if (sol.identifiable[c]) r.coefficients[c] = {sol.estimate[ci], sol.std[ci], true};
+    if (sol.identifiable[c])
+      r.coefficients[c] = {sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true};
   }
   // Residuals in deg/h, not in whitened units.
   const Eigen::VectorXd residuals = observations - design * sol.estimate;
@@ -261,6 +351,9 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   if (fit.directions.empty()) return;
   r.unidentifiable = fit.direction_texts;
   r.combinations = fit.combinations;
+  // Each combination's uncertainty, like the coefficients', from each dwell's own level (the sandwich).
+  for (NamedEstimate& c : r.combinations)
+    c.std = sandwich_std(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), c.name);
   std::string listed;
   for (std::size_t k = 0; k < fit.direction_texts.size(); ++k)
     listed += fmt::format("{}({}) {}", k ? "; " : "", k + 1, fit.direction_texts[k]);
@@ -350,6 +443,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   r.compensation = options.compensation;
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
+  r.data_quality = {reduction.samples_read, reduction.samples_used, reduction.outliers, reduction.gaps};
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   if (options.method == Method::kClosedForm) {

@@ -1,5 +1,6 @@
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -17,6 +18,20 @@ double wrap(double a) {
   return std::remainder(a, 2.0 * kPi);
 }
 
+/// The median of v (the upper one for an even count); reorders v.
+double median(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// 1 / Phi^-1(3/4): the median absolute deviation of normal noise times this is its standard deviation.
+constexpr double kMadToSigma = 1.482602218505602;
+
+/// A block never holds more samples than this (a revolution of more samples is tested in parts): it bounds
+/// the memory of the outlier rule to a few MB whatever the plan.
+constexpr std::size_t kMaxBlockSamples = std::size_t{1} << 15;
+
 }  // namespace
 
 bool ReduceOptions::IsValid(std::string* error) const {
@@ -33,6 +48,10 @@ bool ReduceOptions::IsValid(std::string* error) const {
   if (model_samples_per_revolution < 0 ||
       (model_samples_per_revolution > 0 && model_samples_per_revolution < 16))
     return fail("model_samples_per_revolution must be 0 (every sample) or at least 16");
+  if (!(outlier_threshold == 0.0 || (outlier_threshold >= 3.0 && outlier_threshold <= 1e6)))
+    return fail("outlier_threshold must be 0 (no rejection) or between 3 and 1e6 robust standard deviations");
+  if (outlier_block_samples < 16 || outlier_block_samples > 4096)
+    return fail("outlier_block_samples must be between 16 and 4096");
   return true;
 }
 
@@ -45,6 +64,12 @@ DwellAccumulator::DwellAccumulator(const ReduceOptions& options, std::vector<dou
       duration_s_(planned_duration_s),
       with_std_err_(with_std_err),
       trend_() {
+  robust_ = with_std_err_ && columns_ == 1 && options_.outlier_threshold > 0.0;
+  if (robust_) {
+    const int nd = detection_size();
+    ref_normal_ = Eigen::MatrixXd::Zero(nd, nd);
+    ref_rhs_ = Eigen::VectorXd::Zero(nd);
+  }
   const int n = basis_size();
   const auto ng = static_cast<Eigen::Index>(gammas_.size());
   if (static_) {
@@ -82,13 +107,166 @@ void DwellAccumulator::basis(double gamma_rad, double t_scaled, double* out) con
   if (options_.linear_drift) out[2 * options_.harmonic_order + 1] = t_scaled;
 }
 
+int DwellAccumulator::detection_size() const {
+  return static_ ? 2 : 2 * options_.harmonic_order + 2;
+}
+
+// The outlier rule's fit: harmonics and a linear drift (a static hold: mean and drift), whatever the
+// reduction.
+void DwellAccumulator::detection_basis(double gamma_rad, double t_scaled, double* out) const {
+  if (static_) {
+    out[0] = 1.0;
+    out[1] = t_scaled;
+    return;
+  }
+  const double c1 = std::cos(gamma_rad), s1 = std::sin(gamma_rad);
+  out[0] = 1.0;
+  double c = 1.0, s = 0.0;
+  for (int k = 1; k <= options_.harmonic_order; ++k) {
+    const double cn = c * c1 - s * s1;
+    s = s * c1 + c * s1;
+    c = cn;
+    out[2 * k - 1] = c;
+    out[2 * k] = s;
+  }
+  out[2 * options_.harmonic_order + 1] = t_scaled;
+}
+
 void DwellAccumulator::add(double t, double gamma, const double* values) {
   if (samples_ == 0) {
     t_first_ = t;
     gamma_first_ = gamma;
   }
   t_last_ = t;
+  gamma_last_ = gamma;
   ++samples_;
+  if (!static_) seen_revolution_ = static_cast<int>(std::floor(std::abs(gamma - gamma_first_) / (2.0 * kPi)));
+  if (!robust_) {
+    accumulate(t, gamma, values);
+    return;
+  }
+  // A block closes where a revolution begins (a static hold: anywhere) once it holds enough samples.
+  const std::size_t block = static_cast<std::size_t>(options_.outlier_block_samples);
+  const bool boundary = static_ || seen_revolution_ != block_revolution_;
+  if ((boundary && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples) test_block();
+  block_revolution_ = seen_revolution_;
+  pending_.push_back({t, gamma, values[0]});
+}
+
+// MODEL.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
+// outlier_threshold robust standard deviations of the block's residuals it is an outlier, the fit is
+// repeated without the outliers and the test with it, until the outliers do not change. Outliers are
+// replaced by the final fit's value at their instant, so the reduction operator (which samples, which
+// weights) stays the one the model's channels go through (docs/calibration.md, "Spikes").
+void DwellAccumulator::test_block() {
+  const std::size_t n = pending_.size();
+  if (n == 0) return;
+  const int p = detection_size();
+  const auto pp = static_cast<std::size_t>(p);
+  scratch_basis_.resize(n * pp);
+  for (std::size_t i = 0; i < n; ++i)
+    detection_basis(pending_[i].gamma, (pending_[i].t - t_first_) / duration_s_ - 0.5,
+                    &scratch_basis_[i * pp]);
+  const auto basis_of = [&](std::size_t i) { return &scratch_basis_[i * pp]; };
+  const auto fit_at = [&](std::size_t i, const Eigen::VectorXd& x) {
+    const double* b = basis_of(i);
+    double v = 0.0;
+    for (int k = 0; k < p; ++k) v += b[k] * x[k];
+    return v;
+  };
+
+  std::vector<char> out(n, 0);
+  std::vector<double> work;
+  work.reserve(n);
+  // Residuals below a part in 1e9 of the output are rounding, never outliers (a noise-free record).
+  for (const Pending& s : pending_) work.push_back(std::abs(s.value));
+  const double floor = 1e-9 * (1.0 + median(work));
+  // A first screen on the raw values: a sample a thousand times further from the block's median than their
+  // robust spread (which holds the whole signal) cannot enter the first fit: it would swamp it, and a value
+  // near the largest double would overflow its sums. The iteration below judges these samples again.
+  work.clear();
+  for (const Pending& s : pending_) work.push_back(s.value);
+  const double raw_median = median(work);
+  for (double& w : work) w = std::abs(w - raw_median);
+  const double raw_scale = std::max(kMadToSigma * median(work), floor);
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::abs(pending_[i].value - raw_median) > 1e3 * raw_scale) out[i] = 1;
+
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(p);
+  std::vector<double> residual(n);
+  double scale = 0.0;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    Eigen::MatrixXd normal = ref_normal_;
+    Eigen::VectorXd rhs = ref_rhs_;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (out[i]) continue;
+      const double* b = basis_of(i);
+      for (int j = 0; j < p; ++j) {
+        for (int k = j; k < p; ++k) normal(k, j) += b[k] * b[j];
+        rhs[j] += b[j] * pending_[i].value;
+      }
+    }
+    const Eigen::MatrixXd full = normal.selfadjointView<Eigen::Lower>();
+    x = full.ldlt().solve(rhs);
+    work.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      residual[i] = pending_[i].value - fit_at(i, x);
+      if (!out[i]) work.push_back(residual[i]);
+    }
+    if (work.empty() || !x.allFinite()) break;
+    const double center = median(work);
+    work.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!out[i]) work.push_back(std::abs(residual[i] - center));
+    scale = std::max(kMadToSigma * median(work), floor);
+    // A short block (the dwell's last) estimates its spread from few samples: the previous block's holds too.
+    if (n < static_cast<std::size_t>(options_.outlier_block_samples)) scale = std::max(scale, last_scale_);
+    bool changed = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const char o = std::abs(residual[i] - center) > options_.outlier_threshold * scale ? 1 : 0;
+      changed = changed || o != out[i];
+      out[i] = o;
+    }
+    if (!changed) break;
+  }
+  if (!x.allFinite()) x.setZero();
+  last_scale_ = scale;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Pending& s = pending_[i];
+    const double v = out[i] ? fit_at(i, x) : s.value;
+    if (out[i]) ++outliers_;
+    const double* b = basis_of(i);
+    for (int j = 0; j < p; ++j) {
+      for (int k = j; k < p; ++k) ref_normal_(k, j) += b[k] * b[j];
+      ref_rhs_[j] += b[j] * v;
+    }
+    accumulate(s.t, s.gamma, &v);
+  }
+  pending_.clear();
+}
+
+void DwellAccumulator::flush() {
+  if (finished_) return;
+  finished_ = true;
+  if (robust_) test_block();
+  // The last revolution counts in the scatter as every other one does: every sample that moves the estimate
+  // must be able to raise its uncertainty. It is complete when the dwell's last sample is within 1.5 sample
+  // steps of a whole turn.
+  if (with_std_err_ && !static_ && last_revolution_complete()) close_revolution();
+}
+
+bool DwellAccumulator::last_revolution_complete() const {
+  if (static_ || samples_ < 2) return false;
+  const double span = std::abs(gamma_last_ - gamma_first_);
+  const double step = span / static_cast<double>(samples_ - 1);
+  return span - seen_revolution_ * 2.0 * kPi >= 2.0 * kPi - 1.5 * step;
+}
+
+int DwellAccumulator::complete_revolutions() const {
+  return seen_revolution_ + (last_revolution_complete() ? 1 : 0);
+}
+
+void DwellAccumulator::accumulate(double t, double gamma, const double* values) {
   // Time scaled to about [-0.5, 0.5] over the planned dwell, for a well-conditioned drift column.
   const double ts = (t - t_first_) / duration_s_ - 0.5;
 
@@ -227,7 +405,8 @@ Eigen::MatrixXd DwellAccumulator::RevolutionSums::covariance_at(double t_mid, bo
   return 0.5 * (c + c.transpose());
 }
 
-DwellValues DwellAccumulator::finish(int column) const {
+DwellValues DwellAccumulator::finish(int column) {
+  flush();
   DwellValues out;
   const std::size_t ng = gammas_.size();
   out.value.assign(ng, kNaN);
@@ -243,10 +422,18 @@ DwellValues DwellAccumulator::finish(int column) const {
   const auto set_covariance = [&](const RevolutionSums& sums, bool drift) {
     const Eigen::MatrixXd measured = sums.covariance_at(t_mid, drift);
     out.revolutions = static_cast<int>(sums.n);
+    out.dof = 0.0;
     if (measured.size() == 0 || !measured.allFinite()) return;
     const Eigen::MatrixXd shape = white_noise_covariance();
+    // Degrees of freedom: the revolutions' scatter about a line (or their mean), pooled over the gammas,
+    // whose values are correlated as the shape says: a mean of ng scaled chi-squares with correlations
+    // rho has ng^2 / sum(rho^2) times their degrees of freedom (docs/calibration.md).
+    const Eigen::VectorXd sd = shape.diagonal().cwiseSqrt();
+    const double rho2 = (shape.array() / (sd * sd.transpose()).array()).square().sum();
+    out.dof = (sums.n - (drift ? 2.0 : 1.0)) * static_cast<double>(ng * ng) / rho2;
     const double level = (measured.diagonal().array() / shape.diagonal().array()).mean();
     out.covariance = level * shape;
+    out.level = level;
     for (std::size_t k = 0; k < ng; ++k) {
       const auto kk = static_cast<Eigen::Index>(k);
       out.std_err[k] = std::sqrt(out.covariance(kk, kk));
@@ -256,6 +443,7 @@ DwellValues DwellAccumulator::finish(int column) const {
   if (static_) {
     out.value[0] = static_sum_[column] / static_cast<double>(samples_);
     out.samples[0] = samples_;
+    out.outliers = outliers_;
     if (with_std_err_ && column == 0) {
       RevolutionSums b = batches_;
       if (batch_n_ > 0) b.add(0.0, Eigen::VectorXd::Constant(1, batch_sum_ / static_cast<double>(batch_n_)));
@@ -294,6 +482,7 @@ DwellValues DwellAccumulator::finish(int column) const {
     }
   }
   if (with_std_err_ && column == 0) set_covariance(trend_, options_.linear_drift);
+  out.outliers = outliers_;
   return out;
 }
 

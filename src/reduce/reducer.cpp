@@ -54,6 +54,8 @@ struct Run {
   LineSums theta, psi;
   double beta_sum = 0.0;
   std::size_t n = 0;
+  double t_prev = 0.0;   // the previous measured sample
+  std::size_t gaps = 0;  // intervals between measured samples longer than 1.5 planned sample intervals
 };
 
 }  // namespace
@@ -118,6 +120,8 @@ struct Reducer::State {
     r.theta.add(tt, theta_u - r.theta_first_deg - planned_turn_deg);
     r.psi.add(tt, psi_u - r.psi_first_deg + planned_turn_deg);
     r.beta_sum += s.position_angle_deg;
+    if (r.n > 0 && (s.time_s - r.t_prev) * plan.sample_rate_hz > 1.5) ++r.gaps;
+    r.t_prev = s.time_s;
     ++r.n;
     const double gamma = -psi_u * kDegToRad;
     r.acc->add(s.time_s, gamma, &s.gyro_deg_h);
@@ -142,6 +146,7 @@ struct Reducer::State {
     d.first_time_s = r.acc->first_time_s();
     d.last_time_s = r.acc->last_time_s();
     d.samples = r.n;
+    d.gaps = r.gaps;
     d.sample_interval_s = (d.last_time_s - d.first_time_s) / static_cast<double>(r.n - 1);
     d.planned_duration_s = r.planned_duration;
     double a, b, rms;
@@ -178,6 +183,15 @@ struct Reducer::State {
       d.gammas_rad = plan.gamma_rad;
     }
     d.gyro = r.acc->finish(0);
+    // MODEL.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate at
+    // which clean noise reaches the rule's threshold).
+    if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
+      warnings.push_back(fmt::format(
+          "{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} robust standard "
+          "deviations of the dwell's fit) and replaced by the fit.",
+          at(d.first_time_s), what, d.gyro.outliers, d.samples,
+          100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
+          options.outlier_threshold));
     // Checks a test engineer wants to hear about.
     const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
     if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
@@ -296,6 +310,9 @@ Reduction Reducer::finish() {
   for (int i : in_time_order) {
     renumber[i] = static_cast<int>(out.dwells.size());
     out.dwells.push_back(st.dwells[static_cast<std::size_t>(i)]);
+    out.samples_used += out.dwells.back().samples;
+    out.outliers += out.dwells.back().gyro.outliers;
+    out.gaps += out.dwells.back().gaps;
   }
   std::vector<std::string> missing;
   for (const Position& p : test_positions(st.plan)) {
@@ -321,16 +338,21 @@ Reduction Reducer::finish() {
         fmt::format("{}: {} steady segment{} shorter than one revolution (or hold) were "
                     "skipped as transitions.",
                     st.source, st.short_runs, st.short_runs > 1 ? "s" : ""));
-  int without = 0, zero = 0;
-  for (const ReducedPosition& p : out.positions) {
-    if (std::isnan(p.std_err_deg_h)) ++without;
-    if (p.std_err_deg_h == 0.0) ++zero;
+  // A standard error is the scatter between revolutions (or batches) about a line: without a degree of
+  // freedom left there is no measurement of the noise, and no number may stand in for one
+  // (docs/calibration.md, "Degrees of freedom").
+  int zero = 0;
+  for (const Dwell& d : out.dwells) {
+    if (d.gyro.dof > 0.0) continue;
+    const int needed = d.is_static ? 2 : (st.options.linear_drift ? 3 : 2);
+    throw Error(fmt::format(
+        "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
+        "error from the scatter between them; it needs at least {} ([test] revolutions = {} or more).",
+        st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
+        d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", needed, needed));
   }
-  if (without > 0)
-    out.warnings.push_back(
-        fmt::format("{}: {} position{} have too few revolutions (or batches) for a standard "
-                    "error; least squares weights them with the smallest standard error.",
-                    st.source, without, without > 1 ? "s" : ""));
+  for (const ReducedPosition& p : out.positions)
+    if (p.std_err_deg_h == 0.0) ++zero;
   if (zero > 0)
     out.warnings.push_back(
         fmt::format("{}: {} position{} show no scatter at all between revolutions: a "
@@ -352,6 +374,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.mean_deg_h = d.gyro.value[k];
   rp.std_err_deg_h = d.gyro.std_err[k];
   rp.samples = d.gyro.samples[k];
+  rp.outliers = d.gyro.outliers;
   rp.dwell = dwell_index;
   rp.gamma_slot = slot;
   return rp;

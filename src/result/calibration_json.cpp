@@ -46,7 +46,8 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
                         {"rate_rad_s", p.rate_rad_s},
                         {"mean_deg_h", p.mean_deg_h},
                         {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
-                        {"samples", p.samples}};
+                        {"samples", p.samples},
+                        {"outliers", p.outliers}};
     if (i < r.residuals_deg_h.size()) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
     j["positions"].push_back(e);
   }
@@ -60,6 +61,12 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
     j["uncertainty_amplification"] = number_or_null(r.uncertainty_amplification);
   j["chi2"] = number_or_null(r.chi2);
   j["dof"] = r.dof;
+  // A record's (a prediction reads none).
+  if (r.data_quality.rows_read > 0)
+    j["data_quality"] = {{"rows_read", r.data_quality.rows_read},
+                         {"rows_used", r.data_quality.rows_used},
+                         {"outliers", r.data_quality.outliers},
+                         {"gaps", r.data_quality.gaps}};
   j["unidentifiable"] = r.unidentifiable;
   return j;
 }

@@ -58,6 +58,14 @@ struct NamedEstimate {
   std::vector<double> coefficients;
 };
 
+/// What the record held and what entered the estimate (MODEL.md section 14; INTERFACE.md data_quality).
+struct DataQuality {
+  std::size_t rows_read = 0;  ///< rows in the record
+  std::size_t rows_used = 0;  ///< rows inside the measured parts of the dwells that entered the estimate
+  std::size_t outliers = 0;   ///< of those, rejected as outliers (replaced by the dwell's fit)
+  std::size_t gaps = 0;       ///< breaks in the time series inside those dwells
+};
+
 struct CalibrationResult {
   Method method = Method::kLeastSquares;
   Compensation compensation = Compensation::kFull;
@@ -77,6 +85,7 @@ struct CalibrationResult {
   double uncertainty_amplification = 0.0;
   double chi2 = 0.0;
   int dof = 0;
+  DataQuality data_quality;
   std::vector<std::string> warnings;
 
   /// One line: method, compensation, rank, condition, warnings.

@@ -5,6 +5,7 @@
 //   reduce(W) = reduce(omega_I) + sum_j c_j reduce(x_j)
 // holds exactly whatever harmonics the machine's errors add.
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,15 @@ struct ReduceOptions {
   /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
   /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0: every sample.
   int model_samples_per_revolution = 32;
+  /// Spikes (MODEL.md section 14): a sample of the gyro output whose residual about the dwell's fit lies more
+  /// than this many robust standard deviations (1.4826 x the median absolute deviation of the residuals of
+  /// its block) from the block's median residual is an outlier; iterated until the set of outliers is stable.
+  /// It is counted and replaced by the fit's value at its instant (docs/calibration.md, "Spikes"). 0: no
+  /// rejection.
+  double outlier_threshold = 6.0;
+  /// The rule tests whole revolutions (a static hold: runs of samples) in blocks of at least this many
+  /// samples, against the fit of the dwell so far and the block: the memory of one block.
+  int outlier_block_samples = 128;
 
   /// True when every option is in range; otherwise false with a sentence in *error.
   bool IsValid(std::string* error) const;
@@ -47,6 +57,15 @@ struct DwellValues {
   Eigen::MatrixXd covariance;
   std::vector<std::size_t> samples;  ///< per gamma: samples that entered
   int revolutions = 0;               ///< complete revolutions (or batches) the standard error comes from
+  /// Degrees of freedom of the covariance's level: the scatter of `revolutions` values about a line (or
+  /// their mean), pooled over the gammas (docs/calibration.md, "Degrees of freedom"). +inf when the
+  /// covariance is known rather than measured (a prediction); 0 when there is no scatter to measure.
+  double dof = std::numeric_limits<double>::infinity();
+  /// The covariance's level: the white-noise variance per sample, unit^2, that the scatter implies
+  /// (covariance = level x the operator's white-noise covariance). NaN when not measured.
+  double level = std::numeric_limits<double>::quiet_NaN();
+  /// Samples rejected as outliers (ReduceOptions::outlier_threshold) and replaced by the fit's value.
+  std::size_t outliers = 0;
 };
 
 /// Accumulates one dwell's samples (streaming, memory independent of the dwell's length) and reduces them.
@@ -60,11 +79,14 @@ class DwellAccumulator {
                    double planned_duration_s, bool with_std_err);
 
   /// One sample at time t (s) and arm angle gamma (rad, unwrapped: it must progress monotonically while
-  /// spinning), with `columns` values.
+  /// spinning), with `columns` values. With outlier rejection (with_std_err, one column and
+  /// ReduceOptions::outlier_threshold > 0) samples wait in a block of whole revolutions (at least
+  /// outlier_block_samples) until the block is tested; finish() tests the last one.
   void add(double time_s, double gamma_rad, const double* values);
 
-  /// The reduced values of column `column`, evaluated at the dwell's mid-time.
-  DwellValues finish(int column) const;
+  /// The reduced values of column `column`, evaluated at the dwell's mid-time. The first call ends the
+  /// accumulation (it tests the block still waiting and closes the last revolution).
+  DwellValues finish(int column);
 
   /// Per gamma: the variance of the reduced value per unit variance of white noise on each sample,
   /// i.e. sum_i a_i^2 for the operator value = sum_i a_i y_i (b' (Phi' Phi)^-1 b for the harmonic fit).
@@ -77,10 +99,21 @@ class DwellAccumulator {
   std::size_t samples() const { return samples_; }
   double first_time_s() const { return t_first_; }
   double last_time_s() const { return t_last_; }
-  /// Complete revolutions seen (spinning).
-  int complete_revolutions() const { return revolution_; }
+  /// Complete revolutions seen (spinning), the last one counted when the dwell's last sample completes it.
+  int complete_revolutions() const;
+  /// Samples rejected as outliers so far (all of them once finish() was called).
+  std::size_t outliers() const { return outliers_; }
 
  private:
+  struct Pending {
+    double t, gamma, value;
+  };
+  void accumulate(double time_s, double gamma_rad, const double* values);
+  void test_block();
+  void flush();
+  bool last_revolution_complete() const;
+  int detection_size() const;
+  void detection_basis(double gamma_rad, double t_scaled, double* out) const;
   void close_revolution();
   int basis_size() const;
   void basis(double gamma_rad, double t_scaled, double* out) const;
@@ -94,8 +127,22 @@ class DwellAccumulator {
 
   std::size_t samples_ = 0;
   double t_first_ = 0.0, t_last_ = 0.0;
-  double gamma_first_ = 0.0;
-  int revolution_ = 0;
+  double gamma_first_ = 0.0, gamma_last_ = 0.0;
+  int revolution_ = 0;  // of the samples accumulated
+  bool finished_ = false;
+
+  // Outlier rejection (MODEL.md section 14): the block waiting to be tested, and the normal equations of the
+  // dwell's fit (harmonics and drift; a static hold: mean and drift) on every sample accumulated so far, with
+  // outliers replaced by the fit.
+  bool robust_ = false;
+  std::vector<Pending> pending_;
+  int seen_revolution_ = 0;  // of the samples added
+  int block_revolution_ = 0;
+  Eigen::MatrixXd ref_normal_;
+  Eigen::VectorXd ref_rhs_;
+  double last_scale_ = 0.0;
+  std::size_t outliers_ = 0;
+  std::vector<double> scratch_basis_;  // the block's detection basis, sample by sample
 
   // Harmonic fit over the whole dwell: normal equations of the (well-conditioned) harmonic basis.
   Eigen::MatrixXd normal_;  // basis x basis

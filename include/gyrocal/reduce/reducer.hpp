@@ -32,11 +32,12 @@ struct Dwell {
   std::vector<int> position_index;  ///< per gamma: the plan's position index (1-based, plan/positions.hpp)
   double first_time_s = 0.0, last_time_s = 0.0;  ///< the measured part (after the settle interval)
   std::size_t samples = 0;                       ///< samples in the measured part
-  double sample_interval_s = 0.0;                ///< mean interval between samples
-  AngleLine main;                                ///< theta(t), from the main-axis encoder
-  AngleLine counter;                             ///< psi_r(t), from the counter-platform encoder
-  double planned_duration_s = 0.0;               ///< what the plan asked for the measured part
-  DwellValues gyro;                              ///< the reduced gyro output, deg/h, per gamma
+  std::size_t gaps = 0;  ///< breaks in the measured part: intervals longer than 1.5 planned sample intervals
+  double sample_interval_s = 0.0;   ///< mean interval between samples
+  AngleLine main;                   ///< theta(t), from the main-axis encoder
+  AngleLine counter;                ///< psi_r(t), from the counter-platform encoder
+  double planned_duration_s = 0.0;  ///< what the plan asked for the measured part
+  DwellValues gyro;                 ///< the reduced gyro output, deg/h, per gamma
 
   /// theta, psi_r, beta and rates at the i-th of `samples` evenly spaced instants of the measured part: the
   /// grid on which the model's channels are evaluated and reduced like the gyro output.
@@ -54,6 +55,8 @@ struct ReducedPosition {
   double mean_deg_h = 0.0;  ///< reduced gyro output
   double std_err_deg_h = 0.0;
   std::size_t samples = 0;
+  /// Outliers rejected in the dwell this position is reduced from (one fit reduces all its gammas).
+  std::size_t outliers = 0;
   int dwell = 0;       ///< index into Reduction::dwells
   int gamma_slot = 0;  ///< index into that dwell's gammas
 };
@@ -66,7 +69,10 @@ struct Reduction {
   std::vector<Dwell> dwells;
   std::vector<ReducedPosition> positions;  ///< every position of the plan, in order
   std::vector<std::string> warnings;
-  std::size_t samples_read = 0;
+  std::size_t samples_read = 0;  ///< rows of the record
+  std::size_t samples_used = 0;  ///< rows in the measured parts of the dwells used
+  std::size_t outliers = 0;      ///< of those, rejected as outliers (and replaced by the dwell's fit)
+  std::size_t gaps = 0;          ///< breaks in the time series inside the dwells used (Dwell::gaps)
 };
 
 /// Streaming reducer: push every sample of a record in order, then finish(). Memory is independent of the

@@ -1,0 +1,300 @@
+// Reduction of a record that is not clean (MODEL.md section 14): spikes anywhere in the record, and too few
+// revolutions for the scatter between them to be a measurement.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace gyrocal {
+namespace {
+
+bool sanitized() {
+  return std::getenv("GYROCAL_SANITIZED") != nullptr;
+}
+
+/// A small default-like test: the default scenario at 50 Hz (32 samples per revolution), 20 revolutions.
+Scenario small_test(int revolutions = 20) {
+  Scenario s = default_scenario();
+  s.test.sample_rate_hz = 50.0;
+  s.test.revolutions = revolutions;
+  return s;
+}
+
+std::vector<RecordSample> record_of(const Scenario& s, std::uint64_t seed) {
+  std::vector<RecordSample> rows;
+  SimulationOptions so;
+  so.seed = seed;
+  simulate(s, so, [&](const RecordSample& x) { rows.push_back(x); });
+  return rows;
+}
+
+struct Calibrated {
+  Reduction reduction;
+  CalibrationResult result;
+};
+
+Calibrated calibrate_rows(const Scenario& s, const std::vector<RecordSample>& rows,
+                          const ReduceOptions& ro = {}, Method method = Method::kLeastSquares) {
+  Reducer reducer(s.test, ro, "spiked.csv", s.centrifuge.rate_rad_s);
+  for (const RecordSample& x : rows) reducer.push(x);
+  Calibrated c;
+  c.reduction = reducer.finish();
+  CalibrationOptions o;
+  o.method = method;
+  o.reduce = ro;
+  c.result = identify(c.reduction, reduce_model_channels(c.reduction, s.model(), ro), s.model(), o);
+  return c;
+}
+
+/// The index of the first row at or after time t.
+std::size_t row_at(const std::vector<RecordSample>& rows, double t) {
+  std::size_t i = 0;
+  while (i < rows.size() && rows[i].time_s < t) ++i;
+  return i;
+}
+
+/// Where a spike goes, from the timeline the simulation follows (plan/timeline.hpp): inside the second dwell,
+/// in its last revolution (which the scatter between revolutions did not see), in the settle time before it,
+/// and in the platform move that leads to it.
+std::map<std::string, double> spike_times(const Scenario& s) {
+  const Timeline tl = make_timeline(s.test, s.model());
+  const MeasurementInterval& m = tl.measurements.at(1);
+  const double revolution = 2 * kPi / 9.9;
+  return {{"in a dwell", 0.5 * (m.start_s + m.end_s)},
+          {"in a dwell's last revolution", m.end_s - 0.3 * revolution},
+          {"in the settle time", m.start_s - 0.5 * s.test.settle_s},
+          {"in a platform move", m.start_s - s.test.settle_s - 2.0}};
+}
+
+TEST(Spikes, OneSampleNeverMovesAnEstimateAndIsCounted) {
+  // One sample of +1e6 deg/h (and one of 1e200) anywhere: the estimates stay where the clean record puts them
+  // (within a tenth of their uncertainty), so within their uncertainty of the truth; the uncertainties do not
+  // change; chi2 stays finite; a spike inside a dwell is counted as its one outlier, one outside none.
+  const Scenario s = small_test();
+  const std::vector<RecordSample> clean = record_of(s, 3);
+  const Calibrated ref = calibrate_rows(s, clean);
+  EXPECT_EQ(ref.reduction.outliers, 0u);
+  ASSERT_TRUE(std::isfinite(ref.result.chi2));
+  for (const auto& [where, t] : spike_times(s)) {
+    for (double spike : {1e6, 1e200}) {
+      std::vector<RecordSample> rows = clean;
+      rows[row_at(rows, t)].gyro_deg_h = spike;
+      const Calibrated c = calibrate_rows(s, rows);
+      const std::string tag = where + ", " + std::to_string(spike);
+      const bool inside = where.rfind("in a dwell", 0) == 0;
+      EXPECT_EQ(c.reduction.outliers, inside ? 1u : 0u) << tag;
+      std::size_t counted = 0;
+      for (const ReducedPosition& p : c.reduction.positions) counted += p.outliers;
+      EXPECT_EQ(counted, inside ? 4u : 0u) << tag;  // the dwell's 4 positions share its one outlier
+      const nlohmann::json quality = calibration_to_json(c.result).at("data_quality");
+      EXPECT_EQ(quality.at("outliers").get<std::size_t>(), inside ? 1u : 0u) << tag;
+      EXPECT_EQ(quality.at("rows_read").get<std::size_t>(), rows.size()) << tag;
+      EXPECT_EQ(quality.at("gaps").get<std::size_t>(), 0u) << tag;
+      EXPECT_TRUE(std::isfinite(c.result.chi2)) << tag;
+      EXPECT_LT(c.result.chi2, 5.0 * (c.result.dof + 3.0 * std::sqrt(2.0 * c.result.dof))) << tag;
+      for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+        const CoefficientEstimate& e = c.result.coefficients[k];
+        const CoefficientEstimate& e0 = ref.result.coefficients[k];
+        ASSERT_EQ(e.identifiable, e0.identifiable) << tag;
+        if (!e.identifiable) continue;
+        const std::string name = tag + " " + std::string(kCoefficientNames[k]);
+        ASSERT_TRUE(std::isfinite(e.value) && std::isfinite(e.std)) << name;
+        EXPECT_NEAR(e.std, e0.std, 0.05 * e0.std) << name;
+        EXPECT_NEAR(e.value, e0.value, 0.1 * e0.std) << name;
+        EXPECT_NEAR(e.value, s.gyro.values[k], 4.0 * e.std) << name;
+      }
+    }
+  }
+}
+
+TEST(Spikes, ANoiseFreeRecordWithASpikeIsIdentifiedExactly) {
+  // The outlier is replaced by the dwell's fit at its instant, so the reduction operator - the one the
+  // model's channels go through - is unchanged, and a noise-free record still gives the truth. Several
+  // spikes, one of each sign, in two dwells.
+  Scenario s = small_test(8);
+  s.noise = GyroNoise{};
+  std::vector<RecordSample> rows = record_of(s, 1);
+  const Timeline tl = make_timeline(s.test, s.model());
+  for (int d : {0, 2}) {
+    const MeasurementInterval& m = tl.measurements.at(static_cast<std::size_t>(d));
+    rows[row_at(rows, m.start_s + 1.0)].gyro_deg_h += 500.0;
+    rows[row_at(rows, m.start_s + 3.0)].gyro_deg_h -= 2e4;
+  }
+  const Calibrated c = calibrate_rows(s, rows);
+  EXPECT_EQ(c.reduction.outliers, 4u);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    if (c.result.coefficients[k].identifiable) {
+      EXPECT_NEAR(c.result.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];
+    }
+  }
+}
+
+TEST(Spikes, CleanNoisyRecordsLoseNoSamplesAndKeepTheirEstimates) {
+  // Gaussian noise reaches 6 standard deviations once in 5e8 samples: over these records (about 1e5 samples
+  // in dwells, both reductions) nothing is rejected, and every estimate and uncertainty is the one without
+  // the rule, bit for bit (the rule delays samples but changes none).
+  const int seeds = sanitized() ? 3 : 8;
+  std::size_t used = 0;
+  struct Case {
+    double rate_hz;
+    ReduceOptions::Method method;
+    int order;
+  };
+  // 13 and 32 samples per revolution for the harmonic fit (order 2 where 13 cannot carry order 3); window
+  // means need a sample in every 10 degree window.
+  const Case cases[] = {{20.0, ReduceOptions::Method::kHarmonicFit, 2},
+                        {50.0, ReduceOptions::Method::kHarmonicFit, 3},
+                        {100.0, ReduceOptions::Method::kWindowMean, 3}};
+  for (int seed = 0; seed < seeds; ++seed) {
+    for (const Case& k : cases) {
+      Scenario s = small_test();
+      s.test.sample_rate_hz = k.rate_hz;
+      const std::vector<RecordSample> rows = record_of(s, 100 + static_cast<std::uint64_t>(seed));
+      ReduceOptions with, without;
+      with.method = without.method = k.method;
+      with.harmonic_order = without.harmonic_order = k.order;
+      without.outlier_threshold = 0.0;
+      const Calibrated a = calibrate_rows(s, rows, with), b = calibrate_rows(s, rows, without);
+      EXPECT_EQ(a.reduction.outliers, 0u) << seed << " " << k.rate_hz;
+      used += a.reduction.samples_used;
+      for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+        if (!b.result.coefficients[c].identifiable) continue;
+        EXPECT_EQ(a.result.coefficients[c].value, b.result.coefficients[c].value) << seed << " " << k.rate_hz;
+        EXPECT_EQ(a.result.coefficients[c].std, b.result.coefficients[c].std) << seed << " " << k.rate_hz;
+      }
+    }
+  }
+  EXPECT_GT(used, sanitized() ? 20000u : 60000u);
+}
+
+TEST(DataQuality, RowsUsedAndGapsInsideDwellsAreCounted) {
+  // Rows used: the measured parts of the four dwells, 20 revolutions at 50 Hz each (the planned duration,
+  // 12.69 s, holds 634 or 635 samples). Two rows missing in one dwell make one gap; one missing in a platform
+  // move none.
+  const Scenario s = small_test();
+  std::vector<RecordSample> rows = record_of(s, 2);
+  const Timeline tl = make_timeline(s.test, s.model());
+  const std::size_t a = row_at(rows, tl.measurements.at(2).start_s + 4.0);
+  rows.erase(rows.begin() + static_cast<std::ptrdiff_t>(a),
+             rows.begin() + static_cast<std::ptrdiff_t>(a + 2));
+  const std::size_t b = row_at(rows, tl.measurements.at(1).start_s - s.test.settle_s - 2.0);
+  rows.erase(rows.begin() + static_cast<std::ptrdiff_t>(b));
+  const Calibrated c = calibrate_rows(s, rows);
+  EXPECT_EQ(c.result.data_quality.rows_read, rows.size());
+  EXPECT_EQ(c.result.data_quality.gaps, 1u);
+  EXPECT_GE(c.result.data_quality.rows_used, 4u * 634u - 2u);
+  EXPECT_LE(c.result.data_quality.rows_used, 4u * 635u);
+  EXPECT_EQ(c.result.data_quality.outliers, 0u);
+}
+
+TEST(Spikes, AStaticHoldRejectsASpikeToo) {
+  Scenario s = small_test(6);
+  s.test.rates_rad_s = {9.9, 0.0};
+  s.test.beta_rad = {0.0, kPi / 2};
+  s.test.gamma_rad = {0.0, kPi / 2, kPi, 1.5 * kPi};
+  const std::vector<RecordSample> clean = record_of(s, 5);
+  const Calibrated ref = calibrate_rows(s, clean);
+  const Timeline tl = make_timeline(s.test, s.model());
+  const MeasurementInterval& hold = tl.measurements.back();
+  std::vector<RecordSample> rows = clean;
+  rows[row_at(rows, 0.5 * (hold.start_s + hold.end_s))].gyro_deg_h = -1e6;
+  const Calibrated c = calibrate_rows(s, rows);
+  EXPECT_EQ(c.reduction.outliers, 1u);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    if (ref.result.coefficients[k].identifiable) {
+      EXPECT_NEAR(c.result.coefficients[k].value, ref.result.coefficients[k].value,
+                  0.1 * ref.result.coefficients[k].std)
+          << kCoefficientNames[k];
+    }
+}
+
+/// The spread of (estimate - truth) / std over seeds, for every identifiable coefficient and combination.
+std::map<std::string, double> z_spread(const Scenario& s, int trials, Method method) {
+  std::map<std::string, std::vector<double>> z;
+  const double omega = 9.9;
+  const double ar = omega * s.centrifuge.radius_m *
+                    (omega + 2 * s.site.earth_rate_rad_s * std::sin(s.site.latitude_rad)) /
+                    s.site.gravity_m_s2;
+  const DriftCoefficients& d = s.gyro;
+  const std::map<std::string, double> truth = {
+      {"dII-dSS", d[Coefficient::dII] - d[Coefficient::dSS]},
+      {"dOO-dSS", d[Coefficient::dOO] - d[Coefficient::dSS]},
+      {"dF+(1+Ar^2)dSS", d[Coefficient::dF] + (1 + ar * ar) * d[Coefficient::dSS]}};
+  std::vector<PositionChannels> channels;
+  for (int trial = 0; trial < trials; ++trial) {
+    Reducer reducer(s.test, ReduceOptions{}, "simulated", omega);
+    SimulationOptions so;
+    so.seed = 5000 + static_cast<std::uint64_t>(trial);
+    simulate(s, so, [&](const RecordSample& x) { reducer.push(x); });
+    const Reduction red = reducer.finish();
+    if (channels.empty()) channels = reduce_model_channels(red, s.model(), ReduceOptions{});
+    CalibrationOptions o;
+    o.method = method;
+    const CalibrationResult r = identify(red, channels, s.model(), o);
+    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+      if (r.coefficients[k].identifiable)
+        z[std::string(kCoefficientNames[k])].push_back((r.coefficients[k].value - d.values[k]) /
+                                                       r.coefficients[k].std);
+    for (const NamedEstimate& e : r.combinations) z[e.name].push_back((e.value - truth.at(e.name)) / e.std);
+  }
+  std::map<std::string, double> spread;
+  for (const auto& [name, v] : z) {
+    double mean = 0, var = 0;
+    for (double x : v) mean += x;
+    mean /= static_cast<double>(v.size());
+    for (double x : v) var += (x - mean) * (x - mean);
+    spread[name] = std::sqrt(var / static_cast<double>(v.size() - 1));
+  }
+  return spread;
+}
+
+TEST(Revolutions, FewRevolutionsGiveHonestUncertainties) {
+  // With 3, 4 or 6 revolutions per dwell the standard errors come from 1, 2 or 4 degrees of freedom per
+  // gamma; the uncertainties must still describe the spread of the estimates: z has unit standard deviation
+  // (0.85..1.15; 250 trials pin it to +-0.05).
+  const int trials = sanitized() ? 120 : 250;
+  for (int revolutions : {3, 4, 6}) {
+    for (Method method : {Method::kLeastSquares, Method::kClosedForm}) {
+      Scenario s = small_test(revolutions);
+      s.test.sample_rate_hz = 40.0;
+      s.test.settle_s = 0.5;
+      const std::map<std::string, double> spread = z_spread(s, trials, method);
+      EXPECT_EQ(spread.size(), 9u);
+      std::string line;
+      for (const auto& [name, sd] : spread) line += " " + name + " " + std::to_string(sd).substr(0, 5);
+      std::printf("std of z, %d revolutions, %s:%s\n", revolutions, to_string(method).c_str(), line.c_str());
+      for (const auto& [name, sd] : spread) {
+        EXPECT_GT(sd, sanitized() ? 0.8 : 0.85) << revolutions << " revolutions, " << name;
+        EXPECT_LT(sd, sanitized() ? 1.2 : 1.15) << revolutions << " revolutions, " << name;
+      }
+    }
+  }
+}
+
+TEST(Revolutions, TooFewForAScatterIsARefusalSayingHowManyAreNeeded) {
+  Scenario s = small_test(2);
+  const std::vector<RecordSample> rows = record_of(s, 1);
+  try {
+    calibrate_rows(s, rows);
+    FAIL() << "two revolutions leave no degree of freedom for the scatter about a line";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("revolutions"), std::string::npos) << m;
+    EXPECT_NE(m.find("at least 3"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace gyrocal
