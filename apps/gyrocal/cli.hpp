@@ -7,11 +7,17 @@
 #include <CLI/CLI.hpp>
 
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
 
 /// The built-in default scenario, or the configuration file at `path` when it is not empty.
 Scenario load_configuration(const std::string& path);
+
+/// The check that plan, simulate and calibrate share (reduce/feasibility.hpp), its refusal naming the
+/// configuration file (or the built-in scenario).
+void check_feasible(const Scenario& scenario, const std::string& config_path,
+                    const ReduceOptions& options = ReduceOptions{});
 
 /// Write `content` to `path`: standard output for "-", else atomically (temporary file, then rename).
 /// An existing file is replaced only when `overwrite`.
@@ -31,6 +37,9 @@ class ProgressBar {
   std::string label_;
   int percent_ = -1;
 };
+
+/// A check for a numeric option: refuses NaN and infinities ("--beta-deg nan"), which CLI11 parses.
+extern const CLI::Validator kFinite;
 
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);

@@ -84,7 +84,7 @@ void register_sensitivity(CLI::App& app) {
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_option("--threshold", opt->threshold,
                   "An estimate is affected when its shift exceeds this many noise std; default 0.1")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
       ->check(CLI::NonNegativeNumber);
   sub->callback([opt] {
