@@ -53,6 +53,8 @@ void refuse_to_overwrite_input(const std::string& output, const std::string& inp
 void ProgressBar::operator()(double fraction) {
   const int percent = static_cast<int>(fraction * 100.0);
   if (percent == percent_) return;
+  // Nothing during the first second (a bar never drawn is not completed either).
+  if (percent_ < 0 && std::chrono::steady_clock::now() - start_ < std::chrono::seconds(1)) return;
   percent_ = percent;
   constexpr int kWidth = 40;
   const int filled = percent * kWidth / 100;

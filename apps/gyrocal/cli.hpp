@@ -1,5 +1,6 @@
 #pragma once
 // Shared pieces of the command line: reading the configuration, writing outputs. No physics here.
+#include <chrono>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -27,14 +28,17 @@ void write_output(const std::string& path, std::string_view content, bool overwr
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
 
 /// A progress bar on standard error ("label [####    ]  42%"), redrawn when the whole percentage changes.
-/// Commands install it only when standard error is a terminal.
+/// Commands install it only when standard error is a terminal; it draws nothing during the first second, so
+/// that work shorter than a second shows no bar.
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)) {}
+  explicit ProgressBar(std::string label)
+      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
   void operator()(double fraction);
 
  private:
   std::string label_;
+  std::chrono::steady_clock::time_point start_;
   int percent_ = -1;
 };
 
