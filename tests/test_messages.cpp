@@ -245,7 +245,7 @@ TEST(ConfigurationLimits, RevolutionsAndSampleRateHaveAnUpperLimitNamedInTheRefu
     }
   };
   refused("revolutions = 2147483647", "<= 100000000");
-  refused("sample_rate_hz = 1e9", "between 0 and 1e+06");
+  refused("sample_rate_hz = 1e9", "sample_rate_hz must be > 0 and <= 1e+06");
   EXPECT_EQ(parse_scenario("[test]\nrevolutions = 100000000\n", "c.toml").test.revolutions, 100000000);
 }
 

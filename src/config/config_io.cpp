@@ -241,6 +241,8 @@ double in_file_unit(double si, double to_si) {
 // Reading.
 
 std::string describe(const Range& range) {
+  if (range.max < kInf && range.min_exclusive)
+    return "> " + shortest(range.min) + " and <= " + shortest(range.max);
   if (range.max < kInf) return "between " + shortest(range.min) + " and " + shortest(range.max);
   return (range.min_exclusive ? "> " : ">= ") + shortest(range.min);
 }
