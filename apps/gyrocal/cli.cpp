@@ -1,5 +1,6 @@
 #include "cli.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -9,11 +10,29 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 
 namespace gyrocal::cli {
 
+const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      double value = 0.0;
+      if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+      if (!std::isfinite(value)) return "must be a finite number, not " + text;
+      return {};
+    },
+    "FINITE", "FINITE");
+
 Scenario load_configuration(const std::string& path) {
   return path.empty() ? default_scenario() : load_scenario(path);
+}
+
+void check_feasible(const Scenario& scenario, const std::string& config_path, const ReduceOptions& options) {
+  try {
+    check_test_feasible(scenario.test, options, scenario.centrifuge.rate_rad_s);
+  } catch (const Error& e) {
+    throw Error((config_path.empty() ? std::string("the built-in scenario") : config_path) + ": " + e.what());
+  }
 }
 
 void write_output(const std::string& path, std::string_view content, bool overwrite) {
@@ -34,6 +53,8 @@ void refuse_to_overwrite_input(const std::string& output, const std::string& inp
 void ProgressBar::operator()(double fraction) {
   const int percent = static_cast<int>(fraction * 100.0);
   if (percent == percent_) return;
+  // Nothing during the first second (a bar never drawn is not completed either).
+  if (percent_ < 0 && std::chrono::steady_clock::now() - start_ < std::chrono::seconds(1)) return;
   percent_ = percent;
   constexpr int kWidth = 40;
   const int filled = percent * kWidth / 100;

@@ -1,5 +1,6 @@
 #pragma once
 // Shared pieces of the command line: reading the configuration, writing outputs. No physics here.
+#include <chrono>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -7,11 +8,17 @@
 #include <CLI/CLI.hpp>
 
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
 
 /// The built-in default scenario, or the configuration file at `path` when it is not empty.
 Scenario load_configuration(const std::string& path);
+
+/// The check that plan, simulate and calibrate share (reduce/feasibility.hpp), its refusal naming the
+/// configuration file (or the built-in scenario).
+void check_feasible(const Scenario& scenario, const std::string& config_path,
+                    const ReduceOptions& options = ReduceOptions{});
 
 /// Write `content` to `path`: standard output for "-", else atomically (temporary file, then rename).
 /// An existing file is replaced only when `overwrite`.
@@ -21,16 +28,22 @@ void write_output(const std::string& path, std::string_view content, bool overwr
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
 
 /// A progress bar on standard error ("label [####    ]  42%"), redrawn when the whole percentage changes.
-/// Commands install it only when standard error is a terminal.
+/// Commands install it only when standard error is a terminal; it draws nothing during the first second, so
+/// that work shorter than a second shows no bar.
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)) {}
+  explicit ProgressBar(std::string label)
+      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
   void operator()(double fraction);
 
  private:
   std::string label_;
+  std::chrono::steady_clock::time_point start_;
   int percent_ = -1;
 };
+
+/// A check for a numeric option: refuses NaN and infinities ("--beta-deg nan"), which CLI11 parses.
+extern const CLI::Validator kFinite;
 
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);

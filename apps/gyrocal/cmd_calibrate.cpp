@@ -3,6 +3,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -34,7 +35,14 @@ void register_calibrate(CLI::App& app) {
     options.compensation = parse_compensation(opt->compensation);
     options.reduce.method =
         opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
-    const CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options);
+    check_feasible(s, opt->config, options.reduce);
+    // The record's metadata against the configuration, before the record is read (docs/interface.md).
+    const std::vector<std::string> metadata_warnings =
+        check_record_metadata(RecordReader(opt->record).metadata(), opt->record, s,
+                              opt->config.empty() ? "the built-in scenario" : opt->config);
+    for (const std::string& w : metadata_warnings) fmt::print(stderr, "gyrocal: warning: {}\n", w);
+    CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options);
+    r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
     if (!opt->json.empty()) {
       nlohmann::json j = calibration_to_json(r);
       j["record"] = opt->record;

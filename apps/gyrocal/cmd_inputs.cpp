@@ -11,12 +11,12 @@ namespace {
 std::string inputs_table(const InstantInputs& in) {
   const auto& j = in.joints;
   std::string s;
-  s += fmt::format("time                 {:.9f} s\n", in.time_s);
-  s += fmt::format("main angle theta     {:.9f} deg   rate {:.9f} rad/s\n", j.main_angle_rad * kRadToDeg,
+  s += fmt::format("time                 {:.12g} s\n", in.time_s);
+  s += fmt::format("main angle theta     {:.12g} deg   rate {:.9g} rad/s\n", j.main_angle_rad * kRadToDeg,
                    j.main_rate_rad_s);
-  s += fmt::format("counter angle psi_r  {:.9f} deg   rate {:.9f} rad/s\n", j.counter_angle_rad * kRadToDeg,
+  s += fmt::format("counter angle psi_r  {:.12g} deg   rate {:.9g} rad/s\n", j.counter_angle_rad * kRadToDeg,
                    j.counter_rate_rad_s);
-  s += fmt::format("beta                 {:.6f} deg\ngamma                {:.9f} deg\n\n",
+  s += fmt::format("beta                 {:.9g} deg\ngamma                {:.12g} deg\n\n",
                    j.position_angle_rad * kRadToDeg, j.gamma_rad() * kRadToDeg);
   s += fmt::format("{:<10}{:>22}{:>22}{:>22}\n", "", "exact", "nominal", "exact - nominal");
   s += fmt::format("{:<10}{:>22.12e}{:>22.12e}{:>22.3e}  rad/s\n", "omega_I", in.exact.rate_rad_s.x(),
@@ -42,10 +42,14 @@ void register_inputs(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("inputs", "Exact and nominal inputs to the gyro at one instant");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
-  sub->add_option("--beta-deg", opt->beta_deg, "Position-platform angle beta, deg")->required();
-  CLI::Option* time = sub->add_option("--time-s", opt->time_s, "Time since the start of the dwell, s");
+  sub->add_option("--beta-deg", opt->beta_deg, "Position-platform angle beta, deg")
+      ->required()
+      ->check(kFinite);
+  CLI::Option* time =
+      sub->add_option("--time-s", opt->time_s, "Time since the start of the dwell, s")->check(kFinite);
   CLI::Option* gamma =
-      sub->add_option("--gamma-deg", opt->gamma_deg, "Arm angle gamma seen from the platform, deg");
+      sub->add_option("--gamma-deg", opt->gamma_deg, "Arm angle gamma seen from the platform, deg")
+          ->check(kFinite);
   CLI::Option* rev = sub->add_option("--revolution", opt->revolution,
                                      "Main-axis revolution (from 0) in which gamma is taken")
                          ->check(CLI::NonNegativeNumber)

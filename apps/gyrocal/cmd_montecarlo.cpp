@@ -61,8 +61,10 @@ void register_montecarlo(CLI::App& app) {
                 "Run the whole time-series pipeline per trial (slow; checks the fast linearised mode)");
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--method", opt->method, "closed-form or least-squares (default)");
-  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)");
+  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+      ->check(CLI::IsMember({"closed-form", "least-squares"}));
+  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
+      ->check(CLI::IsMember({"none", "seed", "full"}));
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt, seed] {
     refuse_to_overwrite_input(opt->json, opt->config);

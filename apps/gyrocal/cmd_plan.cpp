@@ -27,6 +27,7 @@ void register_plan(CLI::App& app) {
     CalibrationOptions options;
     options.method = parse_method(opt->method);
     options.compensation = parse_compensation(opt->compensation);
+    check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {
       nlohmann::json j = calibration_to_json(r);

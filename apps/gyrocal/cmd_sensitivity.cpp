@@ -1,4 +1,6 @@
 // gyrocal sensitivity: the seed's error study (MODEL.md section 10, INTERFACE.md).
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -84,7 +86,7 @@ void register_sensitivity(CLI::App& app) {
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_option("--threshold", opt->threshold,
                   "An estimate is affected when its shift exceeds this many noise std; default 0.1")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinite & CLI::PositiveNumber);
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
       ->check(CLI::NonNegativeNumber);
   sub->callback([opt] {
@@ -93,6 +95,7 @@ void register_sensitivity(CLI::App& app) {
     SensitivityOptions options;
     options.threshold = opt->threshold;
     options.threads = opt->threads;
+    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("sensitivity");
     const SensitivityResult result = sensitivity_study(scenario, options);
     if (!opt->json.empty()) write_output(opt->json, sensitivity_to_json(result).dump(2) + "\n", true);
     if (opt->json != "-") fmt::print("{}", sensitivity_table(result));

@@ -1,5 +1,6 @@
 // gyrocal: the command line (INTERFACE.md). Parsing arguments and printing only; no physics here.
 #include <exception>
+#include <string>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -10,7 +11,9 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "gyrocal: calibrate a gyroscope's drift coefficients on a centrifuge with a counter-rotating platform"};
-  app.require_subcommand(1);
+  // At most one subcommand; none at all lists them (below).
+  app.require_subcommand(0, 1);
+  app.set_version_flag("--version", std::string("gyrocal ") + GYROCAL_VERSION);
   gyrocal::cli::register_demo(app);
   gyrocal::cli::register_init(app);
   gyrocal::cli::register_inputs(app);
@@ -23,6 +26,12 @@ int main(int argc, char** argv) {
   gyrocal::cli::register_noise(app);
   try {
     app.parse(argc, argv);
+    if (app.get_subcommands().empty()) {
+      // `gyrocal` alone: the help, which lists the subcommands, and a usage error's status
+      // (docs/interface.md): nothing was done.
+      fmt::print(stderr, "{}\ngyrocal: give one of the subcommands above.\n", app.help());
+      return static_cast<int>(CLI::ExitCodes::RequiredError);
+    }
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const gyrocal::Error& e) {

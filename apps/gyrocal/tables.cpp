@@ -1,5 +1,6 @@
 #include "tables.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -9,11 +10,32 @@ namespace {
 
 std::string value_std(double v, double s) {
   if (!std::isfinite(v)) return "not identifiable";
-  if (!std::isfinite(s)) return fmt::format("{:.6f}", v);
-  return fmt::format("{:.6f} ± {:.6f}", v, s);
+  return format_value_std(v, s);
 }
 
 }  // namespace
+
+std::string format_value_std(double value, double std_dev) {
+  if (!std::isfinite(value)) return fmt::format("{}", value);
+  if (!(std::isfinite(std_dev) && std_dev > 0.0)) return fmt::format("{:.6g}", value);
+  // The standard deviation to two significant digits, the value to the same last digit.
+  const int first = static_cast<int>(std::floor(std::log10(std_dev)));  // the std's first digit
+  const int last = first - 1;                                           // the last digit shown
+  const int top = static_cast<int>(std::floor(std::log10(std::max(std::abs(value), std_dev))));
+  if (top - last > 10)  // an uncertainty far below the value: the value to 10 digits, the std apart
+    return fmt::format("{:.10g} ± {:.2g}", value, std_dev);
+  if (top < 6 && last >= -12) {  // fixed point
+    if (last > 0) {              // digits left of the point: rounded to the std's second digit
+      const double unit = std::pow(10.0, last);
+      return fmt::format("{:.0f} ± {:.0f}", std::round(value / unit) * unit,
+                         std::round(std_dev / unit) * unit);
+    }
+    return fmt::format("{:.{}f} ± {:.{}f}", value, -last, std_dev, -last);
+  }
+  // Scientific, both in the exponent of the larger.
+  const double scale = std::pow(10.0, top);
+  return fmt::format("({:.{}f} ± {:.{}f})e{}", value / scale, top - last, std_dev / scale, top - last, top);
+}
 
 std::string result_table(const CalibrationResult& r) {
   std::string out = r.BriefReport() + "\n\n";
@@ -48,12 +70,11 @@ std::string comparison_table(const std::vector<std::string>& labels,
   const auto cell = [](const CalibrationResult& r, std::size_t k) -> std::string {
     const CoefficientEstimate& e = r.coefficients[k];
     if (!e.identifiable) return "—";
-    return std::isfinite(e.std) && e.std > 0 ? fmt::format("{:.5f} ± {:.5f}", e.value, e.std)
-                                             : fmt::format("{:.6f}", e.value);
+    return format_value_std(e.value, e.std);
   };
   for (std::size_t k = 0; k < kNumCoefficients; ++k) {
     out += fmt::format("{:<16}", fmt::format("{} [{}]", kCoefficientNames[k], kCoefficientUnits[k]));
-    if (truth) out += fmt::format("{:>10.4f}", truth->values[k]);
+    if (truth) out += fmt::format("{:>10.6g}", truth->values[k]);
     for (const CalibrationResult& r : results) out += fmt::format("{:>{}}", cell(r, k), kWidth);
     out += "\n";
   }
@@ -68,14 +89,12 @@ std::string comparison_table(const std::vector<std::string>& labels,
         double v = 0.0;
         for (std::size_t k = 0; k < first.coefficients.size() && k < kNumCoefficients; ++k)
           v += first.coefficients[k] * truth->values[k];
-        out += fmt::format("{:>10.4f}", v);
+        out += fmt::format("{:>10.6g}", v);
       }
       for (const CalibrationResult& r : results) {
         std::string cellv = "—";
         for (const NamedEstimate& e : r.combinations)
-          if (e.name == name)
-            cellv = std::isfinite(e.std) && e.std > 0 ? fmt::format("{:.5f} ± {:.5f}", e.value, e.std)
-                                                      : fmt::format("{:.6f}", e.value);
+          if (e.name == name) cellv = format_value_std(e.value, e.std);
         out += fmt::format("{:>{}}", cellv, kWidth);
       }
       out += "\n";

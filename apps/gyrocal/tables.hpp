@@ -9,6 +9,11 @@
 
 namespace gyrocal::cli {
 
+/// "value ± std" with the digits the uncertainty justifies: the std to two significant digits and the value
+/// to the same last digit (0.0700 ± 0.0018; scientific for large or tiny magnitudes); the value alone to 6
+/// significant digits when the std is zero or unknown.
+std::string format_value_std(double value, double std_dev);
+
 /// Coefficients (value ± std, unit), combinations, alternatives, warnings of one result.
 std::string result_table(const CalibrationResult& result);
 

@@ -241,6 +241,8 @@ double in_file_unit(double si, double to_si) {
 // Reading.
 
 std::string describe(const Range& range) {
+  if (range.max < kInf && range.min_exclusive)
+    return "> " + shortest(range.min) + " and <= " + shortest(range.max);
   if (range.max < kInf) return "between " + shortest(range.min) + " and " + shortest(range.max);
   return (range.min_exclusive ? "> " : ">= ") + shortest(range.min);
 }
@@ -470,10 +472,17 @@ void reject_repeats(const Reader& reader, const toml::node& node, const std::str
   }
 }
 
+/// Upper limits of [test] (docs/interface.md): a gyro's output rate is far below 1 MHz, and 1e8 revolutions
+/// at the 14 samples per revolution a fit needs exceed the most samples a test may hold
+/// (reduce/feasibility.hpp), which is checked on the whole test before anything is run.
+constexpr Range kSampleRate{0.0, 1e6, true};
+constexpr std::int64_t kMaxRevolutions = 100000000;
+
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
-  section.number("sample_rate_hz", 1.0, kPositive, test.sample_rate_hz);
+  section.number("sample_rate_hz", 1.0, kSampleRate, test.sample_rate_hz);
   if (const toml::node* node = section.find("revolutions")) {
-    test.revolutions = static_cast<int>(reader.integer(*node, section.path("revolutions"), 1, INT_MAX));
+    test.revolutions =
+        static_cast<int>(reader.integer(*node, section.path("revolutions"), 1, kMaxRevolutions));
   }
   section.number("settle_s", 1.0, kNonNegative, test.settle_s);
   if (const toml::node* node = section.find("beta_deg")) {

@@ -1,11 +1,30 @@
 #include "gyrocal/identify/channels.hpp"
 
+#include <cmath>
+
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
 
+namespace {
+
+/// A stride of at least `at_least` samples whose arm-angle step, gamma_step * stride wrapped to (-pi, pi],
+/// lies between 2 pi / 40 and 2 pi / 10 in magnitude. The wrapped step changes by gamma_step (< 2 pi / 14)
+/// per unit of stride, so the band (wider than 2 pi / 14) is met within one revolution's worth of strides.
+std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samples_per_revolution) {
+  const auto tries = static_cast<std::size_t>(std::ceil(samples_per_revolution)) + 2;
+  for (std::size_t s = at_least; s < at_least + tries; ++s) {
+    const double step = std::abs(std::remainder(static_cast<double>(s) * gamma_step_rad, 2.0 * kPi));
+    if (step >= 2.0 * kPi / 40.0 && step <= 2.0 * kPi / 10.0) return s;
+  }
+  return at_least;  // not reached for >= 14 samples per revolution (reduce/feasibility.hpp)
+}
+
+}  // namespace
+
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                    const ReduceOptions& options) {
+                                                    const ReduceOptions& options,
+                                                    std::size_t max_samples_per_dwell) {
   // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors.
   constexpr int kColumns = 3 + 2 * static_cast<int>(kNumCoefficients);
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
@@ -23,6 +42,12 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
                                             : 2.0 * kPi / std::abs(d.main.rate_rad_s) / d.sample_interval_s /
                                                   static_cast<double>(options.model_samples_per_revolution);
       stride = static_cast<std::size_t>(std::max(1.0, std::floor(per_period)));
+      if (!d.is_static && max_samples_per_dwell > 0 && d.samples / stride > max_samples_per_dwell) {
+        const double per_revolution = 2.0 * kPi / std::abs(d.counter.rate_rad_s) / d.sample_interval_s;
+        if (std::isfinite(per_revolution) && per_revolution < 1e12)
+          stride = long_stride((d.samples + max_samples_per_dwell - 1) / max_samples_per_dwell,
+                               d.counter.rate_rad_s * d.sample_interval_s, per_revolution);
+      }
     }
     const auto add_sample = [&](std::size_t i) {
       const double t = d.time_of_sample(i);

@@ -1,9 +1,15 @@
 #include "gyrocal/identify/predict.hpp"
 
 #include <cmath>
+#include <complex>
+#include <utility>
+
+#include <Eigen/Cholesky>
+#include <limits>
 
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 
 namespace gyrocal {
 
@@ -59,21 +65,116 @@ void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& c
   }
 }
 
+namespace {
+
+/// sum_{i<n} e^{j theta i} and sum_{i<n} i e^{j theta i}, in closed form (theta not a multiple of 2 pi):
+/// e^{j phi} A and e^{j phi} ((n-1)/2 A - j A') with phi = (n-1) theta / 2, A = sin(n theta/2) /
+/// sin(theta/2).
+std::pair<std::complex<double>, std::complex<double>> power_sums(double theta, double n) {
+  const double s = std::sin(0.5 * theta), c = std::cos(0.5 * theta);
+  const double sn = std::sin(0.5 * n * theta), cn = std::cos(0.5 * n * theta);
+  const double a = sn / s;
+  const double da = (0.5 * n * cn * s - 0.5 * sn * c) / (s * s);
+  const std::complex<double> rotation = std::polar(1.0, 0.5 * (n - 1.0) * theta);
+  return {rotation * a, rotation * std::complex<double>(0.5 * (n - 1.0) * a, -da)};
+}
+
+/// The white-noise covariance of a spinning dwell's harmonic fit (reduce/dwell_accumulator.hpp: the basis
+/// 1, cos k gamma, sin k gamma (k <= order) [, t scaled to [-0.5, 0.5] over the planned duration], the values
+/// at the plan's gammas and mid-time) for the plan's samples: evenly spaced in time and, on constant-rate
+/// joints, in gamma. The normal matrix's entries are sums of e^{j m gamma_i} and i e^{j m gamma_i} over the
+/// samples, which have closed forms: the cost does not depend on the dwell's length (issue 11, item 9).
+Eigen::MatrixXd harmonic_fit_covariance(const Dwell& d, const ReduceOptions& options) {
+  const int order = options.harmonic_order;
+  const int harmonics = 2 * order + 1;
+  const int size = harmonics + (options.linear_drift ? 1 : 0);
+  const double n = static_cast<double>(d.samples);
+  // gamma_i = g0 + i step (the reducer's gamma is minus the counter platform's angle); t_i scaled = alpha i -
+  // 1/2.
+  const double g0 = -d.counter.at_first_rad, step = -d.counter.rate_rad_s * d.sample_interval_s;
+  const double alpha = d.sample_interval_s / d.planned_duration_s, beta0 = -0.5;
+  // E0[m] = sum_i e^{j m gamma_i}, E1[m] = sum_i i e^{j m gamma_i}, m = 0 .. 2 order.
+  std::vector<std::complex<double>> e0(static_cast<std::size_t>(2 * order + 1)), e1(e0.size());
+  e0[0] = n;
+  e1[0] = 0.5 * n * (n - 1.0);
+  for (int m = 1; m <= 2 * order; ++m) {
+    const auto [s0, s1] = power_sums(m * step, n);
+    const std::complex<double> phase = std::polar(1.0, m * g0);
+    e0[static_cast<std::size_t>(m)] = phase * s0;
+    e1[static_cast<std::size_t>(m)] = phase * s1;
+  }
+  const auto sum = [&](const std::vector<std::complex<double>>& e, int m) {
+    return m >= 0 ? e[static_cast<std::size_t>(m)] : std::conj(e[static_cast<std::size_t>(-m)]);
+  };
+  // Basis index -> (harmonic k, is sine).
+  const auto harmonic = [](int j) { return (j + 1) / 2; };
+  const auto is_sine = [](int j) { return j > 0 && j % 2 == 0; };
+  Eigen::MatrixXd normal(size, size);
+  for (int a = 0; a < harmonics; ++a)
+    for (int b = 0; b < harmonics; ++b) {
+      const int ka = harmonic(a), kb = harmonic(b);
+      const std::complex<double> diff = sum(e0, ka - kb), plus = sum(e0, ka + kb);
+      double v;
+      if (!is_sine(a) && !is_sine(b))
+        v = 0.5 * (diff + plus).real();
+      else if (is_sine(a) && is_sine(b))
+        v = 0.5 * (diff - plus).real();
+      else if (is_sine(a))  // sin ka cos kb
+        v = 0.5 * (plus + diff).imag();
+      else  // cos ka sin kb = sin kb cos ka
+        v = 0.5 * (plus - diff).imag();
+      normal(a, b) = v;
+    }
+  if (options.linear_drift) {
+    const int t = harmonics;
+    for (int a = 0; a < harmonics; ++a) {
+      const std::complex<double> w = alpha * sum(e1, harmonic(a)) + beta0 * sum(e0, harmonic(a));
+      normal(a, t) = normal(t, a) = is_sine(a) ? w.imag() : w.real();
+    }
+    const double si = 0.5 * n * (n - 1.0), sii = (n - 1.0) * n * (2.0 * n - 1.0) / 6.0;
+    normal(t, t) = alpha * alpha * sii + 2.0 * alpha * beta0 * si + beta0 * beta0 * n;
+  }
+  const double t_mid = alpha * 0.5 * (n - 1.0) + beta0;
+  const auto ng = static_cast<Eigen::Index>(d.gammas_rad.size());
+  Eigen::MatrixXd basis(size, ng);
+  for (Eigen::Index k = 0; k < ng; ++k) {
+    const double g = d.gammas_rad[static_cast<std::size_t>(k)];
+    basis(0, k) = 1.0;
+    for (int h = 1; h <= order; ++h) {
+      basis(2 * h - 1, k) = std::cos(h * g);
+      basis(2 * h, k) = std::sin(h * g);
+    }
+    if (options.linear_drift) basis(harmonics, k) = t_mid;
+  }
+  return basis.transpose() * normal.ldlt().solve(basis);
+}
+
+}  // namespace
+
+Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& d, const ReduceOptions& options) {
+  const auto ng = static_cast<Eigen::Index>(d.gammas_rad.size());
+  if (d.samples == 0) return Eigen::MatrixXd::Constant(ng, ng, std::numeric_limits<double>::quiet_NaN());
+  // A static hold's mean: 1/N.
+  if (d.is_static) return Eigen::MatrixXd::Constant(ng, ng, 1.0 / static_cast<double>(d.samples));
+  if (options.method == ReduceOptions::Method::kHarmonicFit && d.counter.rate_rad_s != 0.0)
+    return harmonic_fit_covariance(d, options);
+  // The window mean: every sample of the dwell, as the gyro output is reduced.
+  DwellAccumulator acc(options, d.gammas_rad, d.is_static, 1, d.planned_duration_s, false);
+  const double zero = 0.0;
+  for (std::size_t i = 0; i < d.samples; ++i) {
+    const double t = d.time_of_sample(i);
+    acc.add(t, -d.counter.at(t, d.first_time_s), &zero);
+  }
+  return acc.white_noise_covariance();
+}
+
 Eigen::MatrixXd predicted_position_covariance(const Reduction& r, const ReduceOptions& options,
                                               double sample_std_deg_h) {
   const auto n = static_cast<Eigen::Index>(r.positions.size());
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
   std::vector<Eigen::MatrixXd> per_dwell;
-  for (const Dwell& d : r.dwells) {
-    // Every sample of the dwell, as the gyro output is reduced.
-    DwellAccumulator acc(options, d.gammas_rad, d.is_static, 1, d.planned_duration_s, false);
-    const double zero = 0.0;
-    for (std::size_t i = 0; i < d.samples; ++i) {
-      const double t = d.time_of_sample(i);
-      acc.add(t, -d.counter.at(t, d.first_time_s), &zero);
-    }
-    per_dwell.push_back(acc.white_noise_covariance() * (sample_std_deg_h * sample_std_deg_h));
-  }
+  for (const Dwell& d : r.dwells)
+    per_dwell.push_back(dwell_white_noise_covariance(d, options) * (sample_std_deg_h * sample_std_deg_h));
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j) {
       const ReducedPosition& a = r.positions[static_cast<std::size_t>(i)];
@@ -109,12 +210,20 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
 }
 
 CalibrationResult predict_calibration(const Scenario& s, const CalibrationOptions& options) {
+  // What calibrate would refuse, plan refuses too, by the same check (issue 11, item 6).
+  check_test_feasible(s.test, options.reduce, s.centrifuge.rate_rad_s);
   Reduction r = planned_reduction(s);
   const CentrifugeModel model = s.model();
-  const std::vector<PositionChannels> channels = reduce_model_channels(r, model, options.reduce);
+  // A bounded number of model evaluations per dwell: the prediction's cost does not grow with the test.
+  const std::vector<PositionChannels> channels =
+      reduce_model_channels(r, model, options.reduce, kMaxModelSamplesPerDwell);
   set_noise_free_outputs(r, channels, s.gyro);
   set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz, options.reduce);
-  CalibrationResult result = identify(r, channels, model, options);
+  // The predicted outputs are noise-free, so chi2 is ~0 by construction: its test against the degrees of
+  // freedom says nothing about a plan and must not warn.
+  CalibrationOptions identify_options = options;
+  identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  CalibrationResult result = identify(r, channels, model, identify_options);
   if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0)
     result.warnings.push_back(
         "the predicted uncertainties count the angle random walk only; bias instability "

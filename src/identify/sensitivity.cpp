@@ -147,7 +147,7 @@ struct PlannedTest {
 PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
   PlannedTest p;
   p.reduction = planned_reduction(s);
-  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
+  p.channels = reduce_model_channels(p.reduction, s.model(), ro, kMaxModelSamplesPerDwell);
   set_noise_free_outputs(p.reduction, p.channels, s.gyro);
   set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz);
   return p;
@@ -223,14 +223,23 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   result.rows.resize(terms.size());
   // Item 0 is the base case (no machine error), items 1.. the rows; every item is independent.
   std::vector<SixCalibrations> runs(terms.size() + 1);
-  parallel_for(terms.size() + 1, options.threads, [&](std::size_t i) {
-    Scenario s = base;
-    if (i > 0) {
-      const auto& [term, value] = terms[i - 1];
-      term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
-    }
-    runs[i] = calibrate_six(s, options.calibration);
-  });
+  std::atomic<std::size_t> done{0};
+  parallel_for(
+      terms.size() + 1, options.threads,
+      [&](std::size_t i) {
+        Scenario s = base;
+        if (i > 0) {
+          const auto& [term, value] = terms[i - 1];
+          term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
+        }
+        runs[i] = calibrate_six(s, options.calibration);
+        ++done;
+      },
+      [&] {
+        if (options.progress)
+          options.progress(static_cast<double>(done.load()) / static_cast<double>(runs.size()));
+      });
+  if (options.progress) options.progress(1.0);
 
   for (int m = 0; m < 2; ++m) {
     // Names, units and noise std from the base case with full compensation.

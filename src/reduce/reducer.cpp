@@ -10,6 +10,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/plan/positions.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 
 namespace gyrocal {
 namespace {
@@ -231,16 +232,7 @@ Reducer::Reducer(const TestSpec& plan, const ReduceOptions& options, std::string
     }
   if (state_->reference_rate == 0.0)
     throw Error("the plan has no non-zero rate and no reference rate to size the static holds.");
-  const int min_samples = 2 * (2 * options.harmonic_order + 1);
-  for (double r : plan.rates_rad_s) {
-    if (r == 0.0) continue;
-    const double per_rev = plan.sample_rate_hz * 2.0 * kPi / std::abs(r);
-    if (per_rev < min_samples)
-      throw Error(
-          fmt::format("at {} rad/s the plan gives {:.1f} samples per revolution; the harmonic fit of "
-                      "order {} needs at least {}.",
-                      r, per_rev, options.harmonic_order, min_samples));
-  }
+  check_test_feasible(plan, options, state_->reference_rate);
 }
 
 Reducer::~Reducer() = default;

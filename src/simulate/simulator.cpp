@@ -81,6 +81,8 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
       {"reference_rate_rad_s", fmt::format("{}", timeline.reference_rate_rad_s)},
       {"radius_m", fmt::format("{}", scenario.centrifuge.radius_m)},
       {"latitude_deg", degrees(scenario.site.latitude_rad)},
+      {"gravity_m_s2", fmt::format("{}", scenario.site.gravity_m_s2)},
+      {"earth_rate_rad_s", fmt::format("{}", scenario.site.earth_rate_rad_s)},
       {"heading_deg", degrees(scenario.centrifuge.heading_rad)},
       {"initial_main_angle_deg", degrees(scenario.centrifuge.initial_main_angle_rad)},
       {"angles", "encoder readings in deg, wrapped to [0, 360)"},

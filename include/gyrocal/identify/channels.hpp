@@ -38,8 +38,19 @@ struct PositionChannels {
   }
 };
 
-/// Channels of every position of `reduction`, in its order, for `model`.
+/// Most model evaluations per spinning dwell for a prediction (`gyrocal plan`, issue 11, item 9): beyond
+/// ReduceOptions::model_samples_per_revolution * revolutions = this, the channels are evaluated on a stride
+/// longer than a revolution, chosen so that the arm angle advances by 2 pi / 40 .. 2 pi / 10 (mod 2 pi) from
+/// one evaluation to the next: a uniform sampling of gamma (no harmonic up to 9 aliases onto the fit's)
+/// spread over the whole dwell (the drift). The cost of the channels then does not grow with the test's
+/// length; docs/calibration.md states the error.
+inline constexpr std::size_t kMaxModelSamplesPerDwell = 32768;
+
+/// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
+/// the model evaluations of a spinning dwell (above); 0 (a calibration) evaluates ReduceOptions::
+/// model_samples_per_revolution per revolution, however many revolutions.
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                    const ReduceOptions& options);
+                                                    const ReduceOptions& options,
+                                                    std::size_t max_samples_per_dwell = 0);
 
 }  // namespace gyrocal

@@ -22,6 +22,12 @@ double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_h
 void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
                             const DriftCoefficients& truth);
 
+/// gamma x gamma: the covariance of a planned dwell's reduced values per unit variance of white noise on each
+/// sample (DwellAccumulator::white_noise_covariance of its samples). Harmonic fit: in closed form from the
+/// count, spacing and arm-angle step of the samples, at a cost independent of their number; a static hold:
+/// 1/N; the window mean: by walking the samples.
+Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& dwell, const ReduceOptions& options);
+
 /// Covariance (deg/h)^2 of the reduced positions under white rate noise of `sample_std_deg_h` per sample: the
 /// reduction operator's covariance within each dwell (one fit correlates the gammas of one dwell), zero
 /// across dwells; positions in the order of reduction.positions.

@@ -4,6 +4,7 @@
 // the exact model through the same reduction and identification as a real calibration (identify/predict.hpp),
 // not a statistical simulation.
 #include <array>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,6 +51,8 @@ struct SensitivityOptions {
   /// An estimate "matters" for an error when |shift| > threshold * its predicted noise std. Default 0.1.
   double threshold = 0.1;
   int threads = 0;  ///< worker threads; 0 = hardware concurrency. Results do not depend on it.
+  /// Called on the calling thread with the fraction of the study done (0..1), when set.
+  std::function<void(double fraction)> progress;
 };
 
 /// Shifts of one error for one compensation: estimate name -> shift in the estimate's unit.

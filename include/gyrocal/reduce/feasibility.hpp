@@ -1,0 +1,30 @@
+#pragma once
+// Can a record of this test be calibrated at all? One check, used before anything is done by `plan` (through
+// predict_calibration), `simulate` and `calibrate` (the reducer), so that the three agree (issue 11, item 6).
+#include <cstdint>
+
+#include "gyrocal/plan/test_spec.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
+
+namespace gyrocal {
+
+/// The most samples a test may hold (its measured dwells and holds and their settle intervals): a record of
+/// 1e10 rows is about 0.4 TB and takes hours to simulate or calibrate; beyond it the test is refused.
+inline constexpr double kMaxTestSamples = 1e10;
+
+/// The samples per revolution the reduction needs at one rate: 2 (2 harmonic_order + 1), twice the harmonic
+/// fit's unknowns per revolution (the window mean is held to the same, so that both methods see a test
+/// alike).
+int min_samples_per_revolution(const ReduceOptions& options);
+
+/// The number of samples of the test's measured part (dwells, holds, settle intervals; moves not counted).
+/// reference_rate_rad_s sizes a static hold when the plan has no non-zero rate.
+double planned_test_samples(const TestSpec& test, double reference_rate_rad_s);
+
+/// Throws gyrocal::Error naming the [test] key at fault when a record of `test` cannot be reduced with
+/// `options`: too few samples per revolution at a rate (with the sample rate it needs), a non-zero rate
+/// slower than options.static_rate_tolerance_rad_s (it reads as a stopped main axis), or more than
+/// kMaxTestSamples samples in all.
+void check_test_feasible(const TestSpec& test, const ReduceOptions& options, double reference_rate_rad_s);
+
+}  // namespace gyrocal

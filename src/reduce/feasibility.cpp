@@ -1,0 +1,62 @@
+#include "gyrocal/reduce/feasibility.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+
+int min_samples_per_revolution(const ReduceOptions& options) {
+  return 2 * (2 * options.harmonic_order + 1);
+}
+
+double planned_test_samples(const TestSpec& test, double reference_rate_rad_s) {
+  double reference = reference_rate_rad_s;
+  for (double r : test.rates_rad_s)
+    if (r != 0.0) {
+      reference = r;
+      break;
+    }
+  const double revolutions_s = static_cast<double>(test.revolutions) * 2.0 * kPi;
+  const double betas = static_cast<double>(test.beta_rad.size());
+  const double gammas = static_cast<double>(test.gamma_rad.size());
+  double seconds = 0.0;
+  for (double r : test.rates_rad_s) {
+    if (r != 0.0)
+      seconds += betas * (revolutions_s / std::abs(r) + test.settle_s);
+    else
+      seconds += betas * gammas * (revolutions_s / std::abs(reference) + test.settle_s);
+  }
+  return seconds * test.sample_rate_hz;
+}
+
+void check_test_feasible(const TestSpec& test, const ReduceOptions& options, double reference_rate_rad_s) {
+  const int needed = min_samples_per_revolution(options);
+  for (double r : test.rates_rad_s) {
+    if (r == 0.0) continue;
+    if (std::abs(r) < options.static_rate_tolerance_rad_s)
+      throw Error(fmt::format(
+          "[test] rates_rad_s holds {} rad/s: a non-zero rate must be at least {} rad/s in magnitude, slower "
+          "the record reads as a stopped main axis (use 0 for a static set).",
+          r, options.static_rate_tolerance_rad_s));
+    const double per_revolution = test.sample_rate_hz * 2.0 * kPi / std::abs(r);
+    if (per_revolution < needed)
+      throw Error(
+          fmt::format("[test] sample_rate_hz = {} Hz gives {:.3g} samples per revolution at {} rad/s ([test] "
+                      "rates_rad_s); the harmonic fit of order {} needs at least {}: a sample rate of at "
+                      "least {:.4g} Hz.",
+                      test.sample_rate_hz, per_revolution, r, options.harmonic_order, needed,
+                      needed * std::abs(r) / (2.0 * kPi)));
+  }
+  const double samples = planned_test_samples(test, reference_rate_rad_s);
+  if (!(samples <= kMaxTestSamples))
+    throw Error(fmt::format(
+        "the test holds {:.3g} samples ([test] revolutions = {}, sample_rate_hz = {} Hz, rates_rad_s); at "
+        "most {:.0e} can be simulated or calibrated: fewer revolutions, a lower sample rate or faster rates.",
+        samples, test.revolutions, test.sample_rate_hz, kMaxTestSamples));
+}
+
+}  // namespace gyrocal
