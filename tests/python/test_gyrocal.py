@@ -83,6 +83,18 @@ def small(tmp_path_factory):
     return str(path), gyrocal.Scenario.load(str(path))
 
 
+# --- Scenario ---------------------------------------------------------------------------------------------------
+
+def test_scenario_to_toml_is_init_and_parses_back(small, tmp_path):
+    out = tmp_path / "scenario.toml"
+    run_cli("init", out)
+    assert gyrocal.Scenario().to_toml() == out.read_text()
+    config, sc = small
+    again = gyrocal.Scenario.parse(sc.to_toml())
+    assert (again.sample_rate_hz, again.seed, again.rate_rad_s) == (50.0, 3, 9.9)
+    assert again.to_toml() == sc.to_toml()
+
+
 # --- exact_inputs -----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("config", [None, "small"])
