@@ -28,11 +28,13 @@ ensure_packages() {
 }
 
 # libjs-chart.js is inlined into the HTML report; chromium runs the report's browser test (docs/report.md).
-# What the build needs (libjs-chart.js: the plotting library the HTML report inlines).
+# What the build needs (libjs-chart.js: the plotting library the HTML report inlines; pybind11-dev, python3-dev and
+# python3-numpy: the Python module, built for Debian's /usr/bin/python3, docs/python.md).
 GYROCAL_BUILD_PACKAGES=(g++ cmake make libeigen3-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev libjs-chart.js)
-# What the tests need beyond the build: a headless browser that opens the report.
-GYROCAL_TEST_PACKAGES=(chromium)
+                        libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev libjs-chart.js
+                        pybind11-dev python3-dev python3-numpy)
+# What the tests need beyond the build: a headless browser that opens the report; pytest for the Python module.
+GYROCAL_TEST_PACKAGES=(chromium python3-pytest)
 
 # build_gyrocal DIR [CMAKE ARGS...]: configure and build into DIR (Release unless told otherwise).
 build_gyrocal() {

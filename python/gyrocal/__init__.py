@@ -1,0 +1,80 @@
+"""gyrocal from Python: the same library as the command line, so the same numbers (docs/python.md).
+
+    import numpy as np, gyrocal
+    sc = gyrocal.Scenario.load("scenario.toml")        # gyrocal.Scenario() is the default scenario
+    w, f = gyrocal.exact_inputs(sc, time_s=np.linspace(0, 10, 1000), beta_deg=90.0)  # (n, 3): rad/s, g
+    rec = gyrocal.simulate(sc, seed=1)                 # dict of numpy arrays named as the record's columns
+    res = gyrocal.calibrate(rec, sc, method="least-squares", compensation="full", estimate=[])
+    nz = gyrocal.noise("static.csv", sc)               # noise's JSON as a dict
+
+Every error of gyrocal raises ValueError with the command line's sentence.
+"""
+
+import os
+
+import numpy as np
+
+from ._gyrocal import Scenario
+from . import _gyrocal
+
+__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "RECORD_COLUMNS"]
+
+#: The record's required columns, in order (docs/contract.md, "Record (CSV)").
+RECORD_COLUMNS = ("time_s", "main_angle_deg", "counter_angle_deg", "position_angle_deg", "gyro_deg_h")
+
+#: What a record given as arrays is called in messages and in the result's "record".
+_ARRAYS_NAME = "<arrays>"
+
+
+def _is_path(rec):
+    return isinstance(rec, (str, os.PathLike))
+
+
+def _column(rec, name):
+    try:
+        values = rec[name]
+    except (KeyError, IndexError, TypeError):
+        raise ValueError(f"{_ARRAYS_NAME}: the record has no column {name}.") from None
+    return np.ascontiguousarray(values, dtype=np.float64)
+
+
+def exact_inputs(scenario, time_s, beta_deg):
+    """Exact inputs to the gyro at the instants time_s (s) of a dwell at the scenario's rate and beta_deg,
+    as `gyrocal inputs --time-s T --beta-deg B`: (omega, specific_force), each an (n, 3) float64 array of
+    the I, O, S components, rad/s and g. time_s is any array (flattened) or a number."""
+    t = np.ascontiguousarray(time_s, dtype=np.float64).reshape(-1)
+    return _gyrocal._exact_inputs(scenario, t, float(beta_deg))
+
+
+def simulate(scenario, seed=None):
+    """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
+    record's columns (RECORD_COLUMNS). seed=None takes the scenario's [test] seed, as without --seed."""
+    return _gyrocal._simulate(scenario, None if seed is None else int(seed))
+
+
+def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=(), reduction="harmonic"):
+    """`gyrocal calibrate --json` as a dict. rec is a record's path or a mapping of arrays (a dict such as
+    simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
+    method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
+    "window". estimate (machine errors to self-calibrate) must be empty: self-calibration is not built yet."""
+    if estimate is None:
+        estimate = ()
+    if isinstance(estimate, str):
+        estimate = [estimate]
+    if len(estimate) != 0:
+        raise ValueError(
+            f"estimate={list(estimate)!r}: self-calibration of machine errors is not available yet; "
+            "give estimate=[].")
+    if _is_path(rec):
+        return _gyrocal._calibrate_path(os.fspath(rec), scenario, method, compensation, reduction)
+    columns = [_column(rec, name) for name in RECORD_COLUMNS]
+    return _gyrocal._calibrate_arrays(*columns, scenario, method, compensation, reduction, _ARRAYS_NAME)
+
+
+def noise(rec, scenario=None):
+    """`gyrocal noise --json` as a dict: the overlapping Allan deviation of the record's output and the fitted
+    IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and gyro_deg_h. The scenario is
+    accepted for symmetry with the other functions; the noise of a record does not depend on it."""
+    if _is_path(rec):
+        return _gyrocal._noise_path(os.fspath(rec))
+    return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, "gyro_deg_h"), _ARRAYS_NAME)

@@ -1,0 +1,234 @@
+// The compiled part of the Python module gyrocal (docs/python.md): thin bindings over the library, so that
+// its numbers are the command line's. No physics here: every number comes from the same functions the command
+// line calls. python/gyrocal/__init__.py holds the Python-facing functions and their argument handling.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "gyrocal/analysis/record_noise.hpp"
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/noise_json.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace py = pybind11;
+
+namespace gyrocal {
+namespace {
+
+/// A one-dimensional float64 array (NumPy converts what it is given; C order, so data() is the values in
+/// order).
+using Column = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// The JSON as the Python objects json.loads gives for the command line's text, so that a dict from the
+/// module equals the command line's JSON parsed by Python (NaN written as null, as the command line writes
+/// it).
+py::object json_to_python(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+CalibrationOptions calibration_options(const std::string& method, const std::string& compensation,
+                                       const std::string& reduction) {
+  CalibrationOptions options;
+  options.method = parse_method(method);
+  options.compensation = parse_compensation(compensation);
+  if (reduction == "harmonic") {
+    options.reduce.method = ReduceOptions::Method::kHarmonicFit;
+  } else if (reduction == "window") {
+    options.reduce.method = ReduceOptions::Method::kWindowMean;
+  } else {
+    throw Error("unknown reduction '" + reduction + "': use harmonic or window.");
+  }
+  return options;
+}
+
+/// Checks that a dict's columns make a record the reader would accept: one dimension, the same length, finite
+/// values, time strictly increasing. `name` stands for the record in messages; rows are counted from 0.
+void check_columns(const std::vector<const Column*>& columns, const std::vector<std::string>& names,
+                   const std::string& name) {
+  const py::ssize_t n = columns.front()->size();
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c]->ndim() != 1)
+      throw Error(fmt::format("{}: column {} has {} dimensions; a record's column has one.", name, names[c],
+                              columns[c]->ndim()));
+    if (columns[c]->size() != n)
+      throw Error(fmt::format("{}: column {} has {} values but column {} has {}.", name, names[c],
+                              columns[c]->size(), names.front(), n));
+    const double* v = columns[c]->data();
+    for (py::ssize_t i = 0; i < n; ++i)
+      if (!std::isfinite(v[i]))
+        throw Error(fmt::format("{}, row {}: {} is {}, not a finite number.", name, i, names[c], v[i]));
+  }
+  const double* t = columns.front()->data();
+  for (py::ssize_t i = 1; i < n; ++i)
+    if (!(t[i] > t[i - 1]))
+      throw Error(fmt::format("{}, row {}: time_s {} does not increase from the previous row's {}.", name, i,
+                              t[i], t[i - 1]));
+}
+
+py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double beta_deg) {
+  const CentrifugeModel model = scenario.model();
+  // As `gyrocal inputs --time-s`: a spinning dwell at the configured rate, beta in radians from degrees.
+  const double rate = scenario.centrifuge.rate_rad_s, beta = beta_deg * kDegToRad;
+  const py::ssize_t n = time_s.size();
+  py::array_t<double> omega({n, py::ssize_t{3}}), force({n, py::ssize_t{3}});
+  const double* t = time_s.data();
+  double* w = omega.mutable_data();
+  double* f = force.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const GyroInputs in = exact_inputs(model, spinning_joint_state(model, rate, beta, t[i]));
+      for (int k = 0; k < 3; ++k) {
+        w[3 * i + k] = in.rate_rad_s[k];
+        f[3 * i + k] = in.specific_force_g[k];
+      }
+    }
+  }
+  return py::make_tuple(omega, force);
+}
+
+py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
+  std::vector<double> columns[5];
+  {
+    py::gil_scoped_release release;
+    SimulationOptions options;
+    options.seed = seed;
+    simulate(scenario, options, [&columns](const RecordSample& s) {
+      columns[0].push_back(s.time_s);
+      columns[1].push_back(s.main_angle_deg);
+      columns[2].push_back(s.counter_angle_deg);
+      columns[3].push_back(s.position_angle_deg);
+      columns[4].push_back(s.gyro_deg_h);
+    });
+  }
+  py::dict out;
+  for (std::size_t c = 0; c < kRecordColumns.size(); ++c) {
+    const std::string key(kRecordColumns[c]);
+    out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
+  }
+  return out;
+}
+
+py::object calibrate_path_py(const std::string& path, const Scenario& scenario, const std::string& method,
+                             const std::string& compensation, const std::string& reduction) {
+  const CalibrationOptions options = calibration_options(method, compensation, reduction);
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    j = calibration_to_json(calibrate_record(path, scenario.model(), scenario.test, options));
+  }
+  j["record"] = path;  // as `gyrocal calibrate --json` writes it
+  return json_to_python(j);
+}
+
+py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, const Column& counter_deg,
+                               const Column& position_deg, const Column& gyro_deg_h, const Scenario& scenario,
+                               const std::string& method, const std::string& compensation,
+                               const std::string& reduction, const std::string& name) {
+  const CalibrationOptions options = calibration_options(method, compensation, reduction);
+  const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
+  check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    // What calibrate_record does, with the rows from the arrays instead of a RecordReader.
+    const CentrifugeModel model = scenario.model();
+    Reducer reducer(scenario.test, options.reduce, name, model.geometry().rate_rad_s);
+    RecordSample s;
+    for (py::ssize_t i = 0; i < time_s.size(); ++i) {
+      s.time_s = time_s.data()[i];
+      s.main_angle_deg = main_deg.data()[i];
+      s.counter_angle_deg = counter_deg.data()[i];
+      s.position_angle_deg = position_deg.data()[i];
+      s.gyro_deg_h = gyro_deg_h.data()[i];
+      reducer.push(s);
+    }
+    const Reduction reduction_result = reducer.finish();
+    const std::vector<PositionChannels> channels =
+        reduce_model_channels(reduction_result, model, options.reduce);
+    j = calibration_to_json(identify(reduction_result, channels, model, options));
+  }
+  j["record"] = name;
+  return json_to_python(j);
+}
+
+py::object noise_path_py(const std::string& path) {
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    j = noise_to_json(characterise_record_noise(path));
+  }
+  return json_to_python(j);
+}
+
+py::object noise_arrays_py(const Column& time_s, const Column& gyro_deg_h, const std::string& name) {
+  check_columns({&time_s, &gyro_deg_h}, {"time_s", "gyro_deg_h"}, name);
+  const std::vector<double> t(time_s.data(), time_s.data() + time_s.size());
+  const std::vector<double> w(gyro_deg_h.data(), gyro_deg_h.data() + gyro_deg_h.size());
+  nlohmann::json j;
+  {
+    py::gil_scoped_release release;
+    j = noise_to_json(characterise_samples_noise(t, w, name));
+  }
+  return json_to_python(j);
+}
+
+}  // namespace
+}  // namespace gyrocal
+
+PYBIND11_MODULE(_gyrocal, m) {
+  using namespace gyrocal;
+  m.doc() = "Compiled part of gyrocal; use the package gyrocal (docs/python.md).";
+
+  // Every gyrocal::Error is a ValueError with the command line's sentence.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+
+  py::class_<Scenario>(m, "Scenario",
+                       "A scenario: everything a configuration file describes. Scenario() is the default "
+                       "scenario; Scenario.load(path) reads a configuration (TOML).")
+      .def(py::init(&default_scenario))
+      .def_static(
+          "load", [](const std::string& path) { return load_scenario(path); }, py::arg("path"),
+          "Read the configuration file (TOML) at path, as --config does.")
+      .def_static(
+          "parse",
+          [](const std::string& text, const std::string& name) { return parse_scenario(text, name); },
+          py::arg("text"), py::arg("name") = "<string>",
+          "Parse a configuration given as TOML text; name stands for the file in messages.")
+      .def("to_toml", &scenario_to_toml,
+           "The scenario as a commented configuration file (TOML), as init writes.")
+      .def_property_readonly("rate_rad_s", [](const Scenario& s) { return s.centrifuge.rate_rad_s; })
+      .def_property_readonly("sample_rate_hz", [](const Scenario& s) { return s.test.sample_rate_hz; })
+      .def_property_readonly("seed", [](const Scenario& s) { return s.test.seed; });
+
+  m.def("_exact_inputs", &exact_inputs_py, py::arg("scenario"), py::arg("time_s"), py::arg("beta_deg"));
+  m.def("_simulate", &simulate_py, py::arg("scenario"), py::arg("seed"));
+  m.def("_calibrate_path", &calibrate_path_py);
+  m.def("_calibrate_arrays", &calibrate_arrays_py);
+  m.def("_noise_path", &noise_path_py);
+  m.def("_noise_arrays", &noise_arrays_py);
+}

@@ -1,0 +1,279 @@
+"""The Python module gives the command line's numbers bit for bit, and its errors are ValueErrors with the
+command line's sentence (issue 10, item 3; docs/python.md).
+
+ctest runs this file with Debian's /usr/bin/python3 -m pytest, PYTHONPATH=<build>/python and GYROCAL_CLI set to
+the command line's executable (tests/CMakeLists.txt). Every expected value comes from the command line, through
+its JSON or CSV text read back with Python's own parsers (json.loads, float(): both round-trip a double).
+"""
+
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import gyrocal
+
+CLI = os.environ.get("GYROCAL_CLI", "gyrocal")
+
+# A short test so that each simulation and calibration takes a fraction of a second: 4 beta positions x 3
+# revolutions at 9.9 rad/s, sampled at 50 Hz (about 600 rows), with the default scenario's machine errors.
+SMALL_TEST = """
+[test]
+sample_rate_hz = 50.0
+revolutions = 3
+settle_s = 1.0
+seed = 3
+"""
+
+
+def run_cli(*args, check=True):
+    proc = subprocess.run([CLI, *map(str, args)], capture_output=True, text=True)
+    if check:
+        assert proc.returncode == 0, proc.stderr
+    return proc
+
+
+def cli_error(*args):
+    """The command line's error sentence: its standard error without the 'gyrocal: ' prefix."""
+    proc = run_cli(*args, check=False)
+    assert proc.returncode == 1, (proc.returncode, proc.stdout, proc.stderr)
+    prefix = "gyrocal: "
+    assert proc.stderr.startswith(prefix)
+    return proc.stderr[len(prefix):].rstrip("\n")
+
+
+def read_record_csv(path):
+    """The record's columns as written, each value through float() (exact for the writer's shortest form)."""
+    header, rows = None, []
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            if header is None:
+                header = line.split(",")
+            else:
+                rows.append([float(v) for v in line.split(",")])
+    return header, {name: [row[i] for row in rows] for i, name in enumerate(header)}
+
+
+def write_record_csv(path, columns):
+    """A record in gyrocal's format from Python (repr gives the shortest round-trip form)."""
+    names = list(columns)
+    with open(path, "w") as f:
+        f.write("# gyrocal-record 1\n" + ",".join(names) + "\n")
+        for row in zip(*(columns[n] for n in names)):
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
+
+
+def same_bits(a, b):
+    """Equal as doubles, bit for bit (so 0.0 differs from -0.0), for sequences of floats."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """The small configuration: its file, and the same as a Scenario."""
+    path = tmp_path_factory.mktemp("config") / "small.toml"
+    path.write_text(SMALL_TEST)
+    return str(path), gyrocal.Scenario.load(str(path))
+
+
+# --- Scenario ---------------------------------------------------------------------------------------------------
+
+def test_scenario_to_toml_is_init_and_parses_back(small, tmp_path):
+    out = tmp_path / "scenario.toml"
+    run_cli("init", out)
+    assert gyrocal.Scenario().to_toml() == out.read_text()
+    config, sc = small
+    again = gyrocal.Scenario.parse(sc.to_toml())
+    assert (again.sample_rate_hz, again.seed, again.rate_rad_s) == (50.0, 3, 9.9)
+    assert again.to_toml() == sc.to_toml()
+
+
+# --- exact_inputs -----------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("config", [None, "small"])
+def test_exact_inputs_equal_cli_bit_for_bit(config, small):
+    times = [0.0, 0.123456789, 1.0 / 3.0, 17.5, 1234.5678901]
+    betas = [0.0, 90.0, 33.3, 270.0]
+    scenario = gyrocal.Scenario() if config is None else small[1]
+    config_args = [] if config is None else ["--config", small[0]]
+    for beta in betas:
+        omega, force = gyrocal.exact_inputs(scenario, time_s=np.array(times), beta_deg=beta)
+        assert omega.shape == (len(times), 3) and force.shape == (len(times), 3)
+        assert omega.dtype == np.float64 and force.dtype == np.float64
+        for i, t in enumerate(times):
+            out = run_cli("inputs", *config_args, "--time-s", repr(t), "--beta-deg", repr(beta), "--json", "-")
+            expected = json.loads(out.stdout)
+            assert same_bits(omega[i], expected["omega_rad_s"]), (t, beta, omega[i], expected["omega_rad_s"])
+            assert same_bits(force[i], expected["specific_force_g"]), (t, beta)
+
+
+def test_exact_inputs_take_a_number_or_any_array():
+    sc = gyrocal.Scenario()
+    w1, f1 = gyrocal.exact_inputs(sc, time_s=2.5, beta_deg=90.0)
+    w2, f2 = gyrocal.exact_inputs(sc, time_s=[[0.0, 2.5]], beta_deg=90)
+    assert w1.shape == (1, 3) and w2.shape == (2, 3)
+    assert same_bits(w1[0], w2[1]) and same_bits(f1[0], f2[1])
+    # Physics, roughly (physics.md section 4): the counter-rotating platform cancels the main rate of 9.9 rad/s,
+    # so the gyro sees about the Earth's rate; the specific force is gravity plus the centripetal omega^2 R (1 m).
+    assert 5e-5 < np.linalg.norm(w1[0]) < 1e-3
+    assert np.linalg.norm(f1[0]) == pytest.approx(math.hypot(1.0, 9.9**2 * 1.0 / 9.80665), rel=1e-2)
+
+
+# --- simulate ---------------------------------------------------------------------------------------------------
+
+def test_simulate_equals_cli_record_bit_for_bit(small, tmp_path):
+    config, sc = small
+    out = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--seed", 7, "--out", out)
+    header, expected = read_record_csv(out)
+    rec = gyrocal.simulate(sc, seed=7)
+    assert list(rec) == header == list(gyrocal.RECORD_COLUMNS)
+    assert len(expected["time_s"]) > 100
+    for name in header:
+        assert rec[name].dtype == np.float64
+        assert same_bits(rec[name], expected[name]), name
+
+
+def test_simulate_default_seed_is_the_scenarios(small, tmp_path):
+    config, sc = small
+    assert sc.seed == 3
+    out = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--out", out)
+    _, expected = read_record_csv(out)
+    rec = gyrocal.simulate(sc)
+    assert same_bits(rec["gyro_deg_h"], expected["gyro_deg_h"])
+    # Another seed gives another noise (so the test above does compare the seed).
+    assert not same_bits(gyrocal.simulate(sc, seed=4)["gyro_deg_h"], expected["gyro_deg_h"])
+
+
+# --- calibrate --------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("method,compensation,reduction", [
+    ("least-squares", "full", "harmonic"),
+    ("closed-form", "seed", "window"),
+])
+def test_calibrate_from_arrays_and_path_equal_cli(small, tmp_path, method, compensation, reduction):
+    config, sc = small
+    record = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--seed", 11, "--out", record)
+    result = tmp_path / "result.json"
+    run_cli("calibrate", record, "--config", config, "--method", method, "--compensation", compensation,
+            "--reduction", reduction, "--json", result)
+    expected = json.loads(result.read_text())
+
+    from_path = gyrocal.calibrate(str(record), sc, method=method, compensation=compensation, reduction=reduction)
+    assert from_path == expected
+
+    rec = gyrocal.simulate(sc, seed=11)
+    from_arrays = gyrocal.calibrate(rec, sc, method=method, compensation=compensation, estimate=[],
+                                    reduction=reduction)
+    # The same result but for the record's name, which messages carry too.
+    name = expected.pop("record")
+    assert name == str(record)
+    assert from_arrays.pop("record") == "<arrays>"
+    expected["warnings"] = [w.replace(name, "<arrays>") for w in expected["warnings"]]
+    assert from_arrays == expected
+    # Not vacuous: the result holds the estimated coefficients.
+    values = [c["value"] for c in from_arrays["coefficients"].values() if c["identifiable"]]
+    assert len(from_arrays["coefficients"]) == 10 and len(values) >= 5 and all(map(math.isfinite, values))
+
+
+def test_calibrate_takes_a_mapping_with_more_columns(small):
+    _, sc = small
+    rec = gyrocal.simulate(sc, seed=2)
+    plain = gyrocal.calibrate(rec, sc)
+    rec["temperature_c"] = np.full_like(rec["time_s"], 20.0)
+    rec = {k: list(v) for k, v in reversed(rec.items())}  # lists, other order: columns are taken by name
+    assert gyrocal.calibrate(rec, sc) == plain
+
+
+# --- noise ------------------------------------------------------------------------------------------------------
+
+def test_noise_from_path_and_arrays_equal_cli(tmp_path):
+    rng = np.random.default_rng(5)
+    n = 4000
+    columns = {
+        "time_s": np.arange(n) / 100.0,
+        "main_angle_deg": np.zeros(n),
+        "counter_angle_deg": np.zeros(n),
+        "position_angle_deg": np.zeros(n),
+        # white noise plus a random walk on a large offset (a sensor's raw zero)
+        "gyro_deg_h": 1e4 + rng.normal(0.0, 3.0, n) + np.cumsum(rng.normal(0.0, 0.05, n)),
+    }
+    record = tmp_path / "static.csv"
+    write_record_csv(record, columns)
+    result = tmp_path / "noise.json"
+    run_cli("noise", record, "--json", result)
+    expected = json.loads(result.read_text())
+    assert len(expected["allan"]) > 5
+
+    assert gyrocal.noise(str(record), gyrocal.Scenario()) == expected
+    from_arrays = gyrocal.noise({"time_s": columns["time_s"], "gyro_deg_h": columns["gyro_deg_h"]})
+    assert from_arrays.pop("record") == "<arrays>"
+    expected.pop("record")
+    assert from_arrays == expected
+
+
+# --- errors -----------------------------------------------------------------------------------------------------
+
+def test_bad_configuration_raises_value_error_with_cli_sentence(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[test]\nrevolutions = 3\nsample_rate_hz = -5.0\n")
+    message = cli_error("inputs", "--config", bad, "--beta-deg", 0, "--time-s", 0)
+    assert "sample_rate_hz" in message
+    with pytest.raises(ValueError) as e:
+        gyrocal.Scenario.load(str(bad))
+    assert str(e.value) == message
+
+
+def test_bad_record_raises_value_error_with_cli_sentence(small, tmp_path):
+    config, sc = small
+    record = tmp_path / "broken.csv"
+    record.write_text("# gyrocal-record 1\ntime_s,main_angle_deg,counter_angle_deg,position_angle_deg,gyro_deg_h\n"
+                      "0,0,0,0,1\n0.02,1,0,0,x\n")
+    for args, call in [
+        (("calibrate", record, "--config", config), lambda: gyrocal.calibrate(str(record), sc)),
+        (("noise", record), lambda: gyrocal.noise(str(record), sc)),
+    ]:
+        message = cli_error(*args)
+        assert "line 4" in message
+        with pytest.raises(ValueError) as e:
+            call()
+        assert str(e.value) == message
+    missing = str(tmp_path / "missing.csv")
+    message = cli_error("calibrate", missing)
+    with pytest.raises(ValueError) as e:
+        gyrocal.calibrate(missing, gyrocal.Scenario())
+    assert str(e.value) == message
+
+
+def test_bad_arrays_and_options_raise_value_error(small):
+    _, sc = small
+    rec = gyrocal.simulate(sc, seed=1)
+    with pytest.raises(ValueError, match="not available yet"):
+        gyrocal.calibrate(rec, sc, estimate=["counter_rate_offset"])
+    with pytest.raises(ValueError, match="unknown method 'fast'"):
+        gyrocal.calibrate(rec, sc, method="fast")
+    with pytest.raises(ValueError, match="no column gyro_deg_h"):
+        gyrocal.calibrate({k: v for k, v in rec.items() if k != "gyro_deg_h"}, sc)
+    backwards = dict(rec)
+    backwards["time_s"] = rec["time_s"].copy()
+    backwards["time_s"][10] = backwards["time_s"][9]
+    with pytest.raises(ValueError, match="row 10: time_s .* does not increase"):
+        gyrocal.calibrate(backwards, sc)
+    nan = dict(rec)
+    nan["gyro_deg_h"] = rec["gyro_deg_h"].copy()
+    nan["gyro_deg_h"][5] = np.nan
+    with pytest.raises(ValueError, match="row 5: gyro_deg_h is nan"):
+        gyrocal.calibrate(nan, sc)
+    short = dict(rec)
+    short["main_angle_deg"] = rec["main_angle_deg"][:-1]
+    with pytest.raises(ValueError, match="column main_angle_deg has"):
+        gyrocal.calibrate(short, sc)
