@@ -253,18 +253,22 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
   }
 }
 
-/// Refuses a covariance of the reduced positions that cannot weight a fit, naming the positions at fault:
-/// two positions of the plan that are one measurement, or a dwell whose standard errors are not a covariance.
-void refuse_covariance(const Reduction& reduction) {
+/// Refuses two positions of the plan that are one measurement (a repeated rate, beta or gamma), naming them.
+/// Checked before any weighting: their covariance is singular, but rounding may let a factorisation pass it.
+void refuse_repeated_positions(const Reduction& reduction) {
   const auto& ps = reduction.positions;
   for (std::size_t i = 0; i < ps.size(); ++i)
     for (std::size_t j = i + 1; j < ps.size(); ++j)
       if (ps[i].dwell == ps[j].dwell && ps[i].gamma_slot == ps[j].gamma_slot)
         throw Error(
             fmt::format("{} and {} are one and the same measurement (the plan repeats a rate, beta or "
-                        "gamma): they cannot "
-                        "be weighted as two; remove the repeated value from [test].",
+                        "gamma): they cannot be weighted as two; remove the repeated value from [test].",
                         describe_position(reduction, i), describe_position(reduction, j)));
+}
+
+/// Refuses a covariance of the reduced positions that cannot weight a fit, naming the dwell at fault.
+void refuse_covariance(const Reduction& reduction) {
+  const auto& ps = reduction.positions;
   for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
     const Eigen::MatrixXd& c = reduction.dwells[d].gyro.covariance;
     if (c.size() == 0 || Eigen::LLT<Eigen::MatrixXd>(c).info() == Eigen::Success) continue;
@@ -297,6 +301,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
   }
   check_finite(reduction, design, observations, channels, options.compensation);
+  refuse_repeated_positions(reduction);
   const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
   // The weights come from the covariance with one level for the whole record (the levels pooled over the
   // dwells by their degrees of freedom); the uncertainties from each dwell's own level (a sandwich). A few

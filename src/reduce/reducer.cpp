@@ -339,9 +339,14 @@ Reduction Reducer::finish() {
     const int needed = d.is_static ? 2 : (st.options.linear_drift ? 3 : 2);
     throw Error(fmt::format(
         "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
-        "error from the scatter between them; it needs at least {} ([test] revolutions = {} or more).",
+        "error from the scatter between them; it needs at least {}{}.",
         st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
-        d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", needed, needed));
+        d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", needed,
+        d.is_static ? ""
+        : st.options.method == ReduceOptions::Method::kWindowMean
+            ? ": raise [test] revolutions (window means count a revolution only when it passes through every "
+              "window, so a dwell's first or last may not count)"
+            : fmt::format(" ([test] revolutions = {} or more)", needed)));
   }
   for (const ReducedPosition& p : out.positions)
     if (p.std_err_deg_h == 0.0) ++zero;

@@ -18,12 +18,12 @@ import gyrocal
 
 CLI = os.environ.get("GYROCAL_CLI", "gyrocal")
 
-# A short test so that each simulation and calibration takes a fraction of a second: 4 beta positions x 3
-# revolutions at 9.9 rad/s, sampled at 50 Hz (about 600 rows), with the default scenario's machine errors.
+# A short test so that each simulation and calibration takes a fraction of a second: 4 beta positions x 4
+# revolutions at 9.9 rad/s, sampled at 50 Hz (about 700 rows; window means need 4 for 3 complete ones), with the default scenario's machine errors.
 SMALL_TEST = """
 [test]
 sample_rate_hz = 50.0
-revolutions = 3
+revolutions = 4
 settle_s = 1.0
 seed = 3
 """
