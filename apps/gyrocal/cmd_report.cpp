@@ -22,29 +22,7 @@ nlohmann::json read_result(const std::string& path) {
   std::ostringstream bytes;
   bytes << in.rdbuf();
   if (in.bad()) throw Error(fmt::format("cannot read the result file {}.", path));
-  const std::string text = bytes.str();
-  try {
-    nlohmann::json result = nlohmann::json::parse(text);
-    if (!result.is_object())
-      throw Error(fmt::format("{} holds a JSON {}, not an object: a gyrocal result is a JSON object.", path,
-                              result.type_name()));
-    return result;
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.byte counts from 1 and points just past the offending character.
-    const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t k = 0; k < end; ++k) {
-      if (text[k] == '\n') {
-        ++line;
-        column = 1;
-      } else {
-        ++column;
-      }
-    }
-    std::string reason = e.what();
-    if (const auto colon = reason.find(": "); colon != std::string::npos) reason = reason.substr(colon + 2);
-    throw Error(fmt::format("{} is not valid JSON: line {}, column {}: {}.", path, line, column, reason));
-  }
+  return parse_result_json(bytes.str(), path);
 }
 
 bool is_earlier_report(const std::string& path) {

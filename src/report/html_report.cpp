@@ -1224,6 +1224,55 @@ std::string Renderer::render() {
 
 }  // namespace
 
+nlohmann::json parse_result_json(std::string_view text, const std::string& source_name) {
+  // A gyrocal result nests a handful of levels. Deeper input is refused while it is read: the report prints
+  // some values with json::dump, which recurses once per level, so a few hundred thousand '[' overflowed
+  // the stack (found while writing the fuzz target, docs/fuzzing.md).
+  constexpr int kMaxDepth = 64;
+  const json::parser_callback_t limit_depth = [&](int depth, json::parse_event_t event, json&) {
+    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+        depth >= kMaxDepth)
+      throw Error(
+          fmt::format("{} nests arrays and objects more than {} levels deep; a gyrocal result nests "
+                      "a few levels only.",
+                      source_name, kMaxDepth));
+    return true;
+  };
+  try {
+    json result = json::parse(text, limit_depth);
+    if (!result.is_object())
+      throw Error(fmt::format("{} holds a JSON {}, not an object: a gyrocal result is a JSON object.",
+                              source_name, result.type_name()));
+    return result;
+  } catch (const json::parse_error& e) {
+    // e.byte counts from 1 and points just past the offending character.
+    const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+    std::size_t line = 1, column = 1;
+    for (std::size_t k = 0; k < end; ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    std::string reason = e.what();
+    if (const auto colon = reason.find(": "); colon != std::string::npos) reason = reason.substr(colon + 2);
+    throw Error(
+        fmt::format("{} is not valid JSON: line {}, column {}: {}.", source_name, line, column, reason));
+  } catch (const json::out_of_range& e) {
+    // Valid JSON that a double cannot hold (1e400): nlohmann::json throws out_of_range 406, which names the
+    // number but not its place (found by fuzzing, docs/fuzzing.md).
+    // The message ends "number overflow parsing '1e400'": quote the number alone.
+    const std::string what = e.what();
+    const std::size_t open = what.find('\''), close = what.rfind('\'');
+    const std::string number =
+        open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : what;
+    throw Error(fmt::format("{} cannot be read: the number {} is beyond the range of a double.", source_name,
+                            number));
+  }
+}
+
 std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options) {
   if (!result.is_object())
     throw Error(fmt::format("a result must be a JSON object, not a JSON {}", type_name(result)));

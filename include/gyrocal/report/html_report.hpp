@@ -22,6 +22,11 @@ struct HtmlReportOptions {
   std::vector<std::string>* problems = nullptr;
 };
 
+/// Parses the text of a result file as `gyrocal report` reads it: valid JSON that holds an object.
+/// Throws gyrocal::Error naming `source_name` (and the line and column of a syntax error) otherwise, for a
+/// number beyond the range of a double, and for arrays and objects nested more than 64 levels deep.
+nlohmann::json parse_result_json(std::string_view text, const std::string& source_name);
+
 /// Renders the HTML report of `result` (a JSON object with any of the sections of docs/report.md:
 /// coefficients, truth, comparison, combinations, alternatives, warnings, positions, sensitivity,
 /// montecarlo, plan). Sections that are absent are left out. Every string from `result` is escaped.
