@@ -35,12 +35,15 @@ void check_feasible(const Scenario& scenario, const std::string& config_path, co
   }
 }
 
+std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, bool overwrite) {
+  if (path == "-") return std::make_unique<AtomicOutputFile>(AtomicOutputFile::StandardOutput{});
+  return std::make_unique<AtomicOutputFile>(path, overwrite);
+}
+
 void write_output(const std::string& path, std::string_view content, bool overwrite) {
-  if (path == "-") {
-    std::cout << content << std::flush;
-    return;
-  }
-  write_file_atomically(path, content, overwrite);
+  const std::unique_ptr<AtomicOutputFile> file = open_output(path, overwrite);
+  file->write(content);
+  file->commit();
 }
 
 void refuse_to_overwrite_input(const std::string& output, const std::string& input) {

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
@@ -20,8 +21,12 @@ Scenario load_configuration(const std::string& path);
 void check_feasible(const Scenario& scenario, const std::string& config_path,
                     const ReduceOptions& options = ReduceOptions{});
 
-/// Write `content` to `path`: standard output for "-", else atomically (temporary file, then rename).
-/// An existing file is replaced only when `overwrite`.
+/// An output: standard output for "-", else an AtomicOutputFile (a regular file through a temporary and a
+/// rename; a device or FIFO written straight through; anything else refused). An existing regular file is
+/// replaced only when `overwrite`.
+std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, bool overwrite);
+
+/// Writes `content` to `path` through open_output and commits it.
 void write_output(const std::string& path, std::string_view content, bool overwrite);
 
 /// Refuse an output path that names one of the inputs (no input is ever overwritten).

@@ -26,21 +26,27 @@ void register_demo(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("demo", "The main job on the built-in default scenario");
-  sub->add_option("--out", opt->out, "Directory for record.csv, result.json and report.html (replaced)");
+  sub->add_option("--out", opt->out,
+                  "Folder for record.csv, result.json and report.html: created, or those three files in it "
+                  "replaced, all together at the end");
   sub->callback([opt] {
     const Scenario s = demo_scenario();
-    const std::filesystem::path dir(opt->out);
-    std::filesystem::create_directories(dir);
-    const std::string record = (dir / "record.csv").string();
+    // The three files are built in a staging folder and moved into place together at the end: an error or
+    // an interruption leaves the folder as it was (docs/interface.md, "Files").
+    AtomicOutputFolder folder(opt->out, "the demo's outputs");
+    const std::string record_staged = folder.path("record.csv").string();
+    const std::string result_staged = folder.path("result.json").string();
+    const std::string report_staged = folder.path("report.html").string();
+    const std::string record = folder.final_path("record.csv").string();
 
     fmt::print(
         "gyrocal demo: the default scenario of MODEL.md section 11 (R0 {} m, {} rad/s, Ar {:.3f} g).\n",
         s.centrifuge.radius_m, s.centrifuge.rate_rad_s,
         radial_level_g(s.site, s.centrifuge.radius_m, s.centrifuge.rate_rad_s));
-    AtomicOutputFile file(record, /*overwrite=*/true);
+    AtomicOutputFile file(record_staged, /*overwrite=*/false);
     const SimulationSummary sim = simulate_record(s, SimulationOptions{}, file.stream());
     file.commit();
-    fmt::print("simulated {} samples ({:.0f} s of test) into {}\n\n", sim.samples, sim.duration_s, record);
+    fmt::print("simulated {} samples ({:.0f} s of test) for {}\n\n", sim.samples, sim.duration_s, record);
 
     struct Run {
       std::string label;
@@ -58,7 +64,7 @@ void register_demo(CLI::App& app) {
       options.method = run.method;
       options.compensation = run.compensation;
       labels.push_back(run.label);
-      results.push_back(calibrate_record(record, s.model(), s.test, options));
+      results.push_back(calibrate_record(record_staged, s.model(), s.test, options));
     }
     fmt::print("{}\n", comparison_table(labels, results, &s.gyro));
     const CalibrationResult& main = results.back();
@@ -84,13 +90,14 @@ void register_demo(CLI::App& app) {
     fmt::print("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
                budget.trials, to_string(budget.mode));
 
-    const std::string result_path = (dir / "result.json").string();
-    write_output(result_path, j.dump(2) + "\n", true);
+    const std::string result_path = folder.final_path("result.json").string();
+    write_file_atomically(result_staged, j.dump(2) + "\n", false);
     HtmlReportOptions report;
     report.title = "gyrocal demo: the default scenario";
     report.source = result_path;
-    const std::string report_path = (dir / "report.html").string();
-    write_output(report_path, render_html_report(j, report), true);
+    const std::string report_path = folder.final_path("report.html").string();
+    write_file_atomically(report_staged, render_html_report(j, report), false);
+    folder.commit();
     fmt::print("\nwrote {}, {} and {}\n", record, result_path, report_path);
   });
 }

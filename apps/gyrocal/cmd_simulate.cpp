@@ -1,4 +1,5 @@
 // gyrocal simulate: simulate a whole test into a record (INTERFACE.md).
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -10,15 +11,43 @@
 
 #include "cli.hpp"
 #include "gyrocal/core/atomic_file.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
 namespace gyrocal::cli {
 namespace {
 
 std::string size_text(std::uintmax_t bytes) {
+  if (bytes >= 1000000000000) return fmt::format("{:.1f} TB", static_cast<double>(bytes) / 1e12);
+  if (bytes >= 1000000000) return fmt::format("{:.1f} GB", static_cast<double>(bytes) / 1e9);
   if (bytes >= 1000000) return fmt::format("{:.1f} MB", static_cast<double>(bytes) / 1e6);
   if (bytes >= 1000) return fmt::format("{:.1f} kB", static_cast<double>(bytes) / 1e3);
   return fmt::format("{} bytes", bytes);
+}
+
+/// A floor on a simulated row's length: five numbers, four commas and a newline, the noisy gyro output
+/// alone taking 15 or more characters (a typical row is about 65 bytes).
+constexpr std::uint64_t kMinRowBytes = 24;
+
+/// Refuses a record that cannot fit in the free space of the file system that will hold it (a regular
+/// file only; a device, a FIFO or standard output has no such limit). The estimate is a floor, so that a
+/// record that would fit is never refused; one that fits the floor but not the space fails when the disk
+/// is full, with its temporary removed.
+void refuse_what_cannot_fit(const AtomicOutputFile& file, std::uint64_t samples) {
+  const std::filesystem::path folder =
+      file.destination().has_parent_path() ? file.destination().parent_path() : std::filesystem::path(".");
+  struct statvfs fs {};
+  if (::statvfs(folder.c_str(), &fs) != 0) return;
+  const auto free_bytes = static_cast<double>(fs.f_bavail) * static_cast<double>(fs.f_frsize);
+  const double needed = static_cast<double>(samples) * static_cast<double>(kMinRowBytes);
+  if (needed <= free_bytes) return;
+  throw Error(fmt::format(
+      "Cannot write the record '{}': its {} samples need at least {} ({} bytes a row; a typical row is "
+      "about 65), but the file system that holds '{}' has {} free. Shorten the test (fewer revolutions, "
+      "rates, positions or a lower sample_rate_hz) or write elsewhere.",
+      file.target().string(), samples, size_text(static_cast<std::uintmax_t>(needed)), kMinRowBytes,
+      folder.string(), size_text(static_cast<std::uintmax_t>(free_bytes))));
 }
 
 }  // namespace
@@ -32,7 +61,7 @@ void register_simulate(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("simulate", "Simulate a whole test into a record");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
-  sub->add_option("--out", opt->out, "The record to write (CSV)")->required();
+  sub->add_option("--out", opt->out, "The record to write (CSV; '-' = standard output)")->required();
   CLI::Option* seed = sub->add_option("--seed", opt->seed, "Random seed of the noise; default: [test] seed");
   sub->add_flag("--force", opt->force, "Overwrite RECORD if it exists");
   sub->callback([opt, seed] {
@@ -44,12 +73,19 @@ void register_simulate(CLI::App& app) {
     if (seed->count()) options.seed = opt->seed;
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("simulating");
 
-    AtomicOutputFile file(opt->out, opt->force);
-    const SimulationSummary summary = simulate_record(scenario, options, file.stream());
-    file.commit();
-    fmt::print("wrote {}: {} samples, test duration {:.1f} s ({:.2f} h), {}, seed {}\n", opt->out,
-               summary.samples, summary.duration_s, summary.duration_s / 3600.0,
-               size_text(std::filesystem::file_size(opt->out)), summary.seed);
+    const std::uint64_t samples =
+        sample_count(make_timeline(scenario.test, scenario.model()), scenario.test.sample_rate_hz);
+
+    const std::unique_ptr<AtomicOutputFile> file = open_output(opt->out, opt->force);
+    if (!file->writes_through()) refuse_what_cannot_fit(*file, samples);
+    const SimulationSummary summary = simulate_record(scenario, options, file->stream());
+    const std::uint64_t bytes = file->bytes();
+    file->commit();
+    // With the record on standard output, the summary goes to standard error.
+    std::FILE* summary_stream = opt->out == "-" ? stderr : stdout;
+    fmt::print(summary_stream, "wrote {}: {} samples, test duration {:.1f} s ({:.2f} h), {}, seed {}\n",
+               opt->out == "-" ? "standard output" : opt->out, summary.samples, summary.duration_s,
+               summary.duration_s / 3600.0, size_text(bytes), summary.seed);
   });
 }
 

@@ -217,10 +217,13 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   };
 
   // Chunks of trials in a fixed partition: statistics are combined in chunk order, so they do not depend
-  // on which thread ran which chunk.
+  // on which thread ran which chunk. The chunks run in batches that are folded before the next starts, so
+  // that memory does not grow with the number of trials (the samples mode keeps every trial's errors for
+  // its histograms).
   const std::size_t chunk = fast ? 4096 : 8;
   const std::size_t chunks = (trials + chunk - 1) / chunk;
-  std::vector<ChunkStats> stats(chunks);
+  const std::size_t batch = 1024;
+  std::vector<ChunkStats> stats(std::min(chunks, batch));
   std::vector<double> stored(fast ? 0 : trials * ne);
   std::atomic<std::size_t> done{0};
   const double passes = fast ? 2.0 : 1.0;
@@ -229,33 +232,54 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
       options.progress(
           std::min(1.0, static_cast<double>(done.load()) / (passes * static_cast<double>(trials))));
   };
-  parallel_for(
-      chunks, options.threads,
-      [&](std::size_t c) {
-        const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
-        std::vector<double> values((end - begin) * ne);
-        for (std::size_t k = begin; k < end; ++k) trial(k, values.data() + (k - begin) * ne);
-        ChunkStats& st = stats[c];
-        st.n = static_cast<long long>(end - begin);
-        st.mean.assign(ne, 0.0);
-        st.m2.assign(ne, 0.0);
-        st.lo.assign(ne, std::numeric_limits<double>::infinity());
-        st.hi.assign(ne, -std::numeric_limits<double>::infinity());
-        for (std::size_t i = 0; i < ne; ++i) {
-          for (std::size_t k = 0; k < end - begin; ++k) st.mean[i] += values[k * ne + i];
-          st.mean[i] /= static_cast<double>(st.n);
-          for (std::size_t k = 0; k < end - begin; ++k) {
-            const double v = values[k * ne + i];
-            st.m2[i] += (v - st.mean[i]) * (v - st.mean[i]);
-            st.lo[i] = std::min(st.lo[i], v);
-            st.hi[i] = std::max(st.hi[i], v);
+  // Chan et al.'s pairwise update, chunk by chunk in order, per estimate.
+  double n_all = 0;
+  std::vector<double> mean_all(ne, 0.0), m2_all(ne, 0.0), lo_all(ne, std::numeric_limits<double>::infinity()),
+      hi_all(ne, -std::numeric_limits<double>::infinity());
+  for (std::size_t first = 0; first < chunks; first += batch) {
+    const std::size_t count = std::min(batch, chunks - first);
+    parallel_for(
+        count, options.threads,
+        [&](std::size_t b) {
+          const std::size_t c = first + b;
+          const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
+          std::vector<double> values((end - begin) * ne);
+          for (std::size_t k = begin; k < end; ++k) trial(k, values.data() + (k - begin) * ne);
+          ChunkStats& st = stats[b];
+          st.n = static_cast<long long>(end - begin);
+          st.mean.assign(ne, 0.0);
+          st.m2.assign(ne, 0.0);
+          st.lo.assign(ne, std::numeric_limits<double>::infinity());
+          st.hi.assign(ne, -std::numeric_limits<double>::infinity());
+          for (std::size_t i = 0; i < ne; ++i) {
+            for (std::size_t k = 0; k < end - begin; ++k) st.mean[i] += values[k * ne + i];
+            st.mean[i] /= static_cast<double>(st.n);
+            for (std::size_t k = 0; k < end - begin; ++k) {
+              const double v = values[k * ne + i];
+              st.m2[i] += (v - st.mean[i]) * (v - st.mean[i]);
+              st.lo[i] = std::min(st.lo[i], v);
+              st.hi[i] = std::max(st.hi[i], v);
+            }
           }
-        }
-        if (!fast)
-          std::copy(values.begin(), values.end(), stored.begin() + static_cast<std::ptrdiff_t>(begin * ne));
-        done += end - begin;
-      },
-      tick);
+          if (!fast)
+            std::copy(values.begin(), values.end(), stored.begin() + static_cast<std::ptrdiff_t>(begin * ne));
+          done += end - begin;
+        },
+        tick);
+    for (std::size_t b = 0; b < count; ++b) {
+      const ChunkStats& st = stats[b];
+      const auto nb = static_cast<double>(st.n);
+      const double total = n_all + nb;
+      for (std::size_t i = 0; i < ne; ++i) {
+        const double delta = st.mean[i] - mean_all[i];
+        mean_all[i] += delta * nb / total;
+        m2_all[i] += st.m2[i] + delta * delta * n_all * nb / total;
+        lo_all[i] = std::min(lo_all[i], st.lo[i]);
+        hi_all[i] = std::max(hi_all[i], st.hi[i]);
+      }
+      n_all = total;
+    }
+  }
 
   MonteCarloResult result;
   result.trials = options.trials;
@@ -278,19 +302,9 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     d.unit = m.units[i];
     d.truth = m.truth[i];
     d.predicted_mean = m.bias[i];
-    // Chan et al.'s pairwise update, chunk by chunk in order.
-    double n = 0, mean = 0, m2 = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const ChunkStats& st : stats) {
-      const auto nb = static_cast<double>(st.n);
-      const double delta = st.mean[i] - mean, total = n + nb;
-      mean += delta * nb / total;
-      m2 += st.m2[i] + delta * delta * n * nb / total;
-      n = total;
-      lo = std::min(lo, st.lo[i]);
-      hi = std::max(hi, st.hi[i]);
-    }
-    d.mean = mean;
-    d.std = std::sqrt(m2 / (n - 1));
+    double lo = lo_all[i], hi = hi_all[i];
+    d.mean = mean_all[i];
+    d.std = std::sqrt(m2_all[i] / (n_all - 1));
     if (!(hi > lo)) {
       const double pad = std::max(std::abs(lo) * 1e-6, 1e-12);
       lo -= pad;
@@ -319,26 +333,30 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     return static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(x)), 0, bins - 1));
   };
   if (fast) {
-    std::vector<std::vector<long long>> counts(chunks);
-    parallel_for(
-        chunks, options.threads,
-        [&](std::size_t c) {
-          const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
-          counts[c].assign(ne * static_cast<std::size_t>(bins), 0);
-          std::vector<double> v(ne);
-          for (std::size_t k = begin; k < end; ++k) {
-            trial(k, v.data());
-            for (std::size_t i = 0; i < ne; ++i)
-              ++counts[c][i * static_cast<std::size_t>(bins) + bin_of(i, v[i])];
-          }
-          done += end - begin;
-        },
-        tick);
-    for (const auto& cc : counts)
-      for (std::size_t i = 0; i < ne; ++i)
-        for (int b = 0; b < bins; ++b)
-          result.estimates[i].counts[static_cast<std::size_t>(b)] +=
-              cc[i * static_cast<std::size_t>(bins) + static_cast<std::size_t>(b)];
+    std::vector<std::vector<long long>> counts(std::min(chunks, batch));
+    for (std::size_t first = 0; first < chunks; first += batch) {
+      const std::size_t count = std::min(batch, chunks - first);
+      parallel_for(
+          count, options.threads,
+          [&](std::size_t b) {
+            const std::size_t c = first + b;
+            const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
+            counts[b].assign(ne * static_cast<std::size_t>(bins), 0);
+            std::vector<double> v(ne);
+            for (std::size_t k = begin; k < end; ++k) {
+              trial(k, v.data());
+              for (std::size_t i = 0; i < ne; ++i)
+                ++counts[b][i * static_cast<std::size_t>(bins) + bin_of(i, v[i])];
+            }
+            done += end - begin;
+          },
+          tick);
+      for (std::size_t b = 0; b < count; ++b)
+        for (std::size_t i = 0; i < ne; ++i)
+          for (int k = 0; k < bins; ++k)
+            result.estimates[i].counts[static_cast<std::size_t>(k)] +=
+                counts[b][i * static_cast<std::size_t>(bins) + static_cast<std::size_t>(k)];
+    }
   } else {
     for (std::size_t k = 0; k < trials; ++k)
       for (std::size_t i = 0; i < ne; ++i) ++result.estimates[i].counts[bin_of(i, stored[k * ne + i])];

@@ -29,15 +29,27 @@ std::string_view trim(std::string_view text) {
   return text;
 }
 
-/// A piece of input fit to quote in a message: at most 40 characters, unprintable bytes as '?'.
-std::string quote(std::string_view text) {
-  std::string out = "'";
+/// A piece of input fit to show in a message: at most 40 bytes, each byte that is not printable ASCII
+/// written as \xHH (never raw: a message must not carry control characters or broken UTF-8).
+std::string printable(std::string_view text) {
+  std::string out;
   for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 40); ++i) {
-    const char c = text[i];
-    out += (c >= 0x20 && c < 0x7f) ? c : '?';
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f)
+      out += static_cast<char>(c);
+    else
+      out += fmt::format("\\x{:02X}", c);
   }
-  return out + (text.size() > 40 ? "…'" : "'");
+  return out + (text.size() > 40 ? "…" : "");
 }
+
+/// printable(text) in single quotes.
+std::string quote(std::string_view text) {
+  return "'" + printable(text) + "'";
+}
+
+/// The UTF-8 byte order mark that some editors put at the start of a text file.
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
 
 std::size_t count_fields(std::string_view line) {
   return 1 + std::count(line.begin(), line.end(), ',');
@@ -148,6 +160,8 @@ struct RecordReader::State {
     if (!next_line(text)) {
       throw Error(fmt::format("{} is empty; a record begins with the line '{}'.", name, kRecordMagic));
     }
+    // A byte order mark before the first line is no part of it.
+    if (text.starts_with(kByteOrderMark)) text.remove_prefix(kByteOrderMark.size());
     text = trim(text);
     if (text != kRecordMagic) {
       std::string_view body = text.substr(text.empty() ? 0 : 1);
@@ -244,12 +258,13 @@ struct RecordReader::State {
         if (field == last && line_unterminated) fail_truncated();
         const char* field_end = std::find(field, last, ',');
         const std::string_view field_text = trim({field, static_cast<std::size_t>(field_end - field)});
-        if (field_text.empty()) fail(fmt::format("column {} ({}) is empty", i + 1, columns[i]));
-        fail(
-            fmt::format("column {} ({}) is {}, which is not a number", i + 1, columns[i], quote(field_text)));
+        if (field_text.empty()) fail(fmt::format("column {} ({}) is empty", i + 1, printable(columns[i])));
+        fail(fmt::format("column {} ({}) is {}, which is not a number", i + 1, printable(columns[i]),
+                         quote(field_text)));
       }
       if (!std::isfinite(values[i])) {
-        fail(fmt::format("column {} ({}) is {}; a record holds finite numbers only", i + 1, columns[i],
+        fail(fmt::format("column {} ({}) is {}; a record holds finite numbers only", i + 1,
+                         printable(columns[i]),
                          quote({field, static_cast<std::size_t>(result.ptr - field)})));
       }
       if (i + 1 < count) {

@@ -10,6 +10,7 @@
 // [uncertainty] has the keys of [centrifuge.errors] with their units; each value is the standard
 // uncertainty of that error (all zero by default). In a harmonic term, amplitude is the standard
 // uncertainty of that harmonic's amplitude and phase_deg its nominal phase.
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -24,7 +25,14 @@ namespace gyrocal {
 /// wrong type, or a value that is not finite or out of its range.
 Scenario parse_scenario(std::string_view toml_text, const std::string& source_name);
 
-/// Read and parse the configuration file at path. Throws Error naming the file if it cannot be read.
+/// The largest configuration file load_scenario reads: 16 MiB.
+inline constexpr std::size_t kMaxConfigurationBytes = std::size_t{16} << 20;
+
+/// Read and parse the configuration file at path (any readable file: a regular file, a FIFO, /dev/stdin).
+/// Throws Error naming the file if it cannot be read, is a directory, is larger than
+/// kMaxConfigurationBytes (only that much plus one byte is read: /dev/zero ends quickly), or is empty or
+/// white space only (more likely a failed write than a choice of every default; a file of comments alone
+/// does give the default scenario).
 Scenario load_scenario(const std::filesystem::path& path);
 
 /// The scenario as a commented TOML configuration with every key, one comment per key giving its meaning
