@@ -18,12 +18,13 @@ import gyrocal
 
 CLI = os.environ.get("GYROCAL_CLI", "gyrocal")
 
-# A short test so that each simulation and calibration takes a fraction of a second: 4 beta positions x 4
-# revolutions at 9.9 rad/s, sampled at 50 Hz (about 700 rows; window means need 4 for 3 complete ones), with the default scenario's machine errors.
+# A short test so that each simulation and calibration takes a fraction of a second: 4 beta positions x 3
+# revolutions at 9.9 rad/s, sampled at 100 Hz (about 1200 rows; at 50 Hz a sample step of 11 deg can miss the window
+# means' 10 deg windows, and a revolution that misses one does not count), with the default scenario's machine errors.
 SMALL_TEST = """
 [test]
-sample_rate_hz = 50.0
-revolutions = 4
+sample_rate_hz = 100.0
+revolutions = 3
 settle_s = 1.0
 seed = 3
 """
@@ -91,7 +92,7 @@ def test_scenario_to_toml_is_init_and_parses_back(small, tmp_path):
     assert gyrocal.Scenario().to_toml() == out.read_text()
     config, sc = small
     again = gyrocal.Scenario.parse(sc.to_toml())
-    assert (again.sample_rate_hz, again.seed, again.rate_rad_s) == (50.0, 3, 9.9)
+    assert (again.sample_rate_hz, again.seed, again.rate_rad_s) == (100.0, 3, 9.9)
     assert again.to_toml() == sc.to_toml()
 
 
