@@ -1,5 +1,6 @@
-// Simulation throughput, one core: rows/s of the default scenario's test (MODEL.md section 11) simulated and
-// written as CSV, and the parts of one row (timeline, exact model, noise, formatting) on their own.
+// Simulation throughput, one core: rows/s of the default scenario's test (docs/physics.md section 11)
+// simulated and written as CSV, and the parts of one row (timeline, exact model, noise, formatting) on their
+// own.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 

@@ -1,5 +1,5 @@
 // Calibration against known truth: the whole pipeline (simulate -> reduce -> channels -> identify) on
-// simulated tests, noise-free and noisy, with the expectations of MODEL.md sections 8 and 9.
+// simulated tests, noise-free and noisy, with the expectations of docs/physics.md sections 8 and 9.
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -44,13 +44,13 @@ bool sanitized() {
   return std::getenv("GYROCAL_SANITIZED") != nullptr;
 }
 
-/// Ar of MODEL.md section 5, written out here.
+/// Ar of docs/physics.md section 5, written out here.
 double radial_level(const Scenario& s, double omega) {
   return omega * s.centrifuge.radius_m *
          (omega + 2 * s.site.earth_rate_rad_s * std::sin(s.site.latitude_rad)) / s.site.gravity_m_s2;
 }
 
-/// The single-speed combinations of MODEL.md section 8 from the truth.
+/// The single-speed combinations of docs/physics.md section 8 from the truth.
 std::map<std::string, double> true_combinations(const Scenario& s, double ar) {
   const DriftCoefficients& d = s.gyro;
   return {{"dII-dSS", d[Coefficient::dII] - d[Coefficient::dSS]},
@@ -108,7 +108,8 @@ TEST(Calibrate, NoiseFreeDefaultScenarioFullCompensationRecoversTheTruth) {
 TEST(Calibrate, NoiseFreeDefaultScenarioWithoutAndWithSeedCompensationLandWhereTheModelSays) {
   const Scenario s = noise_free_default();
   const Pipeline p = run(s);
-  // MODEL.md section 8: dI -1.82 and dOS 0.66 uncompensated; -0.18 and -1.38 with the seed's compensation.
+  // docs/physics.md section 8: dI -1.82 and dOS 0.66 uncompensated; -0.18 and -1.38 with the seed's
+  // compensation.
   const CalibrationResult none = calibrate(s, p, Method::kClosedForm, Compensation::kNone);
   const CalibrationResult seed = calibrate(s, p, Method::kClosedForm, Compensation::kSeed);
   EXPECT_NEAR(get(none, Coefficient::dI).value, -1.82, 0.005);

@@ -198,7 +198,7 @@ TEST_F(Cli, SimulateThenCalibrateWritesTheResultJsonOfTheInterface) {
     for (const char* key :
          {"index", "beta_deg", "gamma_deg", "rate_rad_s", "mean_deg_h", "std_err_deg_h", "samples"})
       EXPECT_TRUE(j["positions"][0].contains(key)) << key;
-    EXPECT_EQ(j["positions"][8]["beta_deg"].get<double>(), 90.0);  // position 9 of MODEL.md section 7
+    EXPECT_EQ(j["positions"][8]["beta_deg"].get<double>(), 90.0);  // position 9 of docs/physics.md section 7
   }
   // The result is never written over the record.
   const Outcome over = run("calibrate " + path("r.csv").string() + cfg + " --json " + path("r.csv").string());

@@ -1,5 +1,5 @@
 // The configuration file: round trips, units, defaults, and every kind of bad value refused with its key
-// and line (INTERFACE.md, "Configuration (TOML)").
+// and line (docs/contract.md, "Configuration (TOML)").
 #include <bit>
 #include <charconv>
 #include <cmath>

@@ -1,8 +1,8 @@
-// What a plan identifies (MODEL.md sections 8 and 9) on plans other than the seed's 16 positions: every
-// coefficient reported identifiable lands on the truth, every reported combination is what its coefficients
-// say and carries one of MODEL.md's names only when it is that combination, every unidentifiable direction is
-// listed, and the advice fits the plan that was run. Also: the closed form's condition, and messages that
-// name the key or the position at fault instead of the solver's internals.
+// What a plan identifies (docs/physics.md sections 8 and 9) on plans other than the seed's 16 positions:
+// every coefficient reported identifiable lands on the truth, every reported combination is what its
+// coefficients say and carries one of docs/physics.md's names only when it is that combination, every
+// unidentifiable direction is listed, and the advice fits the plan that was run. Also: the closed form's
+// condition, and messages that name the key or the position at fault instead of the solver's internals.
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -66,7 +66,8 @@ const Plan kStatic = {"main axis stopped", {0.0}, {0, 180, 90, 270}, {0, 180, 90
 const Plan kBeta45 = {"beta 45", {9.9}, {45, 135, 225, 315}, {0, 180, 90, 270}};
 const Plan kTwoSpeeds = {"two speeds", {9.9, 0.0}, {0, 180, 90, 270}, {0, 180, 90, 270}};
 
-/// MODEL.md section 5's nominal specific force, written out here: a_I, a_O, a_S at (rate, beta, gamma).
+/// docs/physics.md section 5's nominal specific force, written out here: a_I, a_O, a_S at (rate, beta,
+/// gamma).
 std::array<double, 3> nominal_force(const Scenario& s, double rate, double beta, double gamma) {
   const double ar = rate * s.centrifuge.radius_m *
                     (rate + 2 * s.site.earth_rate_rad_s * std::sin(s.site.latitude_rad)) /
@@ -91,7 +92,7 @@ std::vector<bool> never_excited(const Scenario& s) {
   return zero;
 }
 
-/// MODEL.md section 8's named combinations at radial level ar, as coefficient vectors on dF..dOS.
+/// docs/physics.md section 8's named combinations at radial level ar, as coefficient vectors on dF..dOS.
 std::map<std::string, std::vector<double>> named_definitions(double ar) {
   return {{"dII-dSS", {0, 0, 0, 0, 1, 0, -1, 0, 0, 0}},
           {"dOO-dSS", {0, 0, 0, 0, 0, 1, -1, 0, 0, 0}},
@@ -141,7 +142,7 @@ void expect_honest(const Scenario& s, const CalibrationResult& r, bool noisy, co
       off = std::max(off, std::abs(c.coefficients[k] - it->second[k]));
     }
     EXPECT_LE(off, 1e-3 * largest) << c.name
-                                   << " is reported under MODEL.md's name but is not that combination";
+                                   << " is reported under docs/physics.md's name but is not that combination";
   }
   // Every unidentifiable direction is derived and listed, in the result and in the warning.
   const int directions = 10 - r.rank;

@@ -1,4 +1,4 @@
-// The least-squares core (MODEL.md section 9): NIST StRD linear regression sets graded by LRE,
+// The least-squares core (docs/physics.md section 9): NIST StRD linear regression sets graded by LRE,
 // rank deficiency found with its null direction and estimable combinations, honest uncertainty
 // (z-scores of known truth), and bad inputs refused with their message.
 #include <gtest/gtest.h>

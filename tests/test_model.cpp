@@ -1,6 +1,6 @@
 // The exact centrifuge model against independent routes: the nominal formulas with the terms they omit
-// computed here, a finite difference of a pose built here from MODEL.md section 3, MODEL.md section 7's
-// table typed in, first-order error effects, and invariants.
+// computed here, a finite difference of a pose built here from docs/physics.md section 3, docs/physics.md
+// section 7's table typed in, first-order error effects, and invariants.
 #include <cmath>
 #include <random>
 
@@ -125,7 +125,7 @@ TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAcceleratesAndThePlat
   }
 }
 
-// Gyro axes I, O, S in G for a perfect machine at heading psi and position beta (MODEL.md section 2).
+// Gyro axes I, O, S in G for a perfect machine at heading psi and position beta (docs/physics.md section 2).
 Matrix3d nominal_axes(double psi, double beta) {
   Matrix3d a;
   a.col(0) = Vector3d(std::cos(beta) * std::cos(psi), std::cos(beta) * std::sin(psi), std::sin(beta));
@@ -163,7 +163,7 @@ TEST(ExactModel, PerfectMachineEqualsNominalPlusTheTermsTheSeedOmits) {
           EXPECT_NEAR(ex.specific_force_g[1], no.a_O_g + extra[1], 1e-12 * scale);
           EXPECT_NEAR(ex.specific_force_g[2], no.a_S_g + extra[2], 1e-12 * scale);
           EXPECT_NEAR(ex.rate_rad_s[0], no.omega_I_rad_s, 1e-12 * site.earth_rate_rad_s);
-          // The vertical Coriolis term is as large as MODEL.md section 5 says (1.1e-4 g at 10 g).
+          // The vertical Coriolis term is as large as docs/physics.md section 5 says (1.1e-4 g at 10 g).
           if (omega == 9.9 && t == 0.0 && beta == 0.0 && psi0 == 0.0) {
             EXPECT_NEAR(extra_g.z() / std::cos(th), 1.1e-4, 0.05e-4);
           }
@@ -173,8 +173,8 @@ TEST(ExactModel, PerfectMachineEqualsNominalPlusTheTermsTheSeedOmits) {
   }
 }
 
-// MODEL.md section 7, typed in: beta, gamma (deg) and the coefficients of (a_I, a_O, a_S) on (Ar, 1) and of
-// omega_I on (k1*omega, k2*omega, Omega_N, Omega_U).
+// docs/physics.md section 7, typed in: beta, gamma (deg) and the coefficients of (a_I, a_O, a_S) on (Ar, 1)
+// and of omega_I on (k1*omega, k2*omega, Omega_N, Omega_U).
 struct TableRow {
   double beta_deg, gamma_deg;
   double ai_ar, ai_1, ao_ar, as_ar, as_1;

@@ -211,7 +211,7 @@ TEST(GyroNoise, MeanOfWhiteNoiseHasTheStandardDeviationTheAngleRandomWalkPredict
   // The angle random walk N (deg/sqrt(h)) says the mean rate over T hours has standard deviation N / sqrt(T)
   // deg/h.
   GyroNoise noise;
-  noise.angle_random_walk_deg_rt_h = 0.002;  // MODEL.md section 11
+  noise.angle_random_walk_deg_rt_h = 0.002;  // docs/physics.md section 11
   const double fs = 200.0;
   const std::size_t block = 2000;  // 10 s
   const std::size_t blocks = sanitized() ? 400 : 1500;

@@ -1,4 +1,4 @@
-// The record format (INTERFACE.md, "Record (CSV)") and the atomic output file.
+// The record format (docs/contract.md, "Record (CSV)") and the atomic output file.
 #include <gtest/gtest.h>
 
 #include <algorithm>

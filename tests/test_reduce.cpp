@@ -1,5 +1,5 @@
-// Reduction of a record that is not clean (MODEL.md section 14): spikes anywhere in the record, and too few
-// revolutions for the scatter between them to be a measurement.
+// Reduction of a record that is not clean (docs/physics.md section 14): spikes anywhere in the record, and
+// too few revolutions for the scatter between them to be a measurement.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>

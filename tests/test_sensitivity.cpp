@@ -1,5 +1,5 @@
-// The seed's error study (MODEL.md sections 8 and 10) on the default scenario: which machine error shifts
-// which estimate, without and with compensation, exactly (noise-free).
+// The seed's error study (docs/physics.md sections 8 and 10) on the default scenario: which machine error
+// shifts which estimate, without and with compensation, exactly (noise-free).
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -72,8 +72,8 @@ TEST(Sensitivity, SeedsFindingWithoutCompensation) {
   EXPECT_GT(std::abs(shift(py, kNone, "dI")), 100 * sigma.at("dI"));
   for (const SensitivityRow* r : {&px, &py, &row("counter_rate_mismatch")})
     for (const char* name : kPrimaryUnaffected) EXPECT_LT(std::abs(shift(*r, kNone, name)), 1e-4) << name;
-  // Delta omega enters omega_I as delta_omega * sin(beta) (MODEL.md section 5): the 1 g form of dI, which
-  // subtracts Omega_U, absorbs all of it; the centrifuge forms (positions at beta = 0, 180) see none.
+  // Delta omega enters omega_I as delta_omega * sin(beta) (docs/physics.md section 5): the 1 g form of dI,
+  // which subtracts Omega_U, absorbs all of it; the centrifuge forms (positions at beta = 0, 180) see none.
   const SensitivityRow& dw = row("counter_rate_mismatch");
   EXPECT_NEAR(shift(dw, kNone, "dI_1g"), 2e-6 * kRadPerSecToDegPerHour, 1e-4);
   EXPECT_LT(std::abs(shift(dw, kNone, "dI")), 1e-4);
@@ -83,9 +83,9 @@ TEST(Sensitivity, SeedsFindingWithoutCompensation) {
 }
 
 TEST(Sensitivity, PerpendicularityShiftAgreesWithTheFirstOrderClosedForm) {
-  // MODEL.md section 8: dOS = -[(W3 - W4) - (W7 - W8) + 4 k2 w] / (4 Ar). Uncompensated, the outputs carry
-  // -k2 w, k2 w, k2 w, -k2 w at positions 3, 4, 7, 8 (section 7), so the estimate moves by k2 w / Ar, with
-  // k2 = count_perp_x. Likewise dI = [(W1 - W2) - (W5 - W6) - 4 k1 w] / (-4 Ar) moves by -k1 w / Ar with
+  // docs/physics.md section 8: dOS = -[(W3 - W4) - (W7 - W8) + 4 k2 w] / (4 Ar). Uncompensated, the outputs
+  // carry -k2 w, k2 w, k2 w, -k2 w at positions 3, 4, 7, 8 (section 7), so the estimate moves by k2 w / Ar,
+  // with k2 = count_perp_x. Likewise dI = [(W1 - W2) - (W5 - W6) - 4 k1 w] / (-4 Ar) moves by -k1 w / Ar with
   // k1 = -count_perp_y.
   const Scenario s = study_scenario();
   const double w = s.test.rates_rad_s[0];
@@ -102,8 +102,8 @@ TEST(Sensitivity, SeedCompensationIsExactForPerpendicularityAndRateMismatchNotFo
     for (const char* name : {"dI", "dOS"})
       EXPECT_LT(std::abs(shift(row(error), kSeed, name)), 1e-4) << error << " " << name;
   EXPECT_LT(std::abs(shift(row("counter_rate_mismatch"), kSeed, "dI_1g")), 1e-4);
-  // A wobble's own rate n a w (MODEL.md section 5) is not in the seed's terms: the configured second
-  // harmonics still shift dI or dOS, by hundreds of sigmas (MODEL.md section 8's -0.18 and -1.38).
+  // A wobble's own rate n a w (docs/physics.md section 5) is not in the seed's terms: the configured second
+  // harmonics still shift dI or dOS, by hundreds of sigmas (docs/physics.md section 8's -0.18 and -1.38).
   EXPECT_GT(std::abs(shift(row("counter_wobble_x", 2, 20.0), kSeed, "dI")), 0.1);
   EXPECT_GT(std::abs(shift(row("counter_wobble_y", 2, 70.0), kSeed, "dOS")), 0.1);
 }
@@ -118,9 +118,9 @@ TEST(Sensitivity, FullCompensationRemovesEveryShift) {
 }
 
 TEST(Sensitivity, FirstHarmonicMainWobbleActsLikeACounterPerpendicularity) {
-  // MODEL.md section 10: per arcsec, a first-harmonic main-axis wobble about x shifts dOS (cosine part) or
-  // dI (sine part) as much as the counter platform's perpendicularity does, and the seed's compensation,
-  // which knows only the counter platform, leaves it.
+  // docs/physics.md section 10: per arcsec, a first-harmonic main-axis wobble about x shifts dOS (cosine
+  // part) or dI (sine part) as much as the counter platform's perpendicularity does, and the seed's
+  // compensation, which knows only the counter platform, leaves it.
   const double dos_per_arcsec = shift(row("counter_perpendicularity_x"), kNone, "dOS") / 3.0;
   const double di_per_arcsec = shift(row("counter_perpendicularity_y"), kNone, "dI") / -2.0;
   const SensitivityRow& cosine = row("main_wobble_x", 1, 0.0);  // configured, 0.5 arcsec
@@ -133,8 +133,9 @@ TEST(Sensitivity, FirstHarmonicMainWobbleActsLikeACounterPerpendicularity) {
 }
 
 TEST(Sensitivity, FirstHarmonicCounterWobbleShiftsTheOneGFormOfDS) {
-  // MODEL.md section 10: k1 = -count_wobble_y(psi_r) with psi_r = -gamma makes k1 cos(gamma) w a constant,
-  // which dS_1g = [(W1 + W2) - (W5 + W6) - 4 Omega_N] / 4 takes for a drift; the seed's terms remove it.
+  // docs/physics.md section 10: k1 = -count_wobble_y(psi_r) with psi_r = -gamma makes k1 cos(gamma) w a
+  // constant, which dS_1g = [(W1 + W2) - (W5 + W6) - 4 Omega_N] / 4 takes for a drift; the seed's terms
+  // remove it.
   const SensitivityRow& r = row("counter_wobble_y", 1, 0.0);
   const auto& sigma = default_study().closed_form_noise_std;
   EXPECT_GT(std::abs(shift(r, kNone, "dS_1g")), 100 * sigma.at("dS_1g"));

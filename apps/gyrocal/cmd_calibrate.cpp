@@ -15,7 +15,7 @@ void register_calibrate(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
-  sub->add_option("RECORD", opt->record, "Test record (CSV, INTERFACE.md)")->required();
+  sub->add_option("RECORD", opt->record, "Test record (CSV, docs/contract.md)")->required();
   sub->add_option("--config", opt->config,
                   "Configuration file (TOML): the machine, site and plan of the test");
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")

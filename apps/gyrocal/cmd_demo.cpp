@@ -40,7 +40,8 @@ void register_demo(CLI::App& app) {
     const std::string record = folder.final_path("record.csv").string();
 
     fmt::print(
-        "gyrocal demo: the default scenario of MODEL.md section 11 (R0 {} m, {} rad/s, Ar {:.3f} g).\n",
+        "gyrocal demo: the default scenario of docs/physics.md section 11 (R0 {} m, {} rad/s, Ar {:.3f} "
+        "g).\n",
         s.centrifuge.radius_m, s.centrifuge.rate_rad_s,
         radial_level_g(s.site, s.centrifuge.radius_m, s.centrifuge.rate_rad_s));
     AtomicOutputFile file(record_staged, /*overwrite=*/false);

@@ -1,4 +1,4 @@
-// gyrocal montecarlo: uncertainty budget over random machine errors and noise (INTERFACE.md).
+// gyrocal montecarlo: uncertainty budget over random machine errors and noise (docs/contract.md).
 #include <unistd.h>
 
 #include <algorithm>

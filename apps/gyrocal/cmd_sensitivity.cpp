@@ -1,4 +1,4 @@
-// gyrocal sensitivity: the seed's error study (MODEL.md section 10, INTERFACE.md).
+// gyrocal sensitivity: the seed's error study (docs/physics.md section 10, docs/contract.md).
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,7 +27,8 @@ std::string row_label(const SensitivityRow& row) {
 /// Per compensation: the closed forms' shifts in units of their noise std, '.' below the threshold.
 std::string sensitivity_table(const SensitivityResult& r) {
   std::string s = fmt::format(
-      "Each machine error alone (MODEL.md section 10): shift = estimate(error) - estimate(no error), exact "
+      "Each machine error alone (docs/physics.md section 10): shift = estimate(error) - estimate(no error), "
+      "exact "
       "(noise-free).\nCells: shift / sigma, sigma = the estimate's predicted noise std; '.' = below {} sigma "
       "(does not matter). * = typical magnitude (zero in the configuration).\n",
       r.threshold);

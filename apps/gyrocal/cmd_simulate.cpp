@@ -1,4 +1,4 @@
-// gyrocal simulate: simulate a whole test into a record (INTERFACE.md).
+// gyrocal simulate: simulate a whole test into a record (docs/contract.md).
 #include <sys/statvfs.h>
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-// gyrocal: the command line (INTERFACE.md). Parsing arguments and printing only; no physics here.
+// gyrocal: the command line (docs/contract.md). Parsing arguments and printing only; no physics here.
 #include <exception>
 #include <string>
 

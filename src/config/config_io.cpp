@@ -87,7 +87,7 @@ constexpr std::string_view kCoefficientMeanings[kNumCoefficients] = {
     "drift per aO^2", "drift per aS^2",      "drift per aI*aO",     "drift per aI*aS",     "drift per aO*aS",
 };
 
-/// A key of [centrifuge.errors] and [uncertainty] (MODEL.md section 3): exactly one of scalar, series,
+/// A key of [centrifuge.errors] and [uncertainty] (docs/physics.md section 3): exactly one of scalar, series,
 /// triple is set. A series' terms have the keys harmonic, amplitude_key (in the series' file unit) and
 /// phase_deg.
 struct ErrorKey {
@@ -756,9 +756,10 @@ std::string scenario_to_toml(const Scenario& s) {
                 ": TOML integers end at 9223372036854775807.");
   }
   TomlWriter w;
-  w.comment("gyrocal configuration (INTERFACE.md, \"Configuration (TOML)\"). Every key is optional: a");
+  w.comment("gyrocal configuration (docs/contract.md, \"Configuration (TOML)\"). Every key is optional: a");
   w.comment(
-      "missing key keeps the value of the default scenario (MODEL.md section 11). Units are in the key");
+      "missing key keeps the value of the default scenario (docs/physics.md section 11). Units are in the "
+      "key");
   w.comment(
       "names. A harmonic series is an array of { harmonic = n >= 1, amplitude_<unit> >= 0, phase_deg }");
   w.comment(
@@ -771,10 +772,10 @@ std::string scenario_to_toml(const Scenario& s) {
   w.section("centrifuge", "");
   write_numbers(w, kCentrifugeKeys, s.centrifuge);
 
-  w.section("centrifuge.errors", "Machine errors, names as in MODEL.md section 3.");
+  w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
   write_errors(w, s.errors);
 
-  w.section("gyro", "The gyro's drift coefficients (MODEL.md section 6): the truth, for simulation.");
+  w.section("gyro", "The gyro's drift coefficients (docs/physics.md section 6): the truth, for simulation.");
   for (std::size_t i = 0; i < kNumCoefficients; ++i) {
     w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
           std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));

@@ -5,7 +5,7 @@
 namespace gyrocal {
 
 Scenario default_scenario() {
-  // MODEL.md section 11. Site, geometry, noise and test defaults are the struct defaults; the machine
+  // docs/physics.md section 11. Site, geometry, noise and test defaults are the struct defaults; the machine
   // errors and the truth are set here.
   Scenario s;
   CentrifugeErrors& e = s.errors;

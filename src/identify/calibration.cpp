@@ -116,7 +116,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   const std::vector<int> k16 = sixteen_positions(reduction.positions);
   if (k16.empty())
     throw Error(
-        "the closed forms need the 16 positions of MODEL.md section 7 (beta and gamma in {0, 90, 180, "
+        "the closed forms need the 16 positions of docs/physics.md section 7 (beta and gamma in {0, 90, 180, "
         "270} deg at one spinning rate); this plan does not have them: use --method least-squares.");
   std::array<double, 16> w{};
   const Eigen::MatrixXd all = position_covariance(reduction, 0.0);
@@ -124,7 +124,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   for (std::size_t k = 0; k < 16; ++k) {
     const auto i = static_cast<std::size_t>(k16[k]);
     const PositionChannels& ch = channels[i];
-    // Compensation: remove what the machine adds beyond a perfect one (MODEL.md section 8).
+    // Compensation: remove what the machine adds beyond a perfect one (docs/physics.md section 8).
     w[k] =
         reduction.positions[i].mean_deg_h - (ch.omega_deg_h(options.compensation) - ch.omega_nominal_deg_h);
     for (std::size_t l = 0; l < 16; ++l)
@@ -159,10 +159,10 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     r.combinations.push_back({f.name, f.unit, f.value(w), std_of(f), combination_coefficients.at(f.name)});
   r.unidentifiable.push_back(
       fmt::format("dF, dII, dOO, dSS: adding c to dII, dOO, dSS and -(1+Ar^2) c to dF "
-                  "changes no output at one speed (MODEL.md section 8)"));
+                  "changes no output at one speed (docs/physics.md section 8)"));
   r.rank = 9;
   if (options.method != Method::kClosedForm) return;  // least squares borrows only the second expressions
-  // Its condition, as least squares reports it for the same 16 positions (MODEL.md section 9): the
+  // Its condition, as least squares reports it for the same 16 positions (docs/physics.md section 9): the
   // condition of their whitened, equilibrated design; and how much uncertainty the closed forms give away:
   // the largest ratio of a form's standard uncertainty to least squares' for the same quantity from the same
   // 16 positions and covariance (1 = nothing lost; docs/calibration.md).
@@ -366,7 +366,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   for (const NamedEstimate& c : fit.combinations)
     if (c.name.rfind("combination ", 0) == 0)
       generic += fmt::format(
-          " {} = {} is estimable instead (not one of MODEL.md section 8's).", c.name,
+          " {} = {} is estimable instead (not one of docs/physics.md section 8's).", c.name,
           describe_combination(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), sol.names));
   const std::size_t k = fit.directions.size();
   r.warnings.push_back(

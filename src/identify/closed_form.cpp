@@ -44,7 +44,7 @@ LinearForm combine(std::string name, std::string unit, const LinearForm& a, doub
 ClosedForms closed_forms(double ar, double omega_n, double omega_u) {
   const std::string g1 = "deg/h/g", g2 = "deg/h/g^2";
   ClosedForms cf;
-  // MODEL.md section 8 (seed eq. 7-9 and the cross terms), with k1 = k2 = 0 after compensation.
+  // docs/physics.md section 8 (seed eq. 7-9 and the cross terms), with k1 = k2 = 0 after compensation.
   cf.primary = {
       form("dI", g1, {{1, 1}, {2, -1}, {5, -1}, {6, 1}}, -4 * ar),
       form("dO", g1, {{3, -1}, {4, 1}, {7, -1}, {8, 1}}, 4 * ar),
@@ -59,7 +59,7 @@ ClosedForms closed_forms(double ar, double omega_n, double omega_u) {
       form("dS_1g", g1, {{1, 1}, {2, 1}, {5, -1}, {6, -1}}, 4, -4 * omega_n),
       form("dIS_b", g2, {{9, 1}, {10, -1}, {13, 1}, {14, -1}}, 4 * ar),
   };
-  // What one speed gives of dF, dII, dOO, dSS (MODEL.md section 8, "What one speed cannot give").
+  // What one speed gives of dF, dII, dOO, dSS (docs/physics.md section 8, "What one speed cannot give").
   const LinearForm s1 = form("S1", "deg/h", {{1, 1}, {2, 1}, {5, 1}, {6, 1}}, 4);
   const LinearForm s2 = form("S2", "deg/h", {{3, 1}, {4, 1}, {7, 1}, {8, 1}}, 4);
   const LinearForm s3 = form("S3", "deg/h", {{9, 1}, {10, 1}, {13, 1}, {14, 1}}, 4);

@@ -1,5 +1,5 @@
-// What a plan identifies of the ten drift coefficients (MODEL.md sections 8 and 9; docs/calibration.md,
-// "Identifiability").
+// What a plan identifies of the ten drift coefficients (docs/physics.md sections 8 and 9;
+// docs/calibration.md, "Identifiability").
 #include "gyrocal/identify/identifiability.hpp"
 
 #include <algorithm>
@@ -83,7 +83,7 @@ LeastSquaresSolution expand(const LeastSquaresSolution& s, const std::vector<Ind
   return e;
 }
 
-/// Rows of nominal regressors (MODEL.md section 5) at every (rate, beta, gamma) of the three lists.
+/// Rows of nominal regressors (docs/physics.md section 5) at every (rate, beta, gamma) of the three lists.
 MatrixXd nominal_rows(const CentrifugeModel& model, const std::vector<double>& rates,
                       const std::vector<double>& betas, const std::vector<double>& gammas) {
   MatrixXd x(static_cast<Index>(rates.size() * betas.size() * gammas.size()), kNumCoefficients);
@@ -253,7 +253,8 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   if (nn == 0) return out;
 
   // Every unidentifiable direction, in a canonical form: reduced row echelon with pivots from the last
-  // coefficient, so that MODEL.md section 8's (-(1+Ar^2), 1, 1, 1) on (dF, dII, dOO, dSS) reads as written.
+  // coefficient, so that docs/physics.md section 8's (-(1+Ar^2), 1, 1, 1) on (dF, dII, dOO, dSS) reads as
+  // written.
   std::vector<Index> reversed, forward;
   for (Index j = n - 1; j >= 0; --j) reversed.push_back(j);
   for (Index j = 0; j < n; ++j) forward.push_back(j);
@@ -319,7 +320,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
     chosen_scaled.push_back(kept);
   };
 
-  // MODEL.md section 8's names, only where the estimable combination IS the named one.
+  // docs/physics.md section 8's names, only where the estimable combination IS the named one.
   const auto e = [n](Coefficient k) { return VectorXd::Unit(n, static_cast<Index>(k)); };
   struct Named {
     std::string name, unit;

@@ -1,4 +1,4 @@
-// Weighted linear least squares (MODEL.md section 9; method and measured accuracy in
+// Weighted linear least squares (docs/physics.md section 9; method and measured accuracy in
 // docs/least_squares.md).
 #include "gyrocal/identify/least_squares.hpp"
 

@@ -35,7 +35,7 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoeff
       unit.emplace_back(kCoefficientUnits[k]);
     }
   if (r.method == Method::kClosedForm) {
-    // The 1 g forms estimate the same coefficients as the primary ones (MODEL.md section 8).
+    // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
     const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
                                                       {"dO_1g", Coefficient::dO},
                                                       {"dS_1g", Coefficient::dS},

@@ -214,7 +214,8 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   base.errors = CentrifugeErrors{};
   if (sixteen_positions(planned_reduction(base).positions).empty())
     throw Error(
-        "the sensitivity study needs the 16 positions of MODEL.md section 7 (beta and gamma in {0, 90, 180, "
+        "the sensitivity study needs the 16 positions of docs/physics.md section 7 (beta and gamma in {0, "
+        "90, 180, "
         "270} deg at one spinning rate) for its closed forms; this plan does not have them.");
 
   const std::vector<std::pair<MachineErrorTerm, double>> terms = sensitivity_terms(scenario.errors);

@@ -178,7 +178,7 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   if (!e.lever_arm_m.isZero(0.0)) f.translate(e.lever_arm_m);
   f.rotate_constant(model.mount_rotation());
 
-  // MODEL.md section 4.
+  // docs/physics.md section 4.
   const Vector3d& we = model.earth_rate_g();
   const double g = model.site().gravity_m_s2;
   const Vector3d inertial_acceleration =

@@ -146,7 +146,7 @@ class Builder {
  private:
   double revolutions_s(double rate) const { return test_.revolutions * kTwoPi / std::abs(rate); }
 
-  /// The counter platform's servo law at t (MODEL.md section 3), on the current branch.
+  /// The counter platform's servo law at t (docs/physics.md section 3), on the current branch.
   double servo_angle(double t) const {
     return -main_at(main_, t).angle_rad + timeline_.psi0_rad + timeline_.counter_rate_mismatch_rad_s * t +
            servo_offset_rad_;

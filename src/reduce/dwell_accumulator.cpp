@@ -153,7 +153,7 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   pending_.push_back({t, gamma, values[0]});
 }
 
-// MODEL.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
+// docs/physics.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
 // outlier_threshold robust standard deviations of the block's residuals it is an outlier, the fit is
 // repeated without the outliers and the test with it, until the outliers do not change. Outliers are
 // replaced by the final fit's value at their instant, so the reduction operator (which samples, which

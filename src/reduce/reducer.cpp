@@ -184,8 +184,8 @@ struct Reducer::State {
       d.gammas_rad = plan.gamma_rad;
     }
     d.gyro = r.acc->finish(0);
-    // MODEL.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate at
-    // which clean noise reaches the rule's threshold).
+    // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
+    // at which clean noise reaches the rule's threshold).
     if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
       warnings.push_back(fmt::format(
           "{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} robust standard "

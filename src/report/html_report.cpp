@@ -145,7 +145,7 @@ std::string scalar_text(const json& j) {
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-/// Names in the order of MODEL.md (coefficients, the closed form's alternatives, the combinations of
+/// Names in the order of docs/physics.md (coefficients, the closed form's alternatives, the combinations of
 /// section 8), then any other names alphabetically. nlohmann::json objects are sorted, so the
 /// order must be imposed here.
 std::vector<std::string> ordered_names(const std::set<std::string>& names) {
@@ -535,7 +535,7 @@ void Renderer::combinations(std::string& out) {
                     num_cell(num(std_dev, 2))});
   }
   out +=
-      "<p class=\"note\">What the test identifies where single coefficients are not (MODEL.md section "
+      "<p class=\"note\">What the test identifies where single coefficients are not (docs/physics.md section "
       "8).</p>\n";
   out += table({"combination", "estimate", "standard uncertainty"}, rows, "compact");
 }
@@ -555,7 +555,8 @@ void Renderer::alternatives(std::string& out) {
     rows.push_back({text_cell(name), num_cell(num(value)), num_cell(num(truth))});
   }
   out +=
-      "<p class=\"note\">The closed form's second expressions (MODEL.md section 8), beside the truth of the "
+      "<p class=\"note\">The closed form's second expressions (docs/physics.md section 8), beside the truth "
+      "of the "
       "coefficient they estimate.</p>\n";
   out += table({"alternative", "estimate", "truth"}, rows, "compact");
 }

@@ -1,7 +1,7 @@
 #pragma once
-// An independent route to the gyro's inputs, for tests: the pose of MODEL.md section 3 built by plain matrix
-// products (Eigen, long double) and differentiated by 8th-order central differences. It shares nothing with
-// src/model but the parameter structs.
+// An independent route to the gyro's inputs, for tests: the pose of docs/physics.md section 3 built by plain
+// matrix products (Eigen, long double) and differentiated by 8th-order central differences. It shares nothing
+// with src/model but the parameter structs.
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -12,8 +12,8 @@ namespace gyrocal::test_support {
 
 using Eigen::Vector3d;
 
-// The pose of MODEL.md section 3 by plain matrix products, as a function of time for a spinning dwell. In
-// long double: the finite difference divides round-off by h^2, and theta reaches hundreds of radians.
+// The pose of docs/physics.md section 3 by plain matrix products, as a function of time for a spinning dwell.
+// In long double: the finite difference divides round-off by h^2, and theta reaches hundreds of radians.
 using Real = long double;
 using Matrix3r = Eigen::Matrix<Real, 3, 3>;
 using Vector3r = Eigen::Matrix<Real, 3, 1>;

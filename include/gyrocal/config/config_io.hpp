@@ -1,7 +1,8 @@
 #pragma once
-// The configuration file (INTERFACE.md, "Configuration (TOML)"): reading a scenario from TOML and writing one
-// back as a commented file. Keys carry their unit in their name (deg, arcsec, m, rad_s, ...); the scenario
-// holds SI values (MODEL.md section 1). Every key is optional and defaults to default_scenario().
+// The configuration file (docs/contract.md, "Configuration (TOML)"): reading a scenario from TOML and writing
+// one back as a commented file. Keys carry their unit in their name (deg, arcsec, m, rad_s, ...); the
+// scenario holds SI values (docs/physics.md section 1). Every key is optional and defaults to
+// default_scenario().
 //
 // Relation of [centrifuge] rate_rad_s and [test] rates_rad_s: rate_rad_s is the main rate of a single
 // instant (`gyrocal inputs`), rates_rad_s the rates of the test. When [test] has no rates_rad_s, the test

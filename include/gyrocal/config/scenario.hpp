@@ -1,6 +1,6 @@
 #pragma once
 // A scenario: everything a configuration file describes. Every key is optional; the defaults are the
-// default scenario of MODEL.md section 11.
+// default scenario of docs/physics.md section 11.
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -24,11 +24,11 @@ struct Scenario {
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
 };
 
-/// The default scenario of MODEL.md section 11.
+/// The default scenario of docs/physics.md section 11.
 Scenario default_scenario();
 
 /// What `gyrocal demo` runs: the default scenario, with a standard uncertainty of 10% of each configured
-/// machine error in [uncertainty] (MODEL.md gives none; only the Monte Carlo budget uses them).
+/// machine error in [uncertainty] (docs/physics.md gives none; only the Monte Carlo budget uses them).
 Scenario demo_scenario();
 
 }  // namespace gyrocal

@@ -1,5 +1,5 @@
 #pragma once
-// Output files that appear whole or not at all (INTERFACE.md: "no partial output file is left behind";
+// Output files that appear whole or not at all (docs/contract.md: "no partial output file is left behind";
 // docs/interface.md, "Files").
 //
 // A regular file (new or replaced): bytes go to a temporary file in the target's folder; commit() renames it

@@ -1,5 +1,5 @@
 #pragma once
-// A periodic error as a harmonic series of its joint's angle (MODEL.md section 3):
+// A periodic error as a harmonic series of its joint's angle (docs/physics.md section 3):
 //   h(x) = sum_n a_n * cos(n*x + phi_n)
 // with its exact first and second derivatives in x. The amplitude's unit is the caller's (rad for a
 // wobble, m for a runout).

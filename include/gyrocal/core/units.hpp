@@ -1,5 +1,5 @@
 #pragma once
-// Units and constants (MODEL.md section 1). Internally SI: rad, rad/s, m, s; specific force in g.
+// Units and constants (docs/physics.md section 1). Internally SI: rad, rad/s, m, s; specific force in g.
 #include <numbers>
 
 namespace gyrocal {
@@ -13,9 +13,9 @@ inline constexpr double kRadToArcsec = 1.0 / kArcsecToRad;
 inline constexpr double kDegPerHourToRadPerSec = kPi / 180.0 / 3600.0;
 inline constexpr double kRadPerSecToDegPerHour = 1.0 / kDegPerHourToRadPerSec;
 
-/// Default Earth rate, rad/s (MODEL.md section 1).
+/// Default Earth rate, rad/s (docs/physics.md section 1).
 inline constexpr double kEarthRateRadS = 7.292115e-5;
-/// Default standard gravity, m/s^2 (MODEL.md section 1).
+/// Default standard gravity, m/s^2 (docs/physics.md section 1).
 inline constexpr double kStandardGravityMS2 = 9.80665;
 
 }  // namespace gyrocal

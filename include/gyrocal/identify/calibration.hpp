@@ -1,5 +1,5 @@
 #pragma once
-// Identify the drift coefficients from a reduced record (MODEL.md sections 8 and 9): the seed's closed
+// Identify the drift coefficients from a reduced record (docs/physics.md sections 8 and 9): the seed's closed
 // forms or general weighted least squares, with compensation none, seed or full.
 #include <array>
 #include <limits>
@@ -30,7 +30,7 @@ struct CalibrationOptions {
   double max_uncertainty_ratio = 1e4;
   /// A coefficient (or combination) is reported as identifiable when its share along the unidentifiable
   /// directions, in equilibrated coordinates, is at most this. Default 1e-4: exact regressors tilt the
-  /// unidentifiable direction of a single-speed plan by ~1e-6 off MODEL.md's, onto every coefficient.
+  /// unidentifiable direction of a single-speed plan by ~1e-6 off docs/physics.md's, onto every coefficient.
   double estimable_tolerance = 1e-4;
   /// A coefficient whose regressor stays below this fraction of the specific force (to the regressor's
   /// power) at every position is not excited by the plan and never identifiable. Default 1e-3
@@ -53,12 +53,13 @@ struct NamedEstimate {
   double value = 0.0;
   double std = std::numeric_limits<double>::quiet_NaN();
   /// For a combination: its coefficients on dF..dOS as estimated. With exact regressors the unidentifiable
-  /// direction is not exactly MODEL.md's, so the estimable combination differs from the named one in the
-  /// sixth digit or so; these are the coefficients of the one actually estimated. Empty otherwise.
+  /// direction is not exactly docs/physics.md's, so the estimable combination differs from the named one in
+  /// the sixth digit or so; these are the coefficients of the one actually estimated. Empty otherwise.
   std::vector<double> coefficients;
 };
 
-/// What the record held and what entered the estimate (MODEL.md section 14; INTERFACE.md data_quality).
+/// What the record held and what entered the estimate (docs/physics.md section 14; docs/contract.md
+/// data_quality).
 struct DataQuality {
   std::size_t rows_read = 0;  ///< rows in the record
   std::size_t rows_used = 0;  ///< rows inside the measured parts of the dwells that entered the estimate
@@ -106,8 +107,8 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
                                    const TestSpec& plan, const CalibrationOptions& options);
 
-/// The 16 positions of MODEL.md section 7 in the plan, at its first spinning rate: for k = 1..16 the index
-/// into reduction.positions, or an empty vector when the plan does not hold them.
+/// The 16 positions of docs/physics.md section 7 in the plan, at its first spinning rate: for k = 1..16 the
+/// index into reduction.positions, or an empty vector when the plan does not hold them.
 std::vector<int> sixteen_positions(const std::vector<ReducedPosition>& positions);
 
 }  // namespace gyrocal

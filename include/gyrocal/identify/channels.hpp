@@ -1,7 +1,7 @@
 #pragma once
-// The model's side of each reduced position: omega_I and the drift regressors, exact (MODEL.md section 4)
-// and nominal (section 5), evaluated on each dwell's samples and reduced by the very operator that
-// reduced the gyro output (reduce/dwell_accumulator.hpp).
+// The model's side of each reduced position: omega_I and the drift regressors, exact (docs/physics.md section
+// 4) and nominal (section 5), evaluated on each dwell's samples and reduced by the very operator that reduced
+// the gyro output (reduce/dwell_accumulator.hpp).
 #include <array>
 #include <vector>
 
@@ -11,7 +11,7 @@
 
 namespace gyrocal {
 
-/// What is subtracted from the measurements before identification (MODEL.md section 8).
+/// What is subtracted from the measurements before identification (docs/physics.md section 8).
 enum class Compensation {
   kNone,  ///< nothing known of the machine's errors: nominal inputs of a perfect machine
   kSeed,  ///< the seed's terms (k1 cos g - k2 sin g) w cos b + dw sin b from the configured errors

@@ -1,5 +1,5 @@
 #pragma once
-// The seed's closed forms for the 16-position test (MODEL.md section 8), each written once as a linear
+// The seed's closed forms for the 16-position test (docs/physics.md section 8), each written once as a linear
 // form over the 16 outputs W1..W16 (deg/h), so that its value and its standard uncertainty come from the
 // same definition.
 #include <array>

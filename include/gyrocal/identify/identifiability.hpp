@@ -1,8 +1,9 @@
 #pragma once
-// What a plan identifies of the ten drift coefficients (MODEL.md sections 8 and 9), derived from the design
-// actually run: the coefficients whose regressor the plan never excites, every unidentifiable direction in a
-// canonical form, the estimable combinations (MODEL.md section 8's names only where the estimable one IS the
-// named one) and which kind of extra data would identify the rest. docs/calibration.md, "Identifiability".
+// What a plan identifies of the ten drift coefficients (docs/physics.md sections 8 and 9), derived from the
+// design actually run: the coefficients whose regressor the plan never excites, every unidentifiable
+// direction in a canonical form, the estimable combinations (docs/physics.md section 8's names only where the
+// estimable one IS the named one) and which kind of extra data would identify the rest. docs/calibration.md,
+// "Identifiability".
 #include <string>
 #include <vector>
 
@@ -42,8 +43,8 @@ struct IdentifiabilityOptions {
 
 /// regressors: m x 10, the unwhitened regressors of each position (g units); whitened_design and
 /// whitened_observations: the same rows whitened by the positions' covariance. ar: the radial level of
-/// the first spinning rate (g), for MODEL.md section 8's named combinations. positions and model: the plan
-/// actually run, for the advice.
+/// the first spinning rate (g), for docs/physics.md section 8's named combinations. positions and model: the
+/// plan actually run, for the advice.
 CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::MatrixXd& whitened_design,
                                 const Eigen::VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,

@@ -1,6 +1,6 @@
 #pragma once
 // General weighted linear least squares with honest uncertainty and identifiability analysis
-// (MODEL.md section 9). No physics here: the caller stacks one row per measurement.
+// (docs/physics.md section 9). No physics here: the caller stacks one row per measurement.
 //
 // Method (docs/least_squares.md): rows multiplied by sqrt(weight); columns equilibrated by exact
 // powers of two; a singular value decomposition of the scaled design (never the normal equations);

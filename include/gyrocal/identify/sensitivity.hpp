@@ -1,6 +1,6 @@
 #pragma once
-// The seed's error study (MODEL.md section 10): each machine error of section 3 alone, and the shift it
-// causes in every estimate, without and with compensation. Shifts are exact: noise-free reduced outputs of
+// The seed's error study (docs/physics.md section 10): each machine error of section 3 alone, and the shift
+// it causes in every estimate, without and with compensation. Shifts are exact: noise-free reduced outputs of
 // the exact model through the same reduction and identification as a real calibration (identify/predict.hpp),
 // not a statistical simulation.
 #include <array>
@@ -14,7 +14,7 @@
 
 namespace gyrocal {
 
-/// One machine error of MODEL.md section 3 as a single number: a scalar field of CentrifugeErrors, one
+/// One machine error of docs/physics.md section 3 as a single number: a scalar field of CentrifugeErrors, one
 /// harmonic of a harmonic series, or one component of a vector field.
 struct MachineErrorTerm {
   std::string error;       ///< [centrifuge.errors] key without its unit suffix; a vector's component appended
@@ -84,7 +84,7 @@ struct SensitivityResult {
 
 /// The study on `scenario`: its test, truth, noise and site; the base case has no machine error, each row
 /// one error alone, identified with compensation none, seed and full (the compensation told that error).
-/// Throws Error if the plan lacks the 16 positions of MODEL.md section 7 (the closed forms need them).
+/// Throws Error if the plan lacks the 16 positions of docs/physics.md section 7 (the closed forms need them).
 SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options = {});
 
 }  // namespace gyrocal

@@ -1,5 +1,5 @@
 #pragma once
-// The exact centrifuge model (MODEL.md sections 2-4): a kinematic chain with every error source,
+// The exact centrifuge model (docs/physics.md sections 2-4): a kinematic chain with every error source,
 // evaluated to the gyro's inertial angular rate and specific force with analytic derivatives.
 //
 // Following Pinocchio's model/data split, CentrifugeModel is constant once built (geometry, errors and
@@ -13,7 +13,7 @@
 
 namespace gyrocal {
 
-/// The test site. Frame G is local level North-West-Up (MODEL.md section 2).
+/// The test site. Frame G is local level North-West-Up (docs/physics.md section 2).
 struct Site {
   double latitude_rad = 39.13 * kDegToRad;    ///< geodetic latitude, rad, in [-pi/2, pi/2]
   double gravity_m_s2 = kStandardGravityMS2;  ///< local gravity, m/s^2 (> 0); specific force is in this g
@@ -31,9 +31,9 @@ struct CentrifugeGeometry {
   double initial_main_angle_rad = 0.0;  ///< theta0: main-axis angle at t = 0, rad
 };
 
-/// Every mechanical error of the centrifuge (MODEL.md section 3), SI units. All zero = a perfect machine.
-/// Wobbles and runouts are harmonic series of their own joint's angle: main (theta), counter (psi_r),
-/// position (beta' = beta + position_angle_error).
+/// Every mechanical error of the centrifuge (docs/physics.md section 3), SI units. All zero = a perfect
+/// machine. Wobbles and runouts are harmonic series of their own joint's angle: main (theta), counter
+/// (psi_r), position (beta' = beta + position_angle_error).
 struct CentrifugeErrors {
   double base_tilt_x_rad = 0.0;
   double base_tilt_y_rad = 0.0;
@@ -72,7 +72,7 @@ struct JointState {
   double position_rate_rad_s = 0.0;  ///< d beta / dt: zero during a dwell, not while the platform moves
   double position_accel_rad_s2 = 0.0;
 
-  /// gamma = -psi_r: the arm's radial direction seen from the platform (MODEL.md section 3), rad.
+  /// gamma = -psi_r: the arm's radial direction seen from the platform (docs/physics.md section 3), rad.
   double gamma_rad() const { return -counter_angle_rad; }
 };
 
@@ -134,12 +134,12 @@ class CentrifugeModel {
   PreparedErrors prepared_;
 };
 
-/// Exact inertial rate and specific force in gyro axes (MODEL.md section 4), with analytic derivatives of
-/// the chain of section 3 (wobbles and runouts differentiated through their joint angle).
+/// Exact inertial rate and specific force in gyro axes (docs/physics.md section 4), with analytic derivatives
+/// of the chain of section 3 (wobbles and runouts differentiated through their joint angle).
 GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
-/// theta = theta0 + omega*t, psi_r = -theta + psi0 + delta_omega*t (MODEL.md section 3).
+/// theta = theta0 + omega*t, psi_r = -theta + psi0 + delta_omega*t (docs/physics.md section 3).
 JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,
                                 double time_s);
 

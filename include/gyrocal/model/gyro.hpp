@@ -1,5 +1,5 @@
 #pragma once
-// The gyro's static error model (MODEL.md section 6; the seed's eq. 6) and its noise parameters.
+// The gyro's static error model (docs/physics.md section 6; the seed's eq. 6) and its noise parameters.
 #include <array>
 #include <cstddef>
 #include <string_view>
@@ -19,7 +19,7 @@ inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientUnit
     "deg/h",     "deg/h/g",   "deg/h/g",   "deg/h/g",   "deg/h/g^2",
     "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2"};
 
-/// Drift coefficients: dF deg/h; dI, dO, dS deg/h/g; the rest deg/h/g^2 (MODEL.md section 1).
+/// Drift coefficients: dF deg/h; dI, dO, dS deg/h/g; the rest deg/h/g^2 (docs/physics.md section 1).
 struct DriftCoefficients {
   std::array<double, kNumCoefficients> values{};
 

@@ -8,9 +8,9 @@ namespace gyrocal {
 struct InstantInputs {
   double time_s = 0.0;  ///< time since the start of the dwell, s
   JointState joints;    ///< theta, psi_r, beta and their rates
-  GyroInputs exact;     ///< MODEL.md section 4
+  GyroInputs exact;     ///< docs/physics.md section 4
   NominalInputs
-      nominal;  ///< MODEL.md section 5, with the seed's k1, k2, delta omega of the configured errors
+      nominal;  ///< docs/physics.md section 5, with the seed's k1, k2, delta omega of the configured errors
 };
 
 /// The instant t (s) of a dwell at main rate omega (rad/s; 0 = stopped) and position beta (rad).

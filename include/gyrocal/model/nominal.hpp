@@ -1,11 +1,11 @@
 #pragma once
-// The nominal inputs to the gyro (MODEL.md section 5; the seed's eq. 2-5), written once. The seed's
+// The nominal inputs to the gyro (docs/physics.md section 5; the seed's eq. 2-5), written once. The seed's
 // first-order machine-error terms k1, k2 and delta omega enter omega_I; the specific force is nominal.
 #include "gyrocal/model/centrifuge.hpp"
 
 namespace gyrocal {
 
-/// The seed's first-order error terms of the counter-rotating platform (MODEL.md section 5).
+/// The seed's first-order error terms of the counter-rotating platform (docs/physics.md section 5).
 struct SeedErrorTerms {
   double k1 = 0.0;                 ///< -(count_perp_y + count_wobble_y(psi_r)), rad
   double k2 = 0.0;                 ///< count_perp_x + count_wobble_x(psi_r), rad
@@ -26,8 +26,8 @@ struct NominalInputs {
 /// Ar = omega*R0*(omega + 2*we*sin(lat))/g: the radial level including the radial Coriolis term, g.
 double radial_level_g(const Site& site, double radius_m, double rate_rad_s);
 
-/// MODEL.md section 5 at position beta, gamma (rad) for main rate omega (rad/s, signed), nominal radius R0
-/// (m) and heading psi0 (rad), with the seed's error terms (zero for a perfect machine).
+/// docs/physics.md section 5 at position beta, gamma (rad) for main rate omega (rad/s, signed), nominal
+/// radius R0 (m) and heading psi0 (rad), with the seed's error terms (zero for a perfect machine).
 NominalInputs nominal_inputs(const Site& site, double radius_m, double rate_rad_s, double heading_rad,
                              double beta_rad, double gamma_rad, const SeedErrorTerms& terms);
 

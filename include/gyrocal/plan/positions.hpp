@@ -1,6 +1,6 @@
 #pragma once
-// The positions of a test: each (rate, beta, gamma) of the configured test, numbered as MODEL.md section 7
-// numbers the 16 positions (rate outermost, then beta, then gamma, in the configured order).
+// The positions of a test: each (rate, beta, gamma) of the configured test, numbered as docs/physics.md
+// section 7 numbers the 16 positions (rate outermost, then beta, then gamma, in the configured order).
 #include <vector>
 
 #include "gyrocal/plan/test_spec.hpp"
@@ -8,7 +8,7 @@
 namespace gyrocal {
 
 struct Position {
-  int index = 0;            ///< 1-based, MODEL.md section 7 for the default test
+  int index = 0;            ///< 1-based, docs/physics.md section 7 for the default test
   double rate_rad_s = 0.0;  ///< main-axis rate, rad/s (0 = stopped)
   double beta_rad = 0.0;    ///< position-platform angle, rad
   double gamma_rad = 0.0;   ///< arm angle seen from the platform, rad

@@ -8,7 +8,7 @@
 //   stopped (rate == 0):  for each gamma of test.gamma_rad: [transition] settle, hold (duration
 //                         revolutions * 2 pi / |reference rate|), the counter platform at psi_r = -gamma.
 // The test starts at t = 0 at the first rate, beta and (stopped) gamma with no transition, so that in the
-// first spinning dwell theta = theta0 + omega t and psi_r = -theta + psi0 + delta_omega t (MODEL.md
+// first spinning dwell theta = theta0 + omega t and psi_r = -theta + psi0 + delta_omega t (docs/physics.md
 // section 3) hold exactly as written. A transition holds only the moves that something changes, in this
 // order:
 //   1. position move: beta turns to the new value (by the configured difference, not modulo 2 pi);

@@ -1,5 +1,5 @@
 #pragma once
-// The test record (INTERFACE.md, "Record (CSV)"): a writer and a streaming reader.
+// The test record (docs/contract.md, "Record (CSV)"): a writer and a streaming reader.
 //
 // Format, as written and as accepted:
 //   # gyrocal-record 1                 line 1, exactly (another version number is refused by name)

@@ -31,11 +31,11 @@ struct ReduceOptions {
   /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
   /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0: every sample.
   int model_samples_per_revolution = 32;
-  /// Spikes (MODEL.md section 14): a sample of the gyro output whose residual about the dwell's fit lies more
-  /// than this many robust standard deviations (1.4826 x the median absolute deviation of the residuals of
-  /// its block) from the block's median residual is an outlier; iterated until the set of outliers is stable.
-  /// It is counted and replaced by the fit's value at its instant (docs/calibration.md, "Spikes"). 0: no
-  /// rejection.
+  /// Spikes (docs/physics.md section 14): a sample of the gyro output whose residual about the dwell's fit
+  /// lies more than this many robust standard deviations (1.4826 x the median absolute deviation of the
+  /// residuals of its block) from the block's median residual is an outlier; iterated until the set of
+  /// outliers is stable. It is counted and replaced by the fit's value at its instant (docs/calibration.md,
+  /// "Spikes"). 0: no rejection.
   double outlier_threshold = 6.0;
   /// The rule tests whole revolutions (a static hold: runs of samples) in blocks of at least this many
   /// samples, against the fit of the dwell so far and the block: the memory of one block.
@@ -131,9 +131,9 @@ class DwellAccumulator {
   int revolution_ = 0;  // of the samples accumulated
   bool finished_ = false;
 
-  // Outlier rejection (MODEL.md section 14): the block waiting to be tested, and the normal equations of the
-  // dwell's fit (harmonics and drift; a static hold: mean and drift) on every sample accumulated so far, with
-  // outliers replaced by the fit.
+  // Outlier rejection (docs/physics.md section 14): the block waiting to be tested, and the normal equations
+  // of the dwell's fit (harmonics and drift; a static hold: mean and drift) on every sample accumulated so
+  // far, with outliers replaced by the fit.
   bool robust_ = false;
   std::vector<Pending> pending_;
   int seen_revolution_ = 0;  // of the samples added

@@ -48,7 +48,7 @@ struct Dwell {
 
 /// One reduced position, in the plan's order.
 struct ReducedPosition {
-  int index = 0;            ///< plan/positions.hpp numbering (MODEL.md section 7 for the default test)
+  int index = 0;            ///< plan/positions.hpp numbering (docs/physics.md section 7 for the default test)
   double rate_rad_s = 0.0;  ///< planned rate
   double beta_rad = 0.0;    ///< planned beta
   double gamma_rad = 0.0;   ///< planned gamma

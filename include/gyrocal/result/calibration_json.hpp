@@ -1,5 +1,6 @@
 #pragma once
-// The result JSON of `gyrocal calibrate` (INTERFACE.md, "Result (JSON)"), and the pieces the report reads.
+// The result JSON of `gyrocal calibrate` (docs/contract.md, "Result (JSON)"), and the pieces the report
+// reads.
 #include <optional>
 
 #include <nlohmann/json.hpp>

@@ -1,5 +1,5 @@
 #pragma once
-// JSON of `gyrocal inputs` (INTERFACE.md): one instant's joint angles, exact and nominal inputs.
+// JSON of `gyrocal inputs` (docs/contract.md): one instant's joint angles, exact and nominal inputs.
 #include <nlohmann/json.hpp>
 
 #include "gyrocal/model/instant.hpp"

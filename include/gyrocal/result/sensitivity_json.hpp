@@ -1,5 +1,5 @@
 #pragma once
-// The JSON of `gyrocal sensitivity` (INTERFACE.md, "Result (JSON)").
+// The JSON of `gyrocal sensitivity` (docs/contract.md, "Result (JSON)").
 #include <nlohmann/json.hpp>
 
 #include "gyrocal/identify/sensitivity.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The gyro's output noise (MODEL.md section 6; configuration section [gyro.noise]; docs/noise.md).
+// The gyro's output noise (docs/physics.md section 6; configuration section [gyro.noise]; docs/noise.md).
 //
 // Each successive sample k (time t_k = k / fs) of the output, deg/h:
 //   v_k = clean_k + w_k + b_k + r_k

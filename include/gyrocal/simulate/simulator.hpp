@@ -1,7 +1,7 @@
 #pragma once
-// Simulation of a whole test (issue 3; MODEL.md sections 4 and 6): for each sample k at t_k = k / fs over the
-// timeline of plan/timeline.hpp, the joints -> the exact inputs -> the gyro's static model with the truth
-// coefficients -> the noise of [gyro.noise] -> one row of the record (record/record.hpp).
+// Simulation of a whole test (issue 3; docs/physics.md sections 4 and 6): for each sample k at t_k = k / fs
+// over the timeline of plan/timeline.hpp, the joints -> the exact inputs -> the gyro's static model with the
+// truth coefficients -> the noise of [gyro.noise] -> one row of the record (record/record.hpp).
 //
 // Encoder angles are written as the joints' angles in degrees wrapped to [0, 360), as an encoder reads them
 // (theta, psi_r relative to the arm, beta as commanded). Rows stream out one at a time, so memory does not
@@ -36,8 +36,8 @@ using SampleSink = std::function<void(const RecordSample&)>;
 /// sample_rate_hz, settle_s, revolutions, rates_rad_s, beta_deg, gamma_deg (lists as "[a, b]"), hold_s,
 /// reference_rate_rad_s, radius_m, latitude_deg, heading_deg, initial_main_angle_deg, angles (how encoder
 /// angles are written), duration_s, samples, the noise parameters (noise_<key of [gyro.noise]>) and the truth
-/// (truth_dF ... truth_dOS, in the units of MODEL.md section 1). Numbers are in their shortest exact form,
-/// angles in degrees to 15 significant digits.
+/// (truth_dF ... truth_dOS, in the units of docs/physics.md section 1). Numbers are in their shortest exact
+/// form, angles in degrees to 15 significant digits.
 RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed);
 
 /// Simulates every sample of the scenario's test (timeline with the default MotionLimits) and hands each
