@@ -92,18 +92,27 @@ int DwellAccumulator::basis_size() const {
   return 2 * options_.harmonic_order + 1 + (options_.linear_drift ? 1 : 0);
 }
 
-// 1, cos g, sin g, ..., cos Ng, sin Ng [, t_scaled]; cos kg, sin kg by angle addition.
-void DwellAccumulator::basis(double gamma_rad, double t_scaled, double* out) const {
+namespace {
+
+// 1, cos g, sin g, ..., cos Ng, sin Ng into out[0 .. 2N]; cos kg, sin kg by angle addition.
+void harmonic_basis(double gamma_rad, int order, double* out) {
   const double c1 = std::cos(gamma_rad), s1 = std::sin(gamma_rad);
   out[0] = 1.0;
   double c = 1.0, s = 0.0;
-  for (int k = 1; k <= options_.harmonic_order; ++k) {
+  for (int k = 1; k <= order; ++k) {
     const double cn = c * c1 - s * s1;
     s = s * c1 + c * s1;
     c = cn;
     out[2 * k - 1] = c;
     out[2 * k] = s;
   }
+}
+
+}  // namespace
+
+// The reduction's harmonic fit: harmonic_basis [, t_scaled].
+void DwellAccumulator::basis(double gamma_rad, double t_scaled, double* out) const {
+  harmonic_basis(gamma_rad, options_.harmonic_order, out);
   if (options_.linear_drift) out[2 * options_.harmonic_order + 1] = t_scaled;
 }
 
@@ -119,16 +128,7 @@ void DwellAccumulator::detection_basis(double gamma_rad, double t_scaled, double
     out[1] = t_scaled;
     return;
   }
-  const double c1 = std::cos(gamma_rad), s1 = std::sin(gamma_rad);
-  out[0] = 1.0;
-  double c = 1.0, s = 0.0;
-  for (int k = 1; k <= options_.harmonic_order; ++k) {
-    const double cn = c * c1 - s * s1;
-    s = s * c1 + c * s1;
-    c = cn;
-    out[2 * k - 1] = c;
-    out[2 * k] = s;
-  }
+  harmonic_basis(gamma_rad, options_.harmonic_order, out);
   out[2 * options_.harmonic_order + 1] = t_scaled;
 }
 
