@@ -17,7 +17,6 @@
 namespace gyrocal {
 namespace {
 
-
 bool same_angle(double a_rad, double b_deg) {
   return std::abs(std::remainder(a_rad * kRadToDeg - b_deg, 360.0)) < 1e-6;
 }
