@@ -33,7 +33,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
+#include "support/cli_run.hpp"
 
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
@@ -47,12 +49,7 @@ bool sanitized() {
   return std::getenv("GYROCAL_SANITIZED") != nullptr;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 /// How a run of the CLI ended: its exit status, or the signal that ended it.
 struct Outcome {

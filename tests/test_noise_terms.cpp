@@ -7,16 +7,14 @@
 #include <numeric>
 #include <vector>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include "support/cli_run.hpp"
 
 #include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/config/config_io.hpp"
@@ -222,30 +220,11 @@ void write_static_record(const std::filesystem::path& path, std::size_t rows, st
   writer.finish();
 }
 
-struct Outcome {
-  int status = -1;
-  std::string out, err;
-};
-
-Outcome run_cli(const std::string& args, const std::filesystem::path& dir) {
-  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string(GYROCAL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
-}
+using Outcome = test::CliOutcome;
 
 class NoiseCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("gyrocal-noise-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = test::fresh_test_folder("gyrocal-noise"); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path dir_;
 };
@@ -253,7 +232,8 @@ class NoiseCommand : public ::testing::Test {
 TEST_F(NoiseCommand, WritesTheContractsJsonAndAConfigurationSection) {
   const auto record = dir_ / "static.csv";
   write_static_record(record, 40000);
-  const Outcome o = run_cli("noise " + record.string() + " --json " + (dir_ / "noise.json").string(), dir_);
+  const Outcome o =
+      test::run_cli("noise " + record.string() + " --json " + (dir_ / "noise.json").string(), dir_);
   ASSERT_EQ(o.status, 0) << o.err;
   std::ifstream in(dir_ / "noise.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -274,7 +254,7 @@ TEST_F(NoiseCommand, WritesTheContractsJsonAndAConfigurationSection) {
   EXPECT_TRUE(j["terms"].contains("rate_random_walk_deg_h_rt_h"));
 
   // --toml: a section that a configuration takes as it is, with the fitted values bit for bit.
-  const Outcome t = run_cli("noise " + record.string() + " --toml", dir_);
+  const Outcome t = test::run_cli("noise " + record.string() + " --toml", dir_);
   ASSERT_EQ(t.status, 0) << t.err;
   const Scenario s = parse_scenario(t.out, "noise --toml");
   EXPECT_EQ(s.noise.angle_random_walk_deg_rt_h, n);
@@ -283,7 +263,7 @@ TEST_F(NoiseCommand, WritesTheContractsJsonAndAConfigurationSection) {
 TEST_F(NoiseCommand, RefusesUnevenSamplingWithItsTime) {
   const auto record = dir_ / "gap.csv";
   write_static_record(record, 2000, 1000);  // rows 1000..1002 missing: 0.2 s between t = 49.95 s and 50.15 s
-  const Outcome o = run_cli("noise " + record.string(), dir_);
+  const Outcome o = test::run_cli("noise " + record.string(), dir_);
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.err.find("uneven at t = 49.95 s"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find(record.string()), std::string::npos) << o.err;

@@ -1,0 +1,58 @@
+#pragma once
+// Running the command line from a test: a fresh folder per test, the CLI with its output captured, the
+// outcome. Header-only; the CLI's path comes from GYROCAL_CLI (tests/CMakeLists.txt).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace gyrocal::test {
+
+/// What a run of the CLI gave: its exit status (-1 if it did not exit normally), standard output and error.
+struct CliOutcome {
+  int status = -1;
+  std::string out, err;
+};
+
+/// The whole content of a file ("" if it cannot be read).
+inline std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// A new, empty folder for the running test: <temp>/<prefix>-<test name>-<pid>.
+inline std::filesystem::path fresh_test_folder(const std::string& prefix) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      (prefix + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "-" +
+       std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// Runs `gyrocal ARGS` through the shell (ARGS as written on a command line), standard input from
+/// /dev/null, its outputs captured through files in `dir`, which are removed again.
+inline CliOutcome run_cli(const std::string& args, const std::filesystem::path& dir) {
+  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd =
+      std::string(GYROCAL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const int raw = std::system(cmd.c_str());
+  CliOutcome o;
+  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  o.out = slurp(out);
+  o.err = slurp(err);
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return o;
+}
+
+}  // namespace gyrocal::test
