@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -97,7 +98,7 @@ std::size_t count_lines(const std::filesystem::path& path) {
   return lines + 1;
 }
 
-RecordNoise characterise(std::vector<double>& rate_deg_h, double interval_s, const std::string& name) {
+RecordNoise characterise(std::span<const double> rate_deg_h, double interval_s, const std::string& name) {
   if (rate_deg_h.size() < 16) {
     throw Error(fmt::format("{}: noise characterisation needs at least 16 rows, the record has {}.", name,
                             rate_deg_h.size()));
@@ -122,8 +123,7 @@ RecordNoise characterise_samples_noise(const std::vector<double>& time_s,
   EvenSampling sampling(name, options);
   for (double t : time_s) sampling.add(t);
   const double interval_s = sampling.finish();
-  std::vector<double> rate = rate_deg_h;
-  return characterise(rate, interval_s, name);
+  return characterise(rate_deg_h, interval_s, name);
 }
 
 RecordNoise characterise_record_noise(const std::filesystem::path& path, const RecordNoiseOptions& options) {
