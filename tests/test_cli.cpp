@@ -125,14 +125,7 @@ TEST_F(Cli, ABadConfigurationIsRefusedNamingKeyAndLine) {
   EXPECT_NE(o.err.find("bad.toml"), std::string::npos) << o.err;
 }
 
-/// A short test (two revolutions per dwell at 100 Hz) so that the command-line round trip is quick.
-std::string short_test_toml() {
-  Scenario s = default_scenario();
-  s.test.revolutions = 12;
-  s.test.sample_rate_hz = 100;
-  s.test.settle_s = 1;
-  return scenario_to_toml(s);
-}
+using test::short_test_toml;
 
 TEST_F(Cli, SimulateThenCalibrateWritesTheResultJsonOfTheInterface) {
   write("c.toml", short_test_toml());

@@ -65,14 +65,7 @@ Outcome decode(int raw) {
   return o;
 }
 
-/// A small test (12 revolutions at 100 Hz): quick to simulate and calibrate.
-std::string short_test_toml() {
-  Scenario s = default_scenario();
-  s.test.revolutions = 12;
-  s.test.sample_rate_hz = 100;
-  s.test.settle_s = 1;
-  return scenario_to_toml(s);
-}
+using test::short_test_toml;
 
 class Files : public ::testing::Test {
  protected:

@@ -12,6 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/config/scenario.hpp"
+
 namespace gyrocal::test {
 
 /// What a run of the CLI gave: its exit status (-1 if it did not exit normally), standard output and error.
@@ -53,6 +56,15 @@ inline CliOutcome run_cli(const std::string& args, const std::filesystem::path& 
   std::filesystem::remove(out);
   std::filesystem::remove(err);
   return o;
+}
+
+/// A short test (12 revolutions per dwell at 100 Hz) so that a command-line round trip is quick.
+inline std::string short_test_toml() {
+  Scenario s = default_scenario();
+  s.test.revolutions = 12;
+  s.test.sample_rate_hz = 100;
+  s.test.settle_s = 1;
+  return scenario_to_toml(s);
 }
 
 }  // namespace gyrocal::test
