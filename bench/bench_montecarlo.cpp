@@ -2,8 +2,8 @@
 // for at least 100,000/s on two cores). The linearisation is prepared once, outside the timing.
 #include <benchmark/benchmark.h>
 
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/config/scenario.hpp"
-#include "gyrocal/identify/montecarlo.hpp"
 
 namespace gyrocal {
 namespace {

@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
 namespace gyrocal {

@@ -13,11 +13,11 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 

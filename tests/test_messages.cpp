@@ -18,11 +18,11 @@
 #include <nlohmann/json.hpp>
 #include "support/cli_run.hpp"
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 

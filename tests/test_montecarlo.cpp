@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/config/scenario.hpp"
-#include "gyrocal/identify/montecarlo.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal {

@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/scenario.hpp"
-#include "gyrocal/identify/sensitivity.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 

@@ -6,10 +6,10 @@
 #include <fmt/format.h>
 
 #include "cli.hpp"
+#include "gyrocal/analysis/montecarlo.hpp"
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/montecarlo.hpp"
-#include "gyrocal/identify/sensitivity.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"

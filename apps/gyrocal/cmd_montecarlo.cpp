@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 
 #include "cli.hpp"
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/montecarlo.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal::cli {

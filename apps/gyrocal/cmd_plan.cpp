@@ -2,7 +2,7 @@
 #include <fmt/format.h>
 
 #include "cli.hpp"
-#include "gyrocal/identify/predict.hpp"
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "cli.hpp"
-#include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 
 namespace gyrocal::cli {

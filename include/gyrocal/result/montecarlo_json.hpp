@@ -2,7 +2,7 @@
 // The JSON of `gyrocal montecarlo` (read by the report: tests/data/report_sample.json's "montecarlo").
 #include <nlohmann/json.hpp>
 
-#include "gyrocal/identify/montecarlo.hpp"
+#include "gyrocal/analysis/montecarlo.hpp"
 
 namespace gyrocal {
 

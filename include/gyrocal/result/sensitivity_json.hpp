@@ -2,7 +2,7 @@
 // The JSON of `gyrocal sensitivity` (docs/contract.md, "Result (JSON)").
 #include <nlohmann/json.hpp>
 
-#include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/analysis/sensitivity.hpp"
 
 namespace gyrocal {
 

@@ -5,7 +5,7 @@
 // in its variance.
 //
 // Two modes. Fast: the reduced outputs are linear in the drawn errors and the noise, W = W0 + J*delta + n,
-// with J from central differences of the exact noise-free engine (identify/predict.hpp) and n the white
+// with J from central differences of the exact noise-free engine (analysis/predict.hpp) and n the white
 // noise through the reduction operator (with its correlation between the gammas of one dwell); the
 // identification is an affine map of W (precomputed from identify itself), so a trial is one small
 // matrix-vector product. Samples: the whole time-series pipeline per trial (simulate with the drawn errors,
@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensitivity.hpp"
 
 namespace gyrocal {
 

@@ -1,4 +1,4 @@
-#include "gyrocal/identify/predict.hpp"
+#include "gyrocal/analysis/predict.hpp"
 
 #include <cmath>
 #include <complex>

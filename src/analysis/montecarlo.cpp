@@ -1,4 +1,4 @@
-#include "gyrocal/identify/montecarlo.hpp"
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/core/parallel.hpp"
 
 #include <algorithm>
@@ -12,9 +12,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/random.hpp"
-#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 

@@ -1,4 +1,4 @@
-#include "gyrocal/identify/sensitivity.hpp"
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/core/parallel.hpp"
 
 #include <algorithm>
@@ -11,8 +11,8 @@
 
 #include <fmt/format.h>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/predict.hpp"
 
 namespace gyrocal {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // The seed's error study (docs/physics.md section 10): each machine error of section 3 alone, and the shift
 // it causes in every estimate, without and with compensation. Shifts are exact: noise-free reduced outputs of
-// the exact model through the same reduction and identification as a real calibration (identify/predict.hpp),
+// the exact model through the same reduction and identification as a real calibration (analysis/predict.hpp),
 // not a statistical simulation.
 #include <array>
 #include <functional>
