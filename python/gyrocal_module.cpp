@@ -133,7 +133,8 @@ py::object calibrate_path_py(const std::string& path, const Scenario& scenario, 
   nlohmann::json j;
   {
     py::gil_scoped_release release;
-    j = calibration_to_json(calibrate_record(path, scenario.model(), scenario.test, options));
+    j = calibration_to_json(
+        calibrate_record(path, scenario.model(), scenario.test, options, scenario.record));
   }
   j["record"] = path;  // as `gyrocal calibrate --json` writes it
   return json_to_python(j);
@@ -170,11 +171,12 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
   return json_to_python(j);
 }
 
-py::object noise_path_py(const std::string& path) {
+py::object noise_path_py(const std::string& path, const std::optional<Scenario>& scenario) {
   nlohmann::json j;
   {
     py::gil_scoped_release release;
-    j = noise_to_json(characterise_record_noise(path));
+    // The scenario's [record] says how the record is laid out (docs/records.md).
+    j = noise_to_json(characterise_record_noise(path, {}, scenario ? scenario->record : std::nullopt));
   }
   return json_to_python(j);
 }

@@ -16,8 +16,10 @@ void register_calibrate(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
   sub->add_option("RECORD", opt->record, "Test record (CSV, docs/contract.md)")->required();
-  sub->add_option("--config", opt->config,
-                  "Configuration file (TOML): the machine, site and plan of the test");
+  sub->add_option(
+      "--config", opt->config,
+      "Configuration file (TOML): the machine, site and plan of the test, and the record's layout "
+      "([record])");
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
@@ -36,12 +38,13 @@ void register_calibrate(CLI::App& app) {
     options.reduce.method =
         opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
     check_feasible(s, opt->config, options.reduce);
+    require_angle_columns(s.record, opt->record);
     // The record's metadata against the configuration, before the record is read (docs/interface.md).
     const std::vector<std::string> metadata_warnings =
-        check_record_metadata(RecordReader(opt->record).metadata(), opt->record, s,
+        check_record_metadata(RecordReader(opt->record, s.record).metadata(), opt->record, s,
                               opt->config.empty() ? "the built-in scenario" : opt->config);
     for (const std::string& w : metadata_warnings) fmt::print(stderr, "gyrocal: warning: {}\n", w);
-    CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options);
+    CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options, s.record);
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
     if (!opt->json.empty()) {
       nlohmann::json j = calibration_to_json(r);

@@ -10,7 +10,7 @@ namespace gyrocal::cli {
 
 void register_noise(CLI::App& app) {
   struct Options {
-    std::string record, json;
+    std::string record, config, json;
     bool toml = false;
   };
   auto opt = std::make_shared<Options>();
@@ -18,11 +18,15 @@ void register_noise(CLI::App& app) {
       "noise",
       "Noise of a record's output: overlapping Allan deviation with 68.3 % bounds and the IEEE 952 terms");
   sub->add_option("RECORD", opt->record, "Record of a static test (CSV, docs/contract.md)")->required();
+  sub->add_option("--config", opt->config,
+                  "Configuration file (TOML); only its [record] section (the record's layout) is used");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_flag("--toml", opt->toml, "Print the fitted terms as a [gyro.noise] configuration section");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
-    const RecordNoise r = characterise_record_noise(opt->record);
+    refuse_to_overwrite_input(opt->json, opt->config);
+    const Scenario s = load_configuration(opt->config);
+    const RecordNoise r = characterise_record_noise(opt->record, {}, s.record);
     if (!opt->json.empty()) write_output(opt->json, noise_to_json(r).dump(2) + "\n", true);
     if (opt->toml) {
       fmt::print("{}", noise_to_toml(r));

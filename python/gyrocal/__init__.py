@@ -53,8 +53,9 @@ def simulate(scenario, seed=None):
 
 
 def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=(), reduction="harmonic"):
-    """`gyrocal calibrate --json` as a dict. rec is a record's path or a mapping of arrays (a dict such as
-    simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
+    """`gyrocal calibrate --json` as a dict. rec is a record's path (read through the scenario's [record]
+    layout when its configuration has one, as `gyrocal calibrate --config`) or a mapping of arrays (a dict such
+    as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
     method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
     "window". estimate (machine errors to self-calibrate) must be empty: self-calibration is not built yet."""
     if estimate is None:
@@ -73,8 +74,9 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
 
 def noise(rec, scenario=None):
     """`gyrocal noise --json` as a dict: the overlapping Allan deviation of the record's output and the fitted
-    IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and gyro_deg_h. The scenario is
-    accepted for symmetry with the other functions; the noise of a record does not depend on it."""
+    IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and gyro_deg_h. A record's
+    path is read through the scenario's [record] layout when it has one (as `gyrocal noise --config`); the
+    noise itself does not depend on the scenario."""
     if _is_path(rec):
-        return _gyrocal._noise_path(os.fspath(rec))
+        return _gyrocal._noise_path(os.fspath(rec), scenario)
     return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, "gyro_deg_h"), _ARRAYS_NAME)

@@ -126,8 +126,9 @@ RecordNoise characterise_samples_noise(const std::vector<double>& time_s,
   return characterise(rate_deg_h, interval_s, name);
 }
 
-RecordNoise characterise_record_noise(const std::filesystem::path& path, const RecordNoiseOptions& options) {
-  RecordReader reader(path);
+RecordNoise characterise_record_noise(const std::filesystem::path& path, const RecordNoiseOptions& options,
+                                      const std::optional<RecordLayout>& layout) {
+  RecordReader reader(path, layout);
   const std::string name = path.string();
   EvenSampling sampling(name, options);
   std::vector<double> rate_deg_h;

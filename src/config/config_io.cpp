@@ -10,6 +10,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -324,6 +325,13 @@ class Reader {
     return value;
   }
 
+  /// A string.
+  std::string string(const toml::node& node, const std::string& path) const {
+    const auto* text = node.as_string();
+    if (text == nullptr) fail(node.source(), path + " must be a string, not " + type_name(node));
+    return text->get();
+  }
+
   const toml::array& array(const toml::node& node, const std::string& path) const {
     if (!node.is_array()) fail(node.source(), path + " must be an array, not " + type_name(node));
     return *node.as_array();
@@ -510,6 +518,74 @@ void read_test(const Reader& reader, Section& section, TestSpec& test) {
   section.reject_unknown();
 }
 
+/// The string keys of [record] that name a column (docs/contract.md, "Records").
+constexpr std::pair<std::string_view, std::string RecordLayout::*> kRecordColumnKeys[] = {
+    {"time_column", &RecordLayout::time_column},
+    {"main_angle_column", &RecordLayout::main_angle_column},
+    {"counter_angle_column", &RecordLayout::counter_angle_column},
+    {"position_angle_column", &RecordLayout::position_angle_column},
+    {"output_column", &RecordLayout::output_column},
+};
+/// The keys of [record] that hold encoder counts per revolution.
+constexpr std::pair<std::string_view, std::int64_t RecordLayout::*> kRecordCountKeys[] = {
+    {"main_counts_per_revolution", &RecordLayout::main_counts_per_revolution},
+    {"counter_counts_per_revolution", &RecordLayout::counter_counts_per_revolution},
+    {"position_counts_per_revolution", &RecordLayout::position_counts_per_revolution},
+};
+
+/// [record]: a rig's own record layout (docs/records.md). The layout's own check (RecordLayout::IsValid)
+/// names the key; its line is that key's.
+RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table) {
+  RecordLayout layout;
+  if (const toml::node* node = section.find("delimiter")) {
+    const std::string text = reader.string(*node, section.path("delimiter"));
+    if (text.size() != 1) {
+      reader.fail(node->source(),
+                  "record.delimiter must be one character (\" \" for any run of spaces or "
+                  "tabs, \"\\t\" for a tab), not \"" +
+                      text + "\"");
+    }
+    layout.delimiter = text.front();
+  }
+  if (const toml::node* node = section.find("comment"))
+    layout.comment = reader.string(*node, section.path("comment"));
+  for (const auto& [key, member] : kRecordColumnKeys) {
+    if (const toml::node* node = section.find(key)) layout.*member = reader.string(*node, section.path(key));
+  }
+  if (const toml::node* node = section.find("time_unit")) {
+    const std::string text = reader.string(*node, section.path("time_unit"));
+    const std::optional<TimeUnit> unit = parse_time_unit(text);
+    if (!unit) reader.fail(node->source(), "record.time_unit must be s, ms, us or ns, not \"" + text + "\"");
+    layout.time_unit = *unit;
+  }
+  if (const toml::node* node = section.find("angle_unit")) {
+    const std::string text = reader.string(*node, section.path("angle_unit"));
+    const std::optional<AngleUnit> unit = parse_angle_unit(text);
+    if (!unit) {
+      reader.fail(node->source(),
+                  "record.angle_unit must be deg or rad (encoder counts are set by "
+                  "<angle>_counts_per_revolution), not \"" +
+                      text + "\"");
+    }
+    layout.angle_unit = *unit;
+  }
+  for (const auto& [key, member] : kRecordCountKeys) {
+    if (const toml::node* node = section.find(key)) {
+      layout.*member = reader.integer(*node, section.path(key), INT64_MIN, INT64_MAX);
+    }
+  }
+  if (const toml::node* node = section.find("output_scale_per_deg_h")) {
+    layout.output_scale_per_deg_h = reader.number(*node, section.path("output_scale_per_deg_h"), kPositive);
+  }
+  section.reject_unknown();
+  std::string error, key;
+  if (!layout.IsValid(&error, &key)) {
+    const toml::node* node = table.get(key);
+    reader.fail(node != nullptr ? node->source() : table.source(), error);
+  }
+  return layout;
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Writing.
 
@@ -526,6 +602,16 @@ class TomlWriter {
       begin = end + 1;
     }
     out_ << "[" << name << "]\n";
+  }
+  /// A table header and its key lines (as another writer wrote them), all commented out.
+  void section_commented(std::string_view name, std::string_view note, std::string_view keys) {
+    out_ << "\n";
+    const std::string lines = std::string(note) + "\n[" + std::string(name) + "]\n" + std::string(keys);
+    for (std::size_t begin = 0; begin < lines.size();) {
+      const std::size_t end = std::min(lines.find('\n', begin), lines.size());
+      if (end > begin) comment(std::string_view(lines).substr(begin, end - begin));
+      begin = end + 1;
+    }
   }
   void key(std::string_view key, const std::string& value, std::string_view note) {
     constexpr std::size_t kCommentColumn = 44;
@@ -560,6 +646,49 @@ std::string series_text(const HarmonicSeries& series, const ErrorKey& key) {
   return text + " ]";
 }
 
+/// A TOML basic string: quotes, backslashes and control characters escaped.
+std::string toml_string(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\u%04X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += code;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+/// The keys of [record] with their values and meanings.
+void write_record_keys(TomlWriter& w, const RecordLayout& l) {
+  w.key("delimiter", toml_string(std::string(1, l.delimiter)),
+        "one character; \" \" means any run of spaces or tabs");
+  w.key("comment", toml_string(l.comment), "lines starting with it are metadata (key = value) or comments");
+  w.key("time_column", toml_string(l.time_column), "the time column");
+  w.key("time_unit", toml_string(to_string(l.time_unit)), "s, ms, us or ns");
+  w.key("main_angle_column", toml_string(l.main_angle_column),
+        "main axis theta; \"\" = absent (enough for noise)");
+  w.key("counter_angle_column", toml_string(l.counter_angle_column),
+        "counter platform psi_r relative to the arm");
+  w.key("position_angle_column", toml_string(l.position_angle_column), "position platform beta");
+  w.key("angle_unit", toml_string(to_string(l.angle_unit)),
+        "deg or rad, for angle columns that are not counts");
+  w.key("main_counts_per_revolution", std::to_string(l.main_counts_per_revolution),
+        "> 0 (>= 2): the column holds encoder counts, wrapped or not");
+  w.key("counter_counts_per_revolution", std::to_string(l.counter_counts_per_revolution), "likewise");
+  w.key("position_counts_per_revolution", std::to_string(l.position_counts_per_revolution), "likewise");
+  w.key("output_column", toml_string(l.output_column), "the gyro's output");
+  w.key("output_scale_per_deg_h", toml_number(l.output_scale_per_deg_h),
+        "output units per deg/h (e.g. mV per deg/h): the output is divided by it");
+}
+
 template <class S, std::size_t N>
 void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source) {
   for (const NumberKey<S>& k : keys) {
@@ -587,9 +716,9 @@ void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
 /// such characters away from toml++ 3.3.0 (Debian 12), whose whitespace test reaches __builtin_unreachable
 /// for many of them (U+00A1 to U+049A among others; upstream marzer/tomlplusplus issue 295, found by
 /// fuzzing, docs/fuzzing.md). Strings are followed as TOML writes them (basic, literal, multi-line), so that
-/// a '#' inside a string never counts as a comment; a string holding such a character is refused too, as a
-/// configuration has no string values. Where this scan and TOML could disagree (a closing delimiter with
-/// extra quotes), the scan sees a string where TOML sees none, which refuses more, never less.
+/// a '#' inside a string never counts as a comment; a string holding such a character is refused too (the
+/// only strings, [record]'s, are ASCII: docs/records.md). Where this scan and TOML could disagree (a closing
+/// delimiter with extra quotes), the scan sees a string where TOML sees none, which refuses more, never less.
 void refuse_non_ascii(std::string_view text, const std::string& file) {
   constexpr std::string_view kBom = "\xEF\xBB\xBF", kTripleQuote = R"(""")", kTripleApostrophe = "'''";
   if (text.starts_with(kBom)) text.remove_prefix(kBom.size());
@@ -698,6 +827,11 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
   read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
 
+  if (const toml::table* record_table = top.table("record")) {
+    Section record(reader, record_table, "record");
+    s.record = read_record(reader, record, *record_table);
+  }
+
   top.reject_unknown();
   return s;
 }
@@ -803,6 +937,21 @@ std::string scenario_to_toml(const Scenario& s) {
       "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
       "and phase_deg its nominal phase.");
   write_errors(w, s.uncertainty);
+
+  constexpr std::string_view kRecordNote =
+      "How to read a rig's own record (docs/contract.md, \"Records\"; docs/records.md). Without a [record]\n"
+      "section a record is gyrocal's own format, whose first line is \"# gyrocal-record 1\"; with one (even\n"
+      "empty) no magic line is needed and the columns are found by name. Every key is optional; the\n"
+      "defaults are gyrocal's own format.";
+  if (s.record) {
+    w.section("record", kRecordNote);
+    write_record_keys(w, *s.record);
+  } else {
+    // Commented out, so that the file reads back as the scenario it was written from.
+    TomlWriter keys;
+    write_record_keys(keys, RecordLayout{});
+    w.section_commented("record", kRecordNote, keys.text());
+  }
   return w.text();
 }
 

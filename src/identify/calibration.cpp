@@ -465,8 +465,10 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
 }
 
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
-                                   const TestSpec& plan, const CalibrationOptions& options) {
-  RecordReader reader(record_path);
+                                   const TestSpec& plan, const CalibrationOptions& options,
+                                   const std::optional<RecordLayout>& layout) {
+  require_angle_columns(layout, record_path);
+  RecordReader reader(record_path, layout);
   const Reduction reduction = reduce_record(reader, plan, options.reduce, model.geometry().rate_rad_s);
   const std::vector<PositionChannels> channels = reduce_model_channels(reduction, model, options.reduce);
   return identify(reduction, channels, model, options);

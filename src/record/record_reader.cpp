@@ -2,9 +2,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -12,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace gyrocal {
@@ -29,18 +33,18 @@ std::string_view trim(std::string_view text) {
   return text;
 }
 
-/// A piece of input fit to show in a message: at most 40 bytes, each byte that is not printable ASCII
+/// A piece of input fit to show in a message: at most `shown` bytes, each byte that is not printable ASCII
 /// written as \xHH (never raw: a message must not carry control characters or broken UTF-8).
-std::string printable(std::string_view text) {
+std::string printable(std::string_view text, std::size_t shown = 40) {
   std::string out;
-  for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 40); ++i) {
+  for (std::size_t i = 0; i < std::min(text.size(), shown); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     if (c >= 0x20 && c < 0x7f)
       out += static_cast<char>(c);
     else
       out += fmt::format("\\x{:02X}", c);
   }
-  return out + (text.size() > 40 ? "…" : "");
+  return out + (text.size() > shown ? "…" : "");
 }
 
 /// printable(text) in single quotes.
@@ -48,12 +52,15 @@ std::string quote(std::string_view text) {
   return "'" + printable(text) + "'";
 }
 
+/// A header line in single quotes, up to 200 bytes of it (a message names all of a typical header).
+std::string quote_long(std::string_view text) {
+  return "'" + printable(text, 200) + "'";
+}
+
+__extension__ typedef unsigned __int128 Uint128;  // GCC and Clang: exact quotients of stamps up to 2^94
+
 /// The UTF-8 byte order mark that some editors put at the start of a text file.
 constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
-
-std::size_t count_fields(std::string_view line) {
-  return 1 + std::count(line.begin(), line.end(), ',');
-}
 
 bool parses_as_number(std::string_view text) {
   double value = 0.0;
@@ -82,6 +89,21 @@ struct RecordReader::State {
   double previous_time_s = 0.0;
   bool have_previous = false;
 
+  // How rows are split and what their fields mean. gyrocal's own format (no layout): ',' between fields,
+  // column i into value slot i. With a layout: its delimiter, the mapped columns into the slots of
+  // kSlotNames, the others skipped unread.
+  std::optional<RecordLayout> layout;
+  char delimiter = ',';
+  bool blank_delimited = false;  ///< the delimiter is any run of spaces or tabs
+  bool tab_is_blank = true;      ///< false when the delimiter is a tab
+  std::vector<int> slot;         ///< per header column: its value slot, or -1 to skip it
+  // The conversions of a layout into s, deg and deg/h (all identities without one).
+  std::uint64_t time_ticks_per_s = 1;                     ///< 1000, 1e6 or 1e9 for a time in ms, us or ns
+  std::array<double, 3> angle_multiplier{1.0, 1.0, 1.0};  ///< main, counter, position: 360, 180/pi or 1
+  std::array<double, 3> angle_divisor{1.0, 1.0, 1.0};     ///< counts per revolution, or 1
+  std::array<bool, 3> angle_present{true, true, true};
+  double output_divisor = 1.0;
+
   State(std::string name_, std::size_t chunk)
       : name(std::move(name_)), chunk_bytes(std::max<std::size_t>(chunk, 1)) {
     // Room for the longest accepted line plus one chunk: memory is bounded whatever the input.
@@ -95,6 +117,47 @@ struct RecordReader::State {
 
   [[noreturn]] void fail(std::string_view problem) const {
     throw Error(fmt::format("{}, line {}: {}.", name, line, problem));
+  }
+
+  bool blank(char c) const { return c == ' ' || (c == '\t' && tab_is_blank); }
+
+  /// Sets up the reading of `l` (validated first).
+  void use_layout(const RecordLayout& l) {
+    std::string error;
+    if (!l.IsValid(&error)) throw Error(fmt::format("Cannot read record {}: {}.", name, error));
+    layout = l;
+    delimiter = l.delimiter;
+    blank_delimited = l.delimiter == ' ';
+    tab_is_blank = l.delimiter != '\t';
+    switch (l.time_unit) {
+      case TimeUnit::kSeconds:
+        time_ticks_per_s = 1;
+        break;
+      case TimeUnit::kMilliseconds:
+        time_ticks_per_s = 1000;
+        break;
+      case TimeUnit::kMicroseconds:
+        time_ticks_per_s = 1000000;
+        break;
+      case TimeUnit::kNanoseconds:
+        time_ticks_per_s = 1000000000;
+        break;
+    }
+    const std::array<std::int64_t, 3> counts = {l.main_counts_per_revolution, l.counter_counts_per_revolution,
+                                                l.position_counts_per_revolution};
+    const std::array<const std::string*, 3> names = {&l.main_angle_column, &l.counter_angle_column,
+                                                     &l.position_angle_column};
+    for (std::size_t i = 0; i < 3; ++i) {
+      // docs/records.md: count * 360 / counts is exact (one rounding) for counts below 2^53 / 360.
+      if (counts[i] > 0) {
+        angle_multiplier[i] = 360.0;
+        angle_divisor[i] = static_cast<double>(counts[i]);
+      } else if (l.angle_unit == AngleUnit::kRadians) {
+        angle_multiplier[i] = kRadToDeg;
+      }
+      angle_present[i] = !names[i]->empty();
+    }
+    output_divisor = l.output_scale_per_deg_h;
   }
 
   /// Moves the unconsumed bytes to the front and appends up to one chunk; sets at_eof at the end.
@@ -154,8 +217,9 @@ struct RecordReader::State {
     }
   }
 
-  /// Reads the magic line, the metadata and the header.
+  /// Reads the magic line, the metadata and the header of gyrocal's own format.
   void read_head() {
+    if (layout) return read_mapped_head();
     std::string_view text;
     if (!next_line(text)) {
       throw Error(fmt::format("{} is empty; a record begins with the line '{}'.", name, kRecordMagic));
@@ -184,14 +248,18 @@ struct RecordReader::State {
       text = trim(text);
       if (text.empty()) continue;
       if (text.front() != '#') break;
-      const std::string_view body = text.substr(1);
-      const std::size_t equals = body.find('=');
-      if (equals == std::string_view::npos) continue;  // a comment
-      const std::string_view key = trim(body.substr(0, equals));
-      if (key.empty()) fail("the metadata line has no key before '='");
-      metadata.emplace_back(key, trim(body.substr(equals + 1)));
+      add_metadata(text.substr(1));
     }
     read_header(text);
+  }
+
+  /// A metadata line's text after its comment prefix: `key = value`, or a comment without '='.
+  void add_metadata(std::string_view body) {
+    const std::size_t equals = body.find('=');
+    if (equals == std::string_view::npos) return;  // a comment
+    const std::string_view key = trim(body.substr(0, equals));
+    if (key.empty()) fail("the metadata line has no key before '='");
+    metadata.emplace_back(key, trim(body.substr(equals + 1)));
   }
 
   void read_header(std::string_view text) {
@@ -227,6 +295,132 @@ struct RecordReader::State {
         fail(fmt::format("column {} of the header repeats the name {}", i + 1, quote(columns[i])));
       }
     }
+    slot.resize(columns.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) slot[i] = static_cast<int>(i);
+  }
+
+  /// The layout's column keys and names, in slot order (time, main, counter, position, output).
+  std::array<std::pair<std::string_view, const std::string*>, 5> mapped_columns() const {
+    return {{{"time_column", &layout->time_column},
+             {"main_angle_column", &layout->main_angle_column},
+             {"counter_angle_column", &layout->counter_angle_column},
+             {"position_angle_column", &layout->position_angle_column},
+             {"output_column", &layout->output_column}}};
+  }
+
+  /// Reads the head of a record through a layout (docs/records.md): blank lines, comment lines (metadata
+  /// when they hold '='), an optional magic line, then the header.
+  void read_mapped_head() {
+    std::string_view text;
+    const std::string& comment = layout->comment;
+    for (bool first = true;; first = false) {
+      if (!next_line(text)) {
+        if (first) throw Error(fmt::format("{} is empty; a record has a header line and rows.", name));
+        fail("the record ends without a header line naming its columns");
+      }
+      if (first && text.starts_with(kByteOrderMark)) text.remove_prefix(kByteOrderMark.size());
+      text = trim(text);
+      if (text.empty() || (first && text == kRecordMagic)) continue;
+      if (comment.empty() || !text.starts_with(comment)) break;
+      add_metadata(text.substr(comment.size()));
+    }
+    read_mapped_header(text);
+  }
+
+  /// The header's names split at the delimiter, each trimmed of spaces and of surrounding double quotes.
+  std::vector<std::string> split_header(std::string_view text) const {
+    std::vector<std::string> names;
+    const auto add = [&](std::string_view n) {
+      n = trim(n);
+      if (n.size() >= 2 && n.front() == '"' && n.back() == '"') n = trim(n.substr(1, n.size() - 2));
+      names.emplace_back(n);
+    };
+    if (blank_delimited) {
+      std::size_t i = 0;
+      while (i < text.size()) {
+        while (i < text.size() && blank(text[i])) ++i;
+        if (i == text.size()) break;
+        const std::size_t start = i;
+        while (i < text.size() && !blank(text[i])) ++i;
+        add(text.substr(start, i - start));
+      }
+      return names;
+    }
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t at = std::min(text.find(delimiter, start), text.size());
+      add(text.substr(start, at - start));
+      if (at == text.size()) break;
+      start = at + 1;
+    }
+    return names;
+  }
+
+  std::string delimiter_text() const {
+    if (blank_delimited) return "\" \" (any run of spaces or tabs)";
+    if (delimiter == '\t') return "'\\t' (a tab)";
+    return fmt::format("'{}'", delimiter);
+  }
+
+  void read_mapped_header(std::string_view text) {
+    columns = split_header(text);
+    std::string found;
+    for (std::size_t i = 0; i < columns.size() && i < 24; ++i) {
+      found += (i == 0 ? "" : ", ") + quote(columns[i]);
+    }
+    if (columns.size() > 24) found += fmt::format(", … ({} in all)", columns.size());
+    const std::string header = quote_long(text);
+    if (parses_as_number(columns.front())) {
+      fail(
+          fmt::format("the header line is missing: expected a line naming the columns (record.time_column = "
+                      "'{}', …) before the first row, not {}",
+                      layout->time_column, header));
+    }
+    if (columns.size() == 1) {
+      fail(
+          fmt::format("record.delimiter {} splits nothing in the header line {}: it is one column, but the "
+                      "record's time and output are two",
+                      delimiter_text(), header));
+    }
+    slot.assign(columns.size(), -1);
+    const auto mapped = mapped_columns();
+    for (std::size_t s = 0; s < mapped.size(); ++s) {
+      const auto& [key, configured] = mapped[s];
+      if (configured->empty()) continue;
+      const std::string_view wanted = trim(*configured);
+      std::size_t index = columns.size();
+      for (std::size_t i = 0; i < columns.size(); ++i) {
+        if (columns[i] != wanted) continue;
+        if (index != columns.size()) {
+          fail(
+              fmt::format("the header line {} names '{}' twice (columns {} and {}), so record.{} is "
+                          "ambiguous",
+                          header, printable(wanted), index + 1, i + 1, key));
+        }
+        index = i;
+      }
+      if (index == columns.size()) {
+        fail(
+            fmt::format("record.{} = '{}' is not a column of the header line {} (split at record.delimiter "
+                        "{}, the columns found are {})",
+                        key, printable(wanted), header, delimiter_text(), found));
+      }
+      slot[index] = static_cast<int>(s);
+    }
+  }
+
+  /// The number of fields of a row, as split by the delimiter.
+  std::size_t count_fields(std::string_view text) const {
+    if (!blank_delimited)
+      return 1 + static_cast<std::size_t>(std::count(text.begin(), text.end(), delimiter));
+    std::size_t fields = 0;
+    for (std::size_t i = 0; i < text.size();) {
+      while (i < text.size() && blank(text[i])) ++i;
+      if (i == text.size()) break;
+      ++fields;
+      while (i < text.size() && !blank(text[i])) ++i;
+    }
+    return fields;
   }
 
   [[noreturn]] void fail_truncated() const {
@@ -239,43 +433,125 @@ struct RecordReader::State {
     fail(fmt::format("the row has {} fields but the header has {} columns", fields, columns.size()));
   }
 
-  /// Parses one row into `values`; false for a blank line.
+  /// ticks / ticks_per_s as the nearest double (ties to even), exactly: one division where both are exact
+  /// doubles, else the integer quotient rounded at the precision of the result's binade.
+  static double nearest_seconds(std::uint64_t ticks, std::uint64_t ticks_per_s) {
+    constexpr std::uint64_t kExact = std::uint64_t{1} << 53;
+    if (ticks <= kExact) return static_cast<double>(ticks) / static_cast<double>(ticks_per_s);
+    const double guess = static_cast<double>(ticks / ticks_per_s) +
+                         static_cast<double>(ticks % ticks_per_s) / static_cast<double>(ticks_per_s);
+    int exponent = 0;
+    std::frexp(guess, &exponent);
+    // The guess is within an ulp: the result's binade is the guess's or a neighbour. From the finest, the
+    // first exponent whose rounded mantissa fits 53 bits is the result's.
+    for (int e = exponent - 54; e <= exponent - 52 && e <= 0; ++e) {
+      const Uint128 scaled = static_cast<Uint128>(ticks) << -e;
+      Uint128 mantissa = scaled / ticks_per_s;
+      const Uint128 rest = scaled % ticks_per_s;
+      if (2 * rest > ticks_per_s || (2 * rest == ticks_per_s && (mantissa & 1) != 0)) ++mantissa;
+      if (mantissa <= kExact) return std::ldexp(static_cast<double>(mantissa), e);
+    }
+    return guess;  // stamps beyond 2^53 s: not reached by ms, us or ns stamps of 19 digits
+  }
+
+  /// A time in ms, us or ns (time_ticks_per_s > 1) as seconds. An integer of up to 19 digits is divided
+  /// exactly (nearest_seconds): the seconds are the correctly rounded double of the stamp (docs/records.md).
+  /// Other text is parsed as a double and divided.
+  fast_float::from_chars_result parse_ticks(const char* p, const char* last, double& seconds) const {
+    const char* q = p;
+    const bool negative = q != last && *q == '-';
+    if (negative) ++q;
+    const char* const digits = q;
+    std::uint64_t ticks = 0;
+    while (q != last && q - digits < 19 && static_cast<unsigned>(*q - '0') < 10) {
+      ticks = ticks * 10 + static_cast<unsigned>(*q - '0');
+      ++q;
+    }
+    const bool integer =
+        q != digits &&
+        (q == last || (static_cast<unsigned>(*q - '0') >= 10 && *q != '.' && *q != 'e' && *q != 'E'));
+    if (integer) {
+      const double magnitude = nearest_seconds(ticks, time_ticks_per_s);
+      seconds = negative ? -magnitude : magnitude;
+      return {q, std::errc()};
+    }
+    const auto result = fast_float::from_chars(p, last, seconds);
+    seconds /= static_cast<double>(time_ticks_per_s);
+    return result;
+  }
+
+  /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
+  template <bool kBlankDelimited>
   bool parse_row(std::string_view text, double* values) {
     const char* p = text.data();
     const char* const last = p + text.size();
-    while (p != last && is_blank(*p)) ++p;
+    while (p != last && blank(*p)) ++p;
     if (p == last) return false;
-    if (*p == '#') fail("a '#' line follows the header; metadata lines must come before it");
+    if (!layout) {
+      if (*p == '#') fail("a '#' line follows the header; metadata lines must come before it");
+    } else if (!layout->comment.empty() &&
+               std::string_view(p, static_cast<std::size_t>(last - p)).starts_with(layout->comment)) {
+      return false;  // a comment among the rows of a rig's record (docs/records.md)
+    }
     const std::size_t count = columns.size();
     for (std::size_t i = 0; i < count; ++i) {
-      while (p != last && is_blank(*p)) ++p;
+      while (p != last && blank(*p)) ++p;
       const char* const field = p;
-      const auto result = fast_float::from_chars(p, last, values[i]);
-      p = result.ptr;
-      while (p != last && is_blank(*p)) ++p;
-      const bool field_ends = p == last || *p == ',';
-      if (result.ec != std::errc() || !field_ends) {
-        if (field == last && line_unterminated) fail_truncated();
-        const char* field_end = std::find(field, last, ',');
-        const std::string_view field_text = trim({field, static_cast<std::size_t>(field_end - field)});
-        if (field_text.empty()) fail(fmt::format("column {} ({}) is empty", i + 1, printable(columns[i])));
-        fail(fmt::format("column {} ({}) is {}, which is not a number", i + 1, printable(columns[i]),
-                         quote(field_text)));
-      }
-      if (!std::isfinite(values[i])) {
-        fail(fmt::format("column {} ({}) is {}; a record holds finite numbers only", i + 1,
-                         printable(columns[i]),
-                         quote({field, static_cast<std::size_t>(result.ptr - field)})));
+      const int s = slot[i];
+      if (s < 0) {
+        // A column the layout does not name: skipped unread.
+        if constexpr (kBlankDelimited) {
+          while (p != last && !blank(*p)) ++p;
+          while (p != last && blank(*p)) ++p;
+        } else {
+          const void* at = std::memchr(p, delimiter, static_cast<std::size_t>(last - p));
+          p = at == nullptr ? last : static_cast<const char*>(at);
+        }
+      } else {
+        const auto result = s == 0 && time_ticks_per_s != 1 ? parse_ticks(p, last, values[0])
+                                                            : fast_float::from_chars(p, last, values[s]);
+        p = result.ptr;
+        const char* const number_end = p;
+        while (p != last && blank(*p)) ++p;
+        bool field_ends = false;
+        if constexpr (kBlankDelimited) {
+          field_ends = p == last || p != number_end;
+        } else {
+          field_ends = p == last || *p == delimiter;
+        }
+        if (result.ec != std::errc() || !field_ends) {
+          if (field == last && line_unterminated) fail_truncated();
+          const char* field_end = field;
+          if constexpr (kBlankDelimited) {
+            while (field_end != last && !blank(*field_end)) ++field_end;
+          } else {
+            field_end = std::find(field, last, delimiter);
+          }
+          const std::string_view field_text = trim({field, static_cast<std::size_t>(field_end - field)});
+          if (field_text.empty()) fail(fmt::format("column {} ({}) is empty", i + 1, printable(columns[i])));
+          fail(fmt::format("column {} ({}) is {}, which is not a number", i + 1, printable(columns[i]),
+                           quote(field_text)));
+        }
+        if (!std::isfinite(values[s])) {
+          fail(fmt::format("column {} ({}) is {}; a record holds finite numbers only", i + 1,
+                           printable(columns[i]),
+                           quote({field, static_cast<std::size_t>(number_end - field)})));
+        }
       }
       if (i + 1 < count) {
         if (p == last) fail_field_count(text);
-        ++p;  // the ','
+        if constexpr (!kBlankDelimited) ++p;  // the delimiter
       } else if (p != last) {
         fail_field_count(text);
       }
     }
     if (have_previous && !(values[0] > previous_time_s)) {
-      fail(fmt::format("time_s {} does not increase (the previous row has {})", values[0], previous_time_s));
+      if (!layout) {
+        fail(
+            fmt::format("time_s {} does not increase (the previous row has {})", values[0], previous_time_s));
+      }
+      fail(fmt::format("the time ({}, {} s) does not increase (the previous row has {} s)",
+                       printable(layout->time_column), values[0], previous_time_s));
     }
     previous_time_s = values[0];
     have_previous = true;
@@ -287,19 +563,38 @@ RecordReader::RecordReader(std::unique_ptr<State> state) : state_(std::move(stat
   state_->read_head();
 }
 
-RecordReader::RecordReader(const std::filesystem::path& path, std::size_t chunk_bytes)
-    : state_(std::make_unique<State>(path.string(), chunk_bytes)) {
-  state_->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (state_->fd < 0) {
+std::unique_ptr<RecordReader::State> RecordReader::open(const std::filesystem::path& path,
+                                                        std::size_t chunk_bytes) {
+  auto state = std::make_unique<State>(path.string(), chunk_bytes);
+  state->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (state->fd < 0) {
     throw Error(fmt::format("Cannot open record '{}': {}.", path.string(),
                             std::error_code(errno, std::generic_category()).message()));
   }
-  ::posix_fadvise(state_->fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+  ::posix_fadvise(state->fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+  return state;
+}
+
+RecordReader::RecordReader(const std::filesystem::path& path, std::size_t chunk_bytes)
+    : state_(open(path, chunk_bytes)) {
+  state_->read_head();
+}
+
+RecordReader::RecordReader(const std::filesystem::path& path, const std::optional<RecordLayout>& layout,
+                           std::size_t chunk_bytes)
+    : state_(open(path, chunk_bytes)) {
+  if (layout) state_->use_layout(*layout);
   state_->read_head();
 }
 
 RecordReader RecordReader::from_string(std::string text, std::string name, std::size_t chunk_bytes) {
+  return from_string(std::move(text), std::nullopt, std::move(name), chunk_bytes);
+}
+
+RecordReader RecordReader::from_string(std::string text, const std::optional<RecordLayout>& layout,
+                                       std::string name, std::size_t chunk_bytes) {
   auto state = std::make_unique<State>(std::move(name), chunk_bytes);
+  if (layout) state->use_layout(*layout);
   state->memory = std::move(text);
   return RecordReader(std::move(state));
 }
@@ -315,27 +610,41 @@ const std::vector<std::string>& RecordReader::columns() const {
   return state_->columns;
 }
 std::size_t RecordReader::extra_column_count() const {
-  return state_->columns.size() - kRecordColumns.size();
+  return state_->layout ? 0 : state_->columns.size() - kRecordColumns.size();
 }
 const std::string& RecordReader::name() const {
   return state_->name;
+}
+const std::optional<RecordLayout>& RecordReader::layout() const {
+  return state_->layout;
 }
 std::uint64_t RecordReader::line_number() const {
   return state_->line;
 }
 
 bool RecordReader::next(RecordSample& sample) {
+  State& s = *state_;
   double values[kColumnCountMax];
   std::string_view text;
   do {
-    if (!state_->next_line(text)) return false;
-  } while (!state_->parse_row(text, values));
+    if (!s.next_line(text)) return false;
+  } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
   sample.time_s = values[0];
-  sample.main_angle_deg = values[1];
-  sample.counter_angle_deg = values[2];
-  sample.position_angle_deg = values[3];
-  sample.gyro_deg_h = values[4];
-  std::copy(values + kRecordColumns.size(), values + state_->columns.size(), sample.extra.begin());
+  if (!s.layout) {
+    sample.main_angle_deg = values[1];
+    sample.counter_angle_deg = values[2];
+    sample.position_angle_deg = values[3];
+    sample.gyro_deg_h = values[4];
+    std::copy(values + kRecordColumns.size(), values + s.columns.size(), sample.extra.begin());
+    return true;
+  }
+  // A layout's units into deg and deg/h (docs/records.md); an absent angle column reads as NaN.
+  double* const angles[3] = {&sample.main_angle_deg, &sample.counter_angle_deg, &sample.position_angle_deg};
+  for (std::size_t i = 0; i < 3; ++i) {
+    *angles[i] = s.angle_present[i] ? values[i + 1] * s.angle_multiplier[i] / s.angle_divisor[i]
+                                    : std::numeric_limits<double>::quiet_NaN();
+  }
+  sample.gyro_deg_h = values[4] / s.output_divisor;
   return true;
 }
 

@@ -222,6 +222,43 @@ def test_noise_from_path_and_arrays_equal_cli(tmp_path):
     assert from_arrays == expected
 
 
+def test_a_mapped_record_reads_through_the_scenarios_record_section(small, tmp_path):
+    """A rig's own layout (docs/records.md): ';', ms stamps, angles in radians, the output in mV, no magic line and
+    no angle columns for noise. The module reads a path through the scenario's [record], as --config does."""
+    config, _ = small
+    rec = gyrocal.simulate(gyrocal.Scenario.load(config), seed=4)
+    mapped_config = tmp_path / "rig.toml"
+    mapped_config.write_text(open(config).read() + """
+[record]
+delimiter = ";"
+time_column = "t_ms"
+time_unit = "ms"
+main_angle_column = "theta"
+counter_angle_column = "psi"
+position_angle_column = "beta"
+angle_unit = "rad"
+output_column = "U_mV"
+output_scale_per_deg_h = 4.0
+""")
+    sc = gyrocal.Scenario.load(str(mapped_config))
+    record = tmp_path / "rig.csv"
+    with open(record, "w") as f:
+        f.write("U_mV;t_ms;beta;theta;psi\n")
+        for w, t, b, m, c in zip(rec["gyro_deg_h"], rec["time_s"], rec["position_angle_deg"], rec["main_angle_deg"],
+                                 rec["counter_angle_deg"]):
+            f.write(f"{w * 4.0!r};{round(t * 1000)};{math.radians(b)!r};{math.radians(m)!r};{math.radians(c)!r}\n")
+    expected = json.loads(run_cli("calibrate", record, "--config", mapped_config, "--json", "-").stdout)
+    assert gyrocal.calibrate(str(record), sc) == expected
+    native = gyrocal.calibrate(rec, sc)
+    for name, c in native["coefficients"].items():
+        if c["identifiable"]:
+            assert abs(expected["coefficients"][name]["value"] - c["value"]) <= 1e-6 * c["std"], name
+    expected_noise = json.loads(run_cli("noise", record, "--config", mapped_config, "--json", "-").stdout)
+    assert gyrocal.noise(str(record), sc) == expected_noise
+    with pytest.raises(ValueError, match="this is not a gyrocal record"):
+        gyrocal.noise(str(record))
+
+
 # --- errors -----------------------------------------------------------------------------------------------------
 
 def test_bad_configuration_raises_value_error_with_cli_sentence(tmp_path):

@@ -4,10 +4,12 @@
 // characterise_noise().
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gyrocal/core/noise_terms.hpp"
+#include "gyrocal/record/record_layout.hpp"
 
 namespace gyrocal {
 
@@ -28,11 +30,13 @@ struct RecordNoise {
   std::string record;           ///< the record's name, for messages and the result
 };
 
-/// Reads the record at `path` (gyrocal's format) and characterises its output (deg/h). Throws Error naming
-/// the file and line when the record is not valid, the sampling is uneven (a gap or a stray row, with its
-/// time), or there are too few rows.
+/// Reads the record at `path` and characterises its output (deg/h). `layout`: the record's layout (the
+/// configuration's [record], docs/records.md; its angle columns may be absent), nullopt for gyrocal's own
+/// format. Throws Error naming the file and line when the record is not valid, the sampling is uneven (a gap
+/// or a stray row, with its time), or there are too few rows.
 RecordNoise characterise_record_noise(const std::filesystem::path& path,
-                                      const RecordNoiseOptions& options = {});
+                                      const RecordNoiseOptions& options = {},
+                                      const std::optional<RecordLayout>& layout = std::nullopt);
 
 /// The same for samples held in memory (time in s, output in deg/h); `name` stands for the record in
 /// messages.

@@ -2,12 +2,14 @@
 // A scenario: everything a configuration file describes. Every key is optional; the defaults are the
 // default scenario of docs/physics.md section 11.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/plan/test_spec.hpp"
+#include "gyrocal/record/record_layout.hpp"
 
 namespace gyrocal {
 
@@ -19,6 +21,9 @@ struct Scenario {
   GyroNoise noise;               ///< [gyro.noise]
   TestSpec test;                 ///< [test]
   CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+  /// [record]: how to read a rig's own record (docs/records.md); nullopt (no [record] section) means
+  /// gyrocal's own format, magic line required.
+  std::optional<RecordLayout> record;
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }

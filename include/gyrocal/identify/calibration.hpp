@@ -3,6 +3,7 @@
 // forms or general weighted least squares, with compensation none, seed or full.
 #include <array>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,8 +105,11 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
                            const CentrifugeModel& model, const CalibrationOptions& options);
 
 /// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
+/// `layout`: how the record is laid out (the configuration's [record], docs/records.md); nullopt for
+/// gyrocal's own format. A layout without all three angle columns is refused, naming the keys.
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
-                                   const TestSpec& plan, const CalibrationOptions& options);
+                                   const TestSpec& plan, const CalibrationOptions& options,
+                                   const std::optional<RecordLayout>& layout = std::nullopt);
 
 /// The 16 positions of docs/physics.md section 7 in the plan, at its first spinning rate: for k = 1..16 the
 /// index into reduction.positions, or an empty vector when the plan does not hold them.

@@ -18,16 +18,23 @@
 //   few fields is reported as truncated. (A number cut short in the last field is undetectable.)
 // - A header with no rows is a valid, empty record.
 // Every problem is reported as gyrocal::Error naming the file and the line, and only the first.
+//
+// A rig's own layout is read through a RecordLayout (record/record_layout.hpp, the configuration's [record]
+// section; docs/records.md): its delimiter, comment prefix, columns found by name in any order (the others
+// skipped unread) and units converted to s, deg and deg/h; no magic line is needed.
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "gyrocal/record/record_layout.hpp"
 
 namespace gyrocal {
 
@@ -42,7 +49,8 @@ inline constexpr std::size_t kMaxExtraColumns = 8;
 /// Ordered `# key = value` metadata lines.
 using RecordMetadata = std::vector<std::pair<std::string, std::string>>;
 
-/// One row of a record.
+/// One row of a record, in gyrocal's units whatever the record's layout. A column that the layout leaves
+/// absent (an angle column named "") reads as NaN.
 struct RecordSample {
   double time_s = 0.0;              ///< time since the start of the test, s
   double main_angle_deg = 0.0;      ///< main axis encoder θ, deg (wrapped or unwrapped)
@@ -102,12 +110,22 @@ class RecordReader {
   /// Longest line accepted, bytes (bounds memory on input that is not a record).
   static constexpr std::size_t kMaxLineBytes = std::size_t{1} << 16;
 
-  /// Opens the record at `path` and reads its magic line, metadata and header. Throws gyrocal::Error
-  /// naming the file (and line) if it cannot be opened or is not a valid record so far.
-  /// `chunk_bytes` (> 0) is the read size; small values exist for tests of chunk boundaries.
+  /// Opens the record at `path` (gyrocal's own format) and reads its magic line, metadata and header.
+  /// Throws gyrocal::Error naming the file (and line) if it cannot be opened or is not a valid record so
+  /// far. `chunk_bytes` (> 0) is the read size; small values exist for tests of chunk boundaries.
   explicit RecordReader(const std::filesystem::path& path, std::size_t chunk_bytes = kDefaultChunkBytes);
+  /// The same through `layout` (nullopt: gyrocal's own format, as above): no magic line needed, the
+  /// layout's columns found in the header by name. Throws gyrocal::Error naming the key for an invalid
+  /// layout (RecordLayout::IsValid), and the file, the line, the header and the columns found when the
+  /// header does not hold a column the layout names.
+  RecordReader(const std::filesystem::path& path, const std::optional<RecordLayout>& layout,
+               std::size_t chunk_bytes = kDefaultChunkBytes);
   /// Reads a record held in memory; `name` stands for the file name in messages.
   static RecordReader from_string(std::string text, std::string name = "<memory>",
+                                  std::size_t chunk_bytes = kDefaultChunkBytes);
+  /// The same through `layout` (nullopt: gyrocal's own format).
+  static RecordReader from_string(std::string text, const std::optional<RecordLayout>& layout,
+                                  std::string name = "<memory>",
                                   std::size_t chunk_bytes = kDefaultChunkBytes);
 
   RecordReader(RecordReader&&) noexcept;
@@ -116,10 +134,14 @@ class RecordReader {
 
   /// Metadata lines, in file order, key and value trimmed of surrounding spaces.
   const RecordMetadata& metadata() const;
-  /// All column names of the header: the five of kRecordColumns, then the extra ones.
+  /// All column names of the header: in gyrocal's own format the five of kRecordColumns, then the extra
+  /// ones; through a layout, the header's names in order.
   const std::vector<std::string>& columns() const;
-  /// The number of extra columns (columns().size() - 5).
+  /// The number of extra columns (columns().size() - 5) of gyrocal's own format; 0 through a layout (its
+  /// other columns are skipped, RecordSample::extra is not filled).
   std::size_t extra_column_count() const;
+  /// The layout read through, or nullopt for gyrocal's own format.
+  const std::optional<RecordLayout>& layout() const;
   /// The file name used in messages.
   const std::string& name() const;
 
@@ -132,6 +154,7 @@ class RecordReader {
  private:
   struct State;
   explicit RecordReader(std::unique_ptr<State> state);
+  static std::unique_ptr<State> open(const std::filesystem::path& path, std::size_t chunk_bytes);
   std::unique_ptr<State> state_;
 };
 

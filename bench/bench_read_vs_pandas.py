@@ -1,0 +1,120 @@
+#!/usr/bin/python3
+"""gyrocal's record reader beside pandas.read_csv on the same record, same machine, same run (issue 8, "Speed
+and memory"; docs/performance.md).
+
+    bench/bench_read_vs_pandas.py BUILD_DIR [--rows 2000000] [--rounds 5] [--keep DIR]
+
+Writes a simulated record of about ROWS rows once (`gyrocal simulate`), and the same samples as a rig would
+write them: ';' between fields, time stamps in integer ms, the three angles as encoder counts (2^24 a
+revolution, the main axis wrapped), the output in mV at 2.5 mV per deg/h, read through a [record] mapping.
+Then, in ROUNDS interleaved rounds: the gyrocal reader on the native record (bench_read_file, the reader
+alone), pandas.read_csv on the native record, and the gyrocal reader on the foreign record. Prints the medians,
+the ratio pandas / gyrocal (target >= 3) and foreign / native (target <= 1.5), and the reader's peak memory.
+"""
+import argparse
+import math
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import pandas as pd
+
+COUNTS = 1 << 24
+MV_PER_DEG_H = 2.5
+FOREIGN_TOML = """[record]
+delimiter = ";"
+time_column = "t_ms"
+time_unit = "ms"
+main_angle_column = "theta_cnt"
+counter_angle_column = "psi_cnt"
+position_angle_column = "beta_cnt"
+main_counts_per_revolution = 16777216
+counter_counts_per_revolution = 16777216
+position_counts_per_revolution = 16777216
+output_column = "U_mV"
+output_scale_per_deg_h = 2.5
+"""
+
+
+def gyrocal_read(bench, record, config=None):
+    args = [bench, record] + ([config] if config else [])
+    out = subprocess.run(args, check=True, capture_output=True, text=True).stdout
+    return {k: float(v) for k, v in re.findall(r"(\w+)=([-0-9.e+]+)", out)}
+
+
+def pandas_read(record):
+    start = time.perf_counter()
+    frame = pd.read_csv(record, comment="#")
+    seconds = time.perf_counter() - start
+    assert len(frame) > 0
+    return seconds
+
+
+def write_foreign(native, foreign):
+    frame = pd.read_csv(native, comment="#")
+    out = pd.DataFrame({
+        "t_ms": (frame["time_s"] * 1000.0).round().astype("int64"),
+        "theta_cnt": (frame["main_angle_deg"] / 360.0 * COUNTS).round().astype("int64") % COUNTS,
+        "psi_cnt": (frame["counter_angle_deg"] / 360.0 * COUNTS).round().astype("int64"),
+        "beta_cnt": (frame["position_angle_deg"] / 360.0 * COUNTS).round().astype("int64"),
+        "U_mV": frame["gyro_deg_h"] * MV_PER_DEG_H,
+    })
+    out.to_csv(foreign, sep=";", index=False, float_format="%.17g")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("build", help="the build folder (holds gyrocal and bench/bench_read_file)")
+    parser.add_argument("--rows", type=float, default=2e6)
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--keep", help="folder for the records (default: a temporary one, removed)")
+    args = parser.parse_args()
+    gyrocal = os.path.join(args.build, "gyrocal")
+    bench = os.path.join(args.build, "bench", "bench_read_file")
+    with tempfile.TemporaryDirectory(prefix="gyrocal-bench-read-") as temporary:
+        folder = args.keep or temporary
+        os.makedirs(folder, exist_ok=True)
+        native = os.path.join(folder, "native.csv")
+        foreign = os.path.join(folder, "foreign.csv")
+        config = os.path.join(folder, "foreign.toml")
+        # The default 16-position test at 200 Hz: 4 dwells of revolutions * 2 pi / 9.9 s.
+        revolutions = max(1, int(args.rows / 200.0 / 4.0 / (2 * math.pi / 9.9)))
+        scenario = os.path.join(folder, "scenario.toml")
+        with open(scenario, "w") as f:
+            f.write(f"[test]\nrevolutions = {revolutions}\n")
+        if not os.path.exists(native):
+            subprocess.run([gyrocal, "simulate", "--config", scenario, "--out", native], check=True,
+                           capture_output=True)
+        if not os.path.exists(foreign):
+            write_foreign(native, foreign)
+        with open(config, "w") as f:
+            f.write(FOREIGN_TOML)
+        native_s, pandas_s, foreign_s, peak = [], [], [], 0.0
+        for _ in range(args.rounds):
+            n = gyrocal_read(bench, native)
+            native_s.append(n["seconds"])
+            pandas_s.append(pandas_read(native))
+            f = gyrocal_read(bench, foreign, config)
+            foreign_s.append(f["seconds"])
+            peak = max(peak, n["peak_rss_mb"], f["peak_rss_mb"])
+            assert n["rows"] == f["rows"], (n, f)
+        mb = os.path.getsize(native) / 1e6
+        med = statistics.median
+        print(f"record: {int(n['rows'])} rows, native {mb:.1f} MB, foreign {os.path.getsize(foreign) / 1e6:.1f} MB;"
+              f" {args.rounds} rounds, medians (min-max)")
+        for name, values in (("gyrocal reader, native", native_s), ("pandas.read_csv, native", pandas_s),
+                             ("gyrocal reader, foreign (mapped)", foreign_s)):
+            print(f"  {name:34s} {med(values):7.3f} s  ({min(values):.3f}-{max(values):.3f})")
+        ratios = [p / g for p, g in zip(pandas_s, native_s)]
+        print(f"pandas / gyrocal native: {med(pandas_s) / med(native_s):.2f}x (per round {min(ratios):.2f}-"
+              f"{max(ratios):.2f}; target >= 3)")
+        print(f"foreign / native: {med(foreign_s) / med(native_s):.2f}x (target <= 1.5)")
+        print(f"gyrocal reader peak memory: {peak:.1f} MB")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,163 @@
+#include "gyrocal/record/record_layout.hpp"
+
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+
+namespace gyrocal {
+
+std::string_view to_string(TimeUnit unit) {
+  switch (unit) {
+    case TimeUnit::kSeconds:
+      return "s";
+    case TimeUnit::kMilliseconds:
+      return "ms";
+    case TimeUnit::kMicroseconds:
+      return "us";
+    case TimeUnit::kNanoseconds:
+      return "ns";
+  }
+  return "s";
+}
+
+std::string_view to_string(AngleUnit unit) {
+  return unit == AngleUnit::kRadians ? "rad" : "deg";
+}
+
+std::optional<TimeUnit> parse_time_unit(std::string_view text) {
+  for (TimeUnit unit :
+       {TimeUnit::kSeconds, TimeUnit::kMilliseconds, TimeUnit::kMicroseconds, TimeUnit::kNanoseconds}) {
+    if (text == to_string(unit)) return unit;
+  }
+  return std::nullopt;
+}
+
+std::optional<AngleUnit> parse_angle_unit(std::string_view text) {
+  for (AngleUnit unit : {AngleUnit::kDegrees, AngleUnit::kRadians}) {
+    if (text == to_string(unit)) return unit;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+bool is_line_break(char c) {
+  return c == '\n' || c == '\r';
+}
+
+/// A character a number can hold or begin with ("1.5e-3", "+2", "inf", "nan"): as a delimiter it would cut
+/// numbers apart, as the start of a comment prefix it would take rows for comments.
+bool can_be_in_a_number(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return std::isdigit(u) != 0 || std::isalpha(u) != 0 || c == '.' || c == '+' || c == '-';
+}
+
+}  // namespace
+
+bool RecordLayout::IsValid(std::string* error, std::string* key) const {
+  const auto fail = [&](std::string_view k, std::string text) {
+    if (error != nullptr) *error = std::move(text);
+    if (key != nullptr) *key = std::string(k);
+    return false;
+  };
+  const auto printable = [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u >= 0x20 && u < 0x7f ? fmt::format("'{}'", c) : fmt::format("\\x{:02X}", u);
+  };
+  if (is_line_break(delimiter) || delimiter == '"' || static_cast<unsigned char>(delimiter) >= 0x80 ||
+      (delimiter != '\t' && static_cast<unsigned char>(delimiter) < 0x20) || can_be_in_a_number(delimiter)) {
+    return fail(
+        "delimiter",
+        fmt::format("record.delimiter {} cannot separate numbers: use a punctuation character such as "
+                    "',' or ';', a tab, or \" \" for any run of spaces or tabs",
+                    printable(delimiter)));
+  }
+  for (char c : comment) {
+    if (is_line_break(c)) return fail("comment", "record.comment must not hold a line break");
+  }
+  const auto starts_a_number = [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '+' || c == '-';
+  };
+  if (!comment.empty() && (starts_a_number(comment.front()) || comment.front() == ' ' ||
+                           comment.front() == '\t' || comment.front() == delimiter)) {
+    return fail("comment", fmt::format("record.comment '{}' begins with {}, which a row or a field can begin "
+                                       "with: rows would be taken for comments",
+                                       comment, printable(comment.front())));
+  }
+  if (!(std::isfinite(output_scale_per_deg_h) && output_scale_per_deg_h > 0.0)) {
+    return fail("output_scale_per_deg_h",
+                fmt::format("record.output_scale_per_deg_h must be a finite number > 0 (output units per "
+                            "deg/h; the output is divided by it), not {}",
+                            output_scale_per_deg_h));
+  }
+  const std::array<std::pair<std::string_view, std::int64_t>, 3> counts = {{
+      {"main_counts_per_revolution", main_counts_per_revolution},
+      {"counter_counts_per_revolution", counter_counts_per_revolution},
+      {"position_counts_per_revolution", position_counts_per_revolution},
+  }};
+  for (const auto& [name, value] : counts) {
+    if (value != 0 && value < 2) {
+      return fail(name, fmt::format("record.{} must be 0 (the column holds angles in angle_unit) or an "
+                                    "integer >= 2 (encoder counts per revolution), not {}",
+                                    name, value));
+    }
+  }
+  const std::array<std::pair<std::string_view, const std::string*>, 5> columns = {{
+      {"time_column", &time_column},
+      {"main_angle_column", &main_angle_column},
+      {"counter_angle_column", &counter_angle_column},
+      {"position_angle_column", &position_angle_column},
+      {"output_column", &output_column},
+  }};
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    const auto& [name, column] = columns[i];
+    const bool required = name == "time_column" || name == "output_column";
+    if (column->empty()) {
+      if (!required) continue;
+      return fail(name, fmt::format("record.{} must name a column; only the angle columns may be empty "
+                                    "(absent)",
+                                    name));
+    }
+    for (char c : *column) {
+      if (is_line_break(c) || c == '"' || (delimiter == ' ' ? c == ' ' || c == '\t' : c == delimiter)) {
+        return fail(name, fmt::format("record.{} = '{}' holds {}, which no column name of a header split at "
+                                      "the delimiter can hold",
+                                      name, *column, printable(c)));
+      }
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (*columns[j].second == *column) {
+        return fail(name, fmt::format("record.{} and record.{} both name the column '{}'; each column holds "
+                                      "one quantity",
+                                      columns[j].first, name, *column));
+      }
+    }
+  }
+  return true;
+}
+
+void require_angle_columns(const std::optional<RecordLayout>& layout, const std::string& record_name) {
+  if (!layout || layout->has_angles()) return;
+  std::string empty;
+  for (const auto& [key, column] :
+       {std::pair<std::string_view, const std::string*>{"main_angle_column", &layout->main_angle_column},
+        {"counter_angle_column", &layout->counter_angle_column},
+        {"position_angle_column", &layout->position_angle_column}}) {
+    if (column->empty()) empty += fmt::format("{}record.{}", empty.empty() ? "" : ", ", key);
+  }
+  throw Error(
+      fmt::format("Cannot calibrate from {}: {} {} empty (absent), but a calibration reads the main, "
+                  "counter and position angles; name their columns in [record].",
+                  record_name, empty, empty.find(',') == std::string::npos ? "is" : "are"));
+}
+
+bool RecordLayout::has_angles() const {
+  return !main_angle_column.empty() && !counter_angle_column.empty() && !position_angle_column.empty();
+}
+
+}  // namespace gyrocal
