@@ -4,16 +4,21 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/cli_run.hpp"
 
 namespace gyrocal {
 namespace {
@@ -189,8 +194,13 @@ TEST(SelfCalibration, NoisyZScoresHaveUnitSpread) {
   const Scenario truth = two_speed_truth(true);
   const Scenario config = configured(truth);
   const std::vector<double> expected = counter_truth(truth);
-  double sum_coefficients = 0.0, sum_errors = 0.0;
+  double sum_coefficients = 0.0, sum_errors = 0.0, sum_predicted = 0.0;
   int n_coefficients = 0, n_errors = 0;
+  // What `plan --estimate` predicts for the same plan beforehand (docs/physics.md section 12).
+  CalibrationOptions po;
+  po.estimate = parse_machine_error_names(kCounterErrors, "test");
+  const CalibrationResult predicted = predict_calibration(config, po);
+  ASSERT_EQ(predicted.machine_errors.size(), 3u);
   for (int seed = 1; seed <= seeds; ++seed) {
     const CalibrationResult r =
         self_calibrate(config, simulate_and_reduce(truth, static_cast<std::uint64_t>(seed)), kCounterErrors);
@@ -204,11 +214,18 @@ TEST(SelfCalibration, NoisyZScoresHaveUnitSpread) {
     for (std::size_t j = 0; j < 2; ++j) {
       const double z = (r.machine_errors[j].value - expected[j]) / r.machine_errors[j].std;
       sum_errors += z * z;
+      const double zp = (r.machine_errors[j].value - expected[j]) / predicted.machine_errors[j].std;
+      sum_predicted += zp * zp;
       ++n_errors;
     }
   }
   const double sd_coefficients = std::sqrt(sum_coefficients / n_coefficients);
   const double sd_errors = std::sqrt(sum_errors / n_errors);
+  // The predicted standard uncertainties against the scatter of the estimates about the truth.
+  const double scatter_over_predicted = std::sqrt(sum_predicted / n_errors);
+  std::printf("scatter / predicted std of the estimated errors: %.3f\n", scatter_over_predicted);
+  EXPECT_GT(scatter_over_predicted, sanitized() ? 0.6 : 0.9);
+  EXPECT_LT(scatter_over_predicted, sanitized() ? 1.4 : 1.1);
   RecordProperty("sd_coefficients", std::to_string(sd_coefficients));
   RecordProperty("sd_errors", std::to_string(sd_errors));
   std::printf("z-score spread: coefficients %.3f, errors %.3f over %d seeds\n", sd_coefficients, sd_errors,
@@ -218,6 +235,52 @@ TEST(SelfCalibration, NoisyZScoresHaveUnitSpread) {
   EXPECT_LT(sd_coefficients, high);
   EXPECT_GT(sd_errors, low);
   EXPECT_LT(sd_errors, high);
+}
+
+TEST(SelfCalibrationConfig, EstimateKeyReadWrittenAndRefused) {
+  Scenario s = default_scenario();
+  s.estimate = {"counter_perpendicularity_x", "counter_wobble_y:2"};
+  EXPECT_EQ(parse_scenario(scenario_to_toml(s), "round trip").estimate, s.estimate);
+  try {
+    parse_scenario("[calibration]\nestimate = [\"counter_wobble_x\"]\n", "c.toml");
+    ADD_FAILURE() << "a series without its harmonic was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("c.toml, line 2: calibration.estimate: counter_wobble_x is a harmonic series"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_THROW(parse_scenario("[calibration]\nestimate = [3]\n", "c.toml"), Error);
+  EXPECT_THROW(parse_scenario("[calibration]\nmethod = \"x\"\n", "c.toml"), Error);
+}
+
+TEST(SelfCalibrationCli, PlanSaysOneSpeedCannotGiveThePerpendicularity) {
+  const auto dir = test::fresh_test_folder("gyrocal-estimate");
+  { std::ofstream(dir / "c.toml") << test::short_test_toml(); }
+  const test::CliOutcome one = test::run_cli(
+      "plan --config " + (dir / "c.toml").string() + " --estimate counter_perpendicularity_x", dir);
+  EXPECT_EQ(one.status, 0) << one.err;
+  EXPECT_NE(one.out.find("counter_perpendicularity_x cannot be estimated from this plan"), std::string::npos)
+      << one.out;
+  EXPECT_NE(one.out.find("second non-zero speed"), std::string::npos) << one.out;
+  // A second speed: the same request is identified, with a predicted uncertainty in the JSON.
+  Scenario two = default_scenario();
+  two.test.revolutions = 12;
+  two.test.sample_rate_hz = 100;
+  two.test.rates_rad_s = {9.9, 5.0};
+  two.estimate = {"counter_perpendicularity_x"};
+  { std::ofstream(dir / "two.toml") << scenario_to_toml(two); }
+  const test::CliOutcome both =
+      test::run_cli("plan --config " + (dir / "two.toml").string() + " --json -", dir);
+  EXPECT_EQ(both.status, 0) << both.err;
+  EXPECT_NE(both.out.find("\"machine_errors\""), std::string::npos);
+  EXPECT_NE(both.out.find("\"identifiable\": true,\n      \"std\""), std::string::npos) << both.out;
+  // An unknown name is refused with the key at fault, and nothing is written.
+  const test::CliOutcome bad = test::run_cli("plan --estimate counter_perpendicularity", dir);
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("--estimate: unknown machine error 'counter_perpendicularity'"), std::string::npos)
+      << bad.err;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

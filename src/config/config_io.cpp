@@ -619,6 +619,29 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
   read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
 
+  Section calibration(reader, top.table("calibration"), "calibration");
+  if (const toml::node* node = calibration.find("estimate")) {
+    const std::string path = calibration.path("estimate");
+    const toml::array& items = reader.array(*node, path);
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      const auto* name = items[i].as_string();
+      if (name == nullptr)
+        reader.fail(items[i].source(), path + "[" + std::to_string(i) +
+                                           "] must be a string naming a machine "
+                                           "error, not " +
+                                           type_name(items[i]));
+      s.estimate.push_back(name->get());
+    }
+    try {
+      parse_machine_error_names(s.estimate, path);
+    } catch (const Error& e) {
+      std::string what = e.what();
+      while (!what.empty() && what.back() == '.') what.pop_back();
+      reader.fail(node->source(), what);
+    }
+  }
+  calibration.reject_unknown();
+
   top.reject_unknown();
   return s;
 }
@@ -724,6 +747,13 @@ std::string scenario_to_toml(const Scenario& s) {
       "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
       "and phase_deg its nominal phase.");
   write_errors(w, s.uncertainty);
+
+  w.section("calibration", "The calibration's choices; the command line's options override them.");
+  std::string names = "[";
+  for (std::size_t i = 0; i < s.estimate.size(); ++i) names += (i ? ", \"" : "\"") + s.estimate[i] + "\"";
+  w.key("estimate", names + "]",
+        "machine errors estimated from the data (--estimate; docs/self_calibration.md): NAME, NAME_I/_O/_S, "
+        "NAME:N");
   return w.text();
 }
 

@@ -343,6 +343,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
                        reduction.positions, model, io, extra.names);
   const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
+  r.unknowns = static_cast<int>(n);
   r.condition_number = sol.effective_condition_number;
   r.chi2 = sol.chi2;
   r.dof = sol.dof;
@@ -609,7 +610,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
                              describe_combination(dir, es.names));
         }
         estimates[j].reason = fmt::format(
-            "collinear with the coefficients: at this plan its effect on the reduced outputs is that of a "
+            "collinear with the other unknowns: at this plan its effect on the reduced outputs is that of a "
             "combination of the other unknowns{}.",
             what);
       } else if (!(es.std[static_cast<Eigen::Index>(a)] <= kMaxErrorStdOverTypical * typical_in_unit(j))) {
@@ -828,9 +829,9 @@ std::string CalibrationResult::BriefReport() const {
           ? fmt::format(" (std up to {:.3g} x least squares' from the same positions)",
                         uncertainty_amplification)
           : std::string();
-  return fmt::format("{} with compensation {}: Ar = {:.4f} g, rank {}/10, condition {:.3g}{}, {} warning{}",
-                     to_string(method), to_string(compensation), g_level, rank, condition_number, amplified,
-                     warnings.size(), warnings.size() == 1 ? "" : "s");
+  return fmt::format("{} with compensation {}: Ar = {:.4f} g, rank {}/{}, condition {:.3g}{}, {} warning{}",
+                     to_string(method), to_string(compensation), g_level, rank, unknowns, condition_number,
+                     amplified, warnings.size(), warnings.size() == 1 ? "" : "s");
 }
 
 }  // namespace gyrocal

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
@@ -19,6 +20,9 @@ struct Scenario {
   GyroNoise noise;               ///< [gyro.noise]
   TestSpec test;                 ///< [test]
   CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+  /// [calibration] estimate: machine errors estimated from the data (--estimate; docs/self_calibration.md),
+  /// names as model/machine_errors.hpp parses them. Empty by default.
+  std::vector<std::string> estimate;
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }

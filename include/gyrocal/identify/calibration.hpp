@@ -112,6 +112,8 @@ struct CalibrationResult {
   std::vector<double> residuals_deg_h;      ///< per position: W - model at the estimate (least squares)
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
+  /// The unknowns of the least squares: the ten coefficients and the estimated machine errors' columns.
+  int unknowns = static_cast<int>(kNumCoefficients);
   /// Least squares: of its whitened, equilibrated design. Closed form: the same for its 16 positions.
   double condition_number = 0.0;
   /// Closed form only: the largest ratio of a closed form's standard uncertainty to the least-squares one
