@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
@@ -235,6 +236,34 @@ TEST(SelfCalibration, NoisyZScoresHaveUnitSpread) {
   EXPECT_LT(sd_coefficients, high);
   EXPECT_GT(sd_errors, low);
   EXPECT_LT(sd_errors, high);
+}
+
+TEST(SelfCalibration, CompensationSelfRemovesTheCounterPlatformsErrorsFromTheStudy) {
+  // The sensitivity study on two speeds: with "self" the counter platform's perpendicularity and rate
+  // mismatch, estimated instead of told, shift no coefficient; without compensation they shift dI or dOS.
+  Scenario s = two_speed_truth(false);
+  s.test.revolutions = 4;
+  SensitivityOptions o;
+  o.threads = 1;
+  const SensitivityResult r = sensitivity_study(s, o);
+  ASSERT_TRUE(r.has_self);
+  int checked = 0;
+  for (const SensitivityRow& row : r.rows) {
+    if (row.term.error != "counter_perpendicularity_x" && row.term.error != "counter_perpendicularity_y" &&
+        row.term.error != "counter_rate_mismatch")
+      continue;
+    ++checked;
+    for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+      const std::string name(kCoefficientNames[c]);
+      ASSERT_EQ(row.self.count(name), 1u) << row.term.error << " " << name;
+      EXPECT_NEAR(row.self.at(name), 0.0, 1e-7) << row.term.error << " " << name;
+    }
+    if (row.term.error != "counter_rate_mismatch") {
+      const auto& none = row.least_squares[static_cast<std::size_t>(Compensation::kNone)];
+      EXPECT_GT(std::max(std::abs(none.at("dI")), std::abs(none.at("dOS"))), 1e-3) << row.term.error;
+    }
+  }
+  EXPECT_EQ(checked, 3);
 }
 
 TEST(SelfCalibrationConfig, EstimateKeyReadWrittenAndRefused) {

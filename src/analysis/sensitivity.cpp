@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -136,6 +137,31 @@ SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base)
   return out;
 }
 
+/// Compensation "self": `s`'s planned test identified by least squares with the compensation told every error
+/// but kSelfCalibratedErrors (set to zero, the iteration's start), which are estimated
+/// (docs/self_calibration.md).
+CalibrationResult calibrate_self(const Scenario& s, const CalibrationOptions& base) {
+  const PlannedTest p = planned_test(s, base.reduce);
+  Scenario told = s;
+  CalibrationOptions o = base;
+  o.method = Method::kLeastSquares;
+  o.compensation = Compensation::kFull;
+  o.estimate = parse_machine_error_names(kSelfCalibratedErrors, "compensation self");
+  for (const MachineErrorParameter& e : o.estimate) e.set(told.errors, 0.0);
+  o.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
+  // The predicted outputs are noise-free: chi2 says nothing (as in predict_calibration).
+  o.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  const CentrifugeModel model = told.model();
+  return identify(p.reduction, reduce_model_channels(p.reduction, model, o.reduce, kMaxModelSamplesPerDwell),
+                  model, o);
+}
+
+int spinning_rates(const TestSpec& test) {
+  int n = 0;
+  for (double w : test.rates_rad_s) n += w != 0.0;
+  return n;
+}
+
 }  // namespace
 
 void MachineErrorTerm::add_to(CentrifugeErrors& errors, double amount_si) const {
@@ -188,6 +214,8 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   result.rows.resize(terms.size());
   // Item 0 is the base case (no machine error), items 1.. the rows; every item is independent.
   std::vector<SixCalibrations> runs(terms.size() + 1);
+  result.has_self = spinning_rates(scenario.test) >= 2;
+  std::vector<CalibrationResult> self_runs(result.has_self ? terms.size() + 1 : 0);
   std::atomic<std::size_t> done{0};
   parallel_for(
       terms.size() + 1, options.threads,
@@ -198,6 +226,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
           term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
         }
         runs[i] = calibrate_six(s, options.calibration);
+        if (result.has_self) self_runs[i] = calibrate_self(s, options.calibration);
         ++done;
       },
       [&] {
@@ -220,6 +249,10 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
     for (const NamedEstimate& e : r0.alternatives) result.units[e.name] = e.unit;
     for (const NamedEstimate& e : r0.combinations) result.units[e.name] = e.unit;
   }
+
+  if (result.has_self)
+    for (const auto& [name, vs] : estimates(self_runs[0], scenario.gyro))
+      result.self_noise_std[name] = vs.second;
 
   const bool noisy = scenario.noise.angle_random_walk_deg_rt_h > 0;
   for (std::size_t i = 0; i < terms.size(); ++i) {
@@ -250,6 +283,19 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
         }
       }
     }
+    if (!result.has_self) continue;
+    const auto base_self = estimates(self_runs[0], scenario.gyro);
+    for (const auto& [name, vs] : estimates(self_runs[i + 1], scenario.gyro))
+      for (const auto& [name0, vs0] : base_self) {
+        if (name0 != name) continue;
+        const double d = vs.first - vs0.first;
+        row.self[name] = d;
+        const auto it = result.self_noise_std.find(name);
+        const double sigma = noisy && it != result.self_noise_std.end() && it->second > 0
+                                 ? it->second
+                                 : 1e-6 / options.threshold;
+        if (std::abs(d) > options.threshold * sigma) row.self_matters.push_back(name);
+      }
   }
   return result;
 }
