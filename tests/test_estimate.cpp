@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/config_io.hpp"
@@ -310,6 +311,45 @@ TEST(SelfCalibrationCli, PlanSaysOneSpeedCannotGiveThePerpendicularity) {
   EXPECT_NE(bad.err.find("--estimate: unknown machine error 'counter_perpendicularity'"), std::string::npos)
       << bad.err;
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace gyrocal
+
+namespace gyrocal {
+namespace {
+
+TEST(SelfCalibration, MonteCarloBudgetWithSelfLeavesNoShareToTheEstimatedErrors) {
+  // The counter platform's perpendicularity uncertain by 0.5 arcsec (and a main-axis wobble by 0.1 arcsec):
+  // told to the compensation its draws move dOS and dI; estimated ("self") they carry no share of any
+  // coefficient's variance, and the remaining sources keep theirs.
+  Scenario s = two_speed_truth(true);
+  s.test.revolutions = 4;
+  s.uncertainty = CentrifugeErrors{};
+  s.uncertainty.counter_perpendicularity_x_rad = 0.5 * kArcsecToRad;
+  s.uncertainty.counter_perpendicularity_y_rad = 0.5 * kArcsecToRad;
+  s.uncertainty.main_wobble_x_rad.terms = {{1, 0.1 * kArcsecToRad, 0.0}};
+  MonteCarloOptions o;
+  o.trials = 2000;
+  o.threads = 1;
+  const MonteCarloResult full = monte_carlo(s, o);
+  o.self = true;
+  const MonteCarloResult self = monte_carlo(s, o);
+  EXPECT_TRUE(self.self);
+  ASSERT_EQ(self.sources, full.sources);
+  const auto share = [](const MonteCarloResult& r, const std::string& estimate, const std::string& source) {
+    for (const EstimateDistribution& d : r.estimates)
+      if (d.name == estimate)
+        for (std::size_t k = 0; k < r.sources.size(); ++k)
+          if (r.sources[k] == source) return d.budget[k];
+    ADD_FAILURE() << estimate << " / " << source << " not in the budget";
+    return -1.0;
+  };
+  EXPECT_GT(share(full, "dOS", "counter_perpendicularity_x"), 0.5);
+  EXPECT_GT(share(full, "dI", "counter_perpendicularity_y"), 0.5);
+  for (const char* c : {"dI", "dOS", "dO", "dF"})
+    for (const char* e : {"counter_perpendicularity_x", "counter_perpendicularity_y"})
+      EXPECT_LT(share(self, c, e), 1e-6) << c << " " << e;
 }
 
 }  // namespace
