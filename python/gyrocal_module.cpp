@@ -45,8 +45,9 @@ py::object json_to_python(const nlohmann::json& j) {
 }
 
 CalibrationOptions calibration_options(const std::string& method, const std::string& compensation,
-                                       const std::string& reduction) {
+                                       const std::string& reduction, const std::vector<std::string>& estimate) {
   CalibrationOptions options;
+  options.estimate = parse_machine_error_names(estimate, "estimate");
   options.method = parse_method(method);
   options.compensation = parse_compensation(compensation);
   if (reduction == "harmonic") {
@@ -128,8 +129,9 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
 }
 
 py::object calibrate_path_py(const std::string& path, const Scenario& scenario, const std::string& method,
-                             const std::string& compensation, const std::string& reduction) {
-  const CalibrationOptions options = calibration_options(method, compensation, reduction);
+                             const std::string& compensation, const std::string& reduction,
+                             const std::vector<std::string>& estimate) {
+  const CalibrationOptions options = calibration_options(method, compensation, reduction, estimate);
   nlohmann::json j;
   {
     py::gil_scoped_release release;
@@ -143,8 +145,9 @@ py::object calibrate_path_py(const std::string& path, const Scenario& scenario, 
 py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, const Column& counter_deg,
                                const Column& position_deg, const Column& gyro_deg_h, const Scenario& scenario,
                                const std::string& method, const std::string& compensation,
-                               const std::string& reduction, const std::string& name) {
-  const CalibrationOptions options = calibration_options(method, compensation, reduction);
+                               const std::string& reduction, const std::vector<std::string>& estimate,
+                               const std::string& name) {
+  const CalibrationOptions options = calibration_options(method, compensation, reduction, estimate);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
   check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
   nlohmann::json j;

@@ -11,7 +11,8 @@ namespace gyrocal::cli {
 
 void register_calibrate(CLI::App& app) {
   struct Options {
-    std::string record, config, json, method = "least-squares", compensation = "full", reduction = "harmonic";
+    std::string record, config, json, method = "least-squares", compensation = "full", estimate,
+                                      reduction = "harmonic";
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
@@ -27,6 +28,10 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--reduction", opt->reduction,
                   "harmonic (default: harmonic fit in gamma with drift) or window (mean around each gamma)")
       ->check(CLI::IsMember({"harmonic", "window"}));
+  sub->add_option(
+      "--estimate", opt->estimate,
+      "Machine errors estimated from the data with the coefficients, NAME[,NAME...] (NAME, NAME_I/_O/_S, "
+      "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
@@ -35,6 +40,9 @@ void register_calibrate(CLI::App& app) {
     CalibrationOptions options;
     options.method = parse_method(opt->method);
     options.compensation = parse_compensation(opt->compensation);
+    options.estimate = opt->estimate.empty()
+                           ? parse_machine_error_names(s.estimate, "[calibration] estimate")
+                           : parse_machine_error_names(split_names(opt->estimate), "--estimate");
     options.reduce.method =
         opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
     check_feasible(s, opt->config, options.reduce);

@@ -20,7 +20,8 @@ std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
       "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, which knows the configured "
       "errors only.\nError = estimate - truth. Predicted: the linearised model (mean = noise-free error "
       "at the configured errors).\n\n",
-      r.trials, to_string(r.mode), r.seed, seconds, to_string(r.method), to_string(r.compensation));
+      r.trials, to_string(r.mode), r.seed, seconds, to_string(r.method),
+      r.self ? std::string("self") : to_string(r.compensation));
   s += fmt::format("{:<16}{:>13}{:>13}{:>13}{:>13}  {:<10} {}\n", "estimate", "mean error", "std",
                    "pred. mean", "pred. std", "unit", "largest shares of the variance");
   for (const EstimateDistribution& e : r.estimates) {
@@ -73,8 +74,9 @@ void register_montecarlo(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
-  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
-      ->check(CLI::IsMember({"none", "seed", "full"}));
+  sub->add_option("--compensation", opt->compensation,
+                  "none, seed, full (default) or self (the counter platform's errors estimated; two speeds)")
+      ->check(CLI::IsMember({"none", "seed", "full", "self"}));
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt, seed] {
     const long long most = opt->samples ? kMaxSampleTrials : kMaxFastTrials;
@@ -97,7 +99,8 @@ void register_montecarlo(CLI::App& app) {
     options.mode = opt->samples ? MonteCarloMode::kSamples : MonteCarloMode::kFast;
     options.threads = opt->threads;
     options.calibration.method = parse_method(opt->method);
-    options.calibration.compensation = parse_compensation(opt->compensation);
+    options.self = opt->compensation == "self";
+    options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);

@@ -10,7 +10,7 @@ namespace gyrocal::cli {
 
 void register_plan(CLI::App& app) {
   struct Options {
-    std::string config, json, method = "least-squares", compensation = "full";
+    std::string config, json, method = "least-squares", compensation = "full", estimate;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -20,6 +20,10 @@ void register_plan(CLI::App& app) {
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
       ->check(CLI::IsMember({"none", "seed", "full"}));
+  sub->add_option(
+      "--estimate", opt->estimate,
+      "Machine errors estimated from the data with the coefficients, NAME[,NAME...] (NAME, NAME_I/_O/_S, "
+      "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -27,6 +31,9 @@ void register_plan(CLI::App& app) {
     CalibrationOptions options;
     options.method = parse_method(opt->method);
     options.compensation = parse_compensation(opt->compensation);
+    options.estimate = opt->estimate.empty()
+                           ? parse_machine_error_names(s.estimate, "[calibration] estimate")
+                           : parse_machine_error_names(split_names(opt->estimate), "--estimate");
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {

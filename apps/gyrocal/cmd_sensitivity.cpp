@@ -66,6 +66,12 @@ std::string sensitivity_table(const SensitivityResult& r) {
       for (const std::string& n : row.least_squares_matters[c]) names += (names.empty() ? "" : " ") + n;
       line += fmt::format("  {}: {:<28}", kCompensationNames[c], names.empty() ? "-" : names);
     }
+    if (r.has_self) {
+      // The counter platform's perpendicularity and rate mismatch estimated (docs/self_calibration.md).
+      std::string names;
+      for (const std::string& n : row.self_matters) names += (names.empty() ? "" : " ") + n;
+      line += fmt::format("  self: {:<28}", names.empty() ? "-" : names);
+    }
     s += fmt::format("{:<30}{:>18}{}\n", row_label(row), magnitude(row), line);
   }
   return s;

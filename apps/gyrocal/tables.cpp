@@ -48,6 +48,22 @@ std::string result_table(const CalibrationResult& r) {
     for (const NamedEstimate& c : r.combinations)
       out += fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.value, c.std), c.unit);
   }
+  if (!r.machine_errors.empty()) {
+    // The self-calibration: each estimate beside its configured value, and its correlation with the
+    // coefficients it trades against (dI, dOS) or any other beyond 0.5.
+    out += fmt::format("\nmachine errors estimated ({} Gauss-Newton iterations)\n", r.iterations);
+    out += fmt::format("{:<30} {:>30} {:>12}  {:<8} {}\n", "error", "estimate ± std", "configured", "unit",
+                       "correlations");
+    for (const MachineErrorEstimate& e : r.machine_errors) {
+      std::string correlations;
+      for (const auto& [name, rho] : e.correlations)
+        if (std::isfinite(rho) && (name == "dI" || name == "dOS" || std::abs(rho) > 0.5))
+          correlations += fmt::format("{}{} {:+.2f}", correlations.empty() ? "" : ", ", name, rho);
+      out += fmt::format("{:<30} {:>30} {:>12.6g}  {:<8} {}\n", e.parameter.label(),
+                         e.identifiable ? value_std(e.value, e.std) : std::string("not identifiable"),
+                         e.configured, e.unit, correlations);
+    }
+  }
   if (!r.alternatives.empty()) {
     out += "\nclosed form's second expressions\n";
     for (const NamedEstimate& c : r.alternatives)

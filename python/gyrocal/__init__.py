@@ -57,19 +57,17 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     layout when its configuration has one, as `gyrocal calibrate --config`) or a mapping of arrays (a dict such
     as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
     method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
-    "window". estimate (machine errors to self-calibrate) must be empty: self-calibration is not built yet."""
+    "window". estimate: machine errors estimated with the coefficients (self-calibration, as --estimate:
+    NAME, NAME_I/_O/_S, NAME:N; docs/self_calibration.md), a list of names or one name."""
     if estimate is None:
         estimate = ()
     if isinstance(estimate, str):
         estimate = [estimate]
-    if len(estimate) != 0:
-        raise ValueError(
-            f"estimate={list(estimate)!r}: self-calibration of machine errors is not available yet; "
-            "give estimate=[].")
+    estimate = [str(name) for name in estimate]
     if _is_path(rec):
-        return _gyrocal._calibrate_path(os.fspath(rec), scenario, method, compensation, reduction)
+        return _gyrocal._calibrate_path(os.fspath(rec), scenario, method, compensation, reduction, estimate)
     columns = [_column(rec, name) for name in RECORD_COLUMNS]
-    return _gyrocal._calibrate_arrays(*columns, scenario, method, compensation, reduction, _ARRAYS_NAME)
+    return _gyrocal._calibrate_arrays(*columns, scenario, method, compensation, reduction, estimate, _ARRAYS_NAME)
 
 
 def noise(rec, scenario=None):

@@ -112,14 +112,23 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   MonteCarloModel m;
   m.scenario = scenario;
   m.calibration = options.calibration;
+  m.told = scenario;
+  if (options.self) {
+    m.calibration.method = Method::kLeastSquares;
+    m.calibration.compensation = Compensation::kFull;
+    m.calibration.estimate = parse_machine_error_names(kSelfCalibratedErrors, "compensation self");
+    for (const MachineErrorParameter& e : m.calibration.estimate) e.set(m.told.errors, 0.0);
+  }
   for (const auto& [term, u] : nonzero_error_terms(scenario.uncertainty)) m.sources.push_back({term, u});
   const ReduceOptions& ro = options.calibration.reduce;
 
   // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
   Reduction r0 = planned_reduction(scenario);
-  const CentrifugeModel model0 = scenario.model();
+  const CentrifugeModel model0 = m.told.model();
   const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
-  set_noise_free_outputs(r0, ch0, scenario.gyro);
+  // The outputs are the true machine's (the told one differs under "self").
+  set_noise_free_outputs(r0, options.self ? reduce_model_channels(r0, scenario.model(), ro) : ch0,
+                         scenario.gyro);
   set_predicted_std_errors(r0, scenario.noise, scenario.test.sample_rate_hz, ro);
   const auto np = static_cast<Eigen::Index>(r0.positions.size());
   m.positions = static_cast<int>(np);
@@ -128,7 +137,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const auto identify_at = [&](const Eigen::VectorXd& dw) {
     Reduction r = r0;
     for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean_deg_h += dw[i];
-    return identify(r, ch0, model0, options.calibration);
+    return identify(r, ch0, model0, m.calibration);
   };
   m.bias =
       estimate_errors(identify_at(Eigen::VectorXd::Zero(np)), scenario.gyro, m.names, &m.units, &m.truth);
@@ -178,7 +187,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   const auto trials = static_cast<std::size_t>(options.trials);
 
   // The samples mode's fixed parts: the configured model the calibration knows.
-  const CentrifugeModel model0 = m.scenario.model();
+  const CentrifugeModel model0 = m.told.model();
 
   // Trial k's estimate errors into out[0..ne).
   const auto trial = [&](std::size_t k, double* out) {
@@ -286,6 +295,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   result.mode = options.mode;
   result.seed = options.seed;
   result.method = m.calibration.method;
+  result.self = !m.calibration.estimate.empty();
   result.compensation = m.calibration.compensation;
   result.sources.push_back("noise");
   result.source_std.push_back(m.scenario.noise.angle_random_walk_deg_rt_h);

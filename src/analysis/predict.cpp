@@ -223,6 +223,8 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   // freedom says nothing about a plan and must not warn.
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  // A self-calibration's Jacobian evaluated on the same bounded samples as the channels.
+  identify_options.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
   CalibrationResult result = identify(r, channels, model, identify_options);
   if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0)
     result.warnings.push_back(

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -13,65 +14,29 @@
 
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/model/machine_errors.hpp"
 
 namespace gyrocal {
 namespace {
 
-enum class Kind { kScalar, kSeries, kVector };
+using Kind = MachineErrorKind;
 
-/// A field of CentrifugeErrors: its [centrifuge.errors] key without unit, unit, typical magnitude.
-struct Field {
-  const char* key;
-  const char* unit;
-  double unit_to_si;
-  double typical_si;
-  Kind kind;
-  double CentrifugeErrors::*scalar = nullptr;
-  HarmonicSeries CentrifugeErrors::*series = nullptr;
-  Eigen::Vector3d CentrifugeErrors::*vector = nullptr;
-};
-
-using E = CentrifugeErrors;
-constexpr double kArcsec = kArcsecToRad;
-
-// Typical magnitudes (docs/sensitivity.md): 1 arcsec for angles and wobbles, 1 um runout, 10 um radius
-// error, 1e-7 m/(rad/s)^2 stretch (10 um at 9.9 rad/s), 1e-6 rad/s rate mismatch, 1 mm lever arm.
-const Field kFields[] = {
-    {"base_tilt_x", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::base_tilt_x_rad},
-    {"base_tilt_y", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::base_tilt_y_rad},
-    {"main_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::main_perpendicularity_x_rad},
-    {"main_perpendicularity_y", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::main_perpendicularity_y_rad},
-    {"main_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::main_wobble_x_rad},
-    {"main_wobble_y", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::main_wobble_y_rad},
-    {"main_runout_x", "m", 1.0, 1e-6, Kind::kSeries, nullptr, &E::main_runout_x_m},
-    {"main_runout_y", "m", 1.0, 1e-6, Kind::kSeries, nullptr, &E::main_runout_y_m},
-    {"radius_error", "m", 1.0, 1e-5, Kind::kScalar, &E::radius_error_m},
-    {"radius_stretch", "m/(rad/s)^2", 1.0, 1e-7, Kind::kScalar, &E::radius_stretch_m_per_rad2_s2},
-    {"counter_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar,
-     &E::counter_perpendicularity_x_rad},
-    {"counter_perpendicularity_y", "arcsec", kArcsec, kArcsec, Kind::kScalar,
-     &E::counter_perpendicularity_y_rad},
-    {"counter_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::counter_wobble_x_rad},
-    {"counter_wobble_y", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::counter_wobble_y_rad},
-    {"counter_rate_mismatch", "rad/s", 1.0, 1e-6, Kind::kScalar, &E::counter_rate_mismatch_rad_s},
-    {"position_perpendicularity_x", "arcsec", kArcsec, kArcsec, Kind::kScalar,
-     &E::position_perpendicularity_x_rad},
-    {"position_perpendicularity_z", "arcsec", kArcsec, kArcsec, Kind::kScalar,
-     &E::position_perpendicularity_z_rad},
-    {"position_wobble_x", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::position_wobble_x_rad},
-    {"position_wobble_z", "arcsec", kArcsec, kArcsec, Kind::kSeries, nullptr, &E::position_wobble_z_rad},
-    {"position_angle_error", "arcsec", kArcsec, kArcsec, Kind::kScalar, &E::position_angle_error_rad},
-    {"mount_misalignment", "arcsec", kArcsec, kArcsec, Kind::kVector, nullptr, nullptr,
-     &E::mount_misalignment_rad},
-    {"lever_arm", "m", 1.0, 1e-3, Kind::kVector, nullptr, nullptr, &E::lever_arm_m},
-};
-constexpr const char* kAxes[3] = {"I", "O", "S"};
+/// The fields of CentrifugeErrors: the one table of machine errors (model/machine_errors.hpp).
+const MachineErrorField& field_info(int field) {
+  return machine_error_fields()[static_cast<std::size_t>(field)];
+}
+int field_count() {
+  return static_cast<int>(machine_error_fields().size());
+}
 
 MachineErrorTerm make_term(int field, int harmonic, double phase_rad, int component) {
-  const Field& f = kFields[field];
+  const MachineErrorField& f = field_info(field);
   MachineErrorTerm t;
   t.field = field;
-  t.error = f.kind == Kind::kVector ? std::string(f.key) + "_" + kAxes[component] : f.key;
+  t.error = f.kind == Kind::kVector
+                ? std::string(f.name) + "_" +
+                      std::string(kVectorComponentNames[static_cast<std::size_t>(component)])
+                : std::string(f.name);
   t.harmonic = harmonic;
   t.phase_rad = phase_rad;
   t.component = component;
@@ -85,9 +50,9 @@ MachineErrorTerm make_term(int field, int harmonic, double phase_rad, int compon
 /// harmonics 1 and 2 of a series where they are not configured.
 void field_terms(int fi, const CentrifugeErrors& errors, bool all,
                  std::vector<std::pair<MachineErrorTerm, double>>& out) {
-  const Field& f = kFields[fi];
+  const MachineErrorField& f = field_info(fi);
   switch (f.kind) {
-    case Kind::kScalar: {
+    case Kind::kConstant: {
       const double v = errors.*f.scalar;
       if (v != 0.0 || all) out.emplace_back(make_term(fi, 0, 0.0, 0), v);
       break;
@@ -172,12 +137,37 @@ SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base)
   return out;
 }
 
+/// Compensation "self": `s`'s planned test identified by least squares with the compensation told every error
+/// but kSelfCalibratedErrors (set to zero, the iteration's start), which are estimated
+/// (docs/self_calibration.md).
+CalibrationResult calibrate_self(const Scenario& s, const CalibrationOptions& base) {
+  const PlannedTest p = planned_test(s, base.reduce);
+  Scenario told = s;
+  CalibrationOptions o = base;
+  o.method = Method::kLeastSquares;
+  o.compensation = Compensation::kFull;
+  o.estimate = parse_machine_error_names(kSelfCalibratedErrors, "compensation self");
+  for (const MachineErrorParameter& e : o.estimate) e.set(told.errors, 0.0);
+  o.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
+  // The predicted outputs are noise-free: chi2 says nothing (as in predict_calibration).
+  o.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  const CentrifugeModel model = told.model();
+  return identify(p.reduction, reduce_model_channels(p.reduction, model, o.reduce, kMaxModelSamplesPerDwell),
+                  model, o);
+}
+
+int spinning_rates(const TestSpec& test) {
+  int n = 0;
+  for (double w : test.rates_rad_s) n += w != 0.0;
+  return n;
+}
+
 }  // namespace
 
 void MachineErrorTerm::add_to(CentrifugeErrors& errors, double amount_si) const {
-  const Field& f = kFields[field];
+  const MachineErrorField& f = field_info(field);
   switch (f.kind) {
-    case Kind::kScalar:
+    case Kind::kConstant:
       errors.*f.scalar += amount_si;
       break;
     case Kind::kVector:
@@ -198,13 +188,13 @@ std::string MachineErrorTerm::label() const {
 
 std::vector<std::pair<MachineErrorTerm, double>> nonzero_error_terms(const CentrifugeErrors& errors) {
   std::vector<std::pair<MachineErrorTerm, double>> out;
-  for (int f = 0; f < static_cast<int>(std::size(kFields)); ++f) field_terms(f, errors, false, out);
+  for (int f = 0; f < field_count(); ++f) field_terms(f, errors, false, out);
   return out;
 }
 
 std::vector<std::pair<MachineErrorTerm, double>> sensitivity_terms(const CentrifugeErrors& configured) {
   std::vector<std::pair<MachineErrorTerm, double>> out;
-  for (int f = 0; f < static_cast<int>(std::size(kFields)); ++f) field_terms(f, configured, true, out);
+  for (int f = 0; f < field_count(); ++f) field_terms(f, configured, true, out);
   return out;
 }
 
@@ -224,6 +214,8 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   result.rows.resize(terms.size());
   // Item 0 is the base case (no machine error), items 1.. the rows; every item is independent.
   std::vector<SixCalibrations> runs(terms.size() + 1);
+  result.has_self = spinning_rates(scenario.test) >= 2;
+  std::vector<CalibrationResult> self_runs(result.has_self ? terms.size() + 1 : 0);
   std::atomic<std::size_t> done{0};
   parallel_for(
       terms.size() + 1, options.threads,
@@ -234,6 +226,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
           term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
         }
         runs[i] = calibrate_six(s, options.calibration);
+        if (result.has_self) self_runs[i] = calibrate_self(s, options.calibration);
         ++done;
       },
       [&] {
@@ -256,6 +249,10 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
     for (const NamedEstimate& e : r0.alternatives) result.units[e.name] = e.unit;
     for (const NamedEstimate& e : r0.combinations) result.units[e.name] = e.unit;
   }
+
+  if (result.has_self)
+    for (const auto& [name, vs] : estimates(self_runs[0], scenario.gyro))
+      result.self_noise_std[name] = vs.second;
 
   const bool noisy = scenario.noise.angle_random_walk_deg_rt_h > 0;
   for (std::size_t i = 0; i < terms.size(); ++i) {
@@ -286,6 +283,19 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
         }
       }
     }
+    if (!result.has_self) continue;
+    const auto base_self = estimates(self_runs[0], scenario.gyro);
+    for (const auto& [name, vs] : estimates(self_runs[i + 1], scenario.gyro))
+      for (const auto& [name0, vs0] : base_self) {
+        if (name0 != name) continue;
+        const double d = vs.first - vs0.first;
+        row.self[name] = d;
+        const auto it = result.self_noise_std.find(name);
+        const double sigma = noisy && it != result.self_noise_std.end() && it->second > 0
+                                 ? it->second
+                                 : 1e-6 / options.threshold;
+        if (std::abs(d) > options.threshold * sigma) row.self_matters.push_back(name);
+      }
   }
   return result;
 }

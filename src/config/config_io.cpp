@@ -20,6 +20,7 @@
 #include <toml++/toml.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/model/machine_errors.hpp"
 
 namespace gyrocal {
 namespace {
@@ -88,115 +89,23 @@ constexpr std::string_view kCoefficientMeanings[kNumCoefficients] = {
     "drift per aO^2", "drift per aS^2",      "drift per aI*aO",     "drift per aI*aS",     "drift per aO*aS",
 };
 
-/// A key of [centrifuge.errors] and [uncertainty] (docs/physics.md section 3): exactly one of scalar, series,
-/// triple is set. A series' terms have the keys harmonic, amplitude_key (in the series' file unit) and
-/// phase_deg.
+/// A key of [centrifuge.errors] and [uncertainty] (docs/physics.md section 3), derived from the one table of
+/// machine errors (model/machine_errors.hpp): its key, and for a series the key of its terms' amplitude.
+/// The strings live as long as the program (Section keeps views of the keys it was asked for).
 struct ErrorKey {
-  std::string_view key;
-  double to_si;  ///< file unit -> SI (of a series: of its amplitude)
-  std::string_view comment;
-  double CentrifugeErrors::*scalar = nullptr;
-  HarmonicSeries CentrifugeErrors::*series = nullptr;
-  Eigen::Vector3d CentrifugeErrors::*triple = nullptr;
-  std::string_view amplitude_key = {};
+  const MachineErrorField* field;
+  std::string key;
+  std::string amplitude_key;
 };
 
-using E = CentrifugeErrors;
-constexpr ErrorKey kErrorKeys[] = {
-    {.key = "base_tilt_x_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "tilt of the base about x (North), arcsec",
-     .scalar = &E::base_tilt_x_rad},
-    {.key = "base_tilt_y_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "tilt of the base about y (West), arcsec",
-     .scalar = &E::base_tilt_y_rad},
-    {.key = "main_perpendicularity_x_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "main axis tilt about x, arcsec",
-     .scalar = &E::main_perpendicularity_x_rad},
-    {.key = "main_perpendicularity_y_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "main axis tilt about y, arcsec",
-     .scalar = &E::main_perpendicularity_y_rad},
-    {.key = "main_wobble_x",
-     .to_si = kArcsecToRad,
-     .comment = "main axis wobble about x, harmonics of theta, arcsec",
-     .series = &E::main_wobble_x_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "main_wobble_y",
-     .to_si = kArcsecToRad,
-     .comment = "main axis wobble about y, harmonics of theta, arcsec",
-     .series = &E::main_wobble_y_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "main_runout_x",
-     .to_si = 1.0,
-     .comment = "main axis runout along x, harmonics of theta, m",
-     .series = &E::main_runout_x_m,
-     .amplitude_key = "amplitude_m"},
-    {.key = "main_runout_y",
-     .to_si = 1.0,
-     .comment = "main axis runout along y, harmonics of theta, m",
-     .series = &E::main_runout_y_m,
-     .amplitude_key = "amplitude_m"},
-    {.key = "radius_error_m", .to_si = 1.0, .comment = "added to R0, m", .scalar = &E::radius_error_m},
-    {.key = "radius_stretch_m_per_rad2_s2",
-     .to_si = 1.0,
-     .comment = "radius growth per omega^2, m/(rad/s)^2",
-     .scalar = &E::radius_stretch_m_per_rad2_s2},
-    {.key = "counter_perpendicularity_x_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "counter-rotating platform tilt about x, arcsec",
-     .scalar = &E::counter_perpendicularity_x_rad},
-    {.key = "counter_perpendicularity_y_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "counter-rotating platform tilt about y, arcsec",
-     .scalar = &E::counter_perpendicularity_y_rad},
-    {.key = "counter_wobble_x",
-     .to_si = kArcsecToRad,
-     .comment = "counter platform wobble about x, harmonics of psi_r, arcsec",
-     .series = &E::counter_wobble_x_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "counter_wobble_y",
-     .to_si = kArcsecToRad,
-     .comment = "counter platform wobble about y, harmonics of psi_r, arcsec",
-     .series = &E::counter_wobble_y_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "counter_rate_mismatch_rad_s",
-     .to_si = 1.0,
-     .comment = "delta omega: platform heading drift about Up, rad/s",
-     .scalar = &E::counter_rate_mismatch_rad_s},
-    {.key = "position_perpendicularity_x_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "position platform tilt about x, arcsec",
-     .scalar = &E::position_perpendicularity_x_rad},
-    {.key = "position_perpendicularity_z_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "position platform tilt about z, arcsec",
-     .scalar = &E::position_perpendicularity_z_rad},
-    {.key = "position_wobble_x",
-     .to_si = kArcsecToRad,
-     .comment = "position platform wobble about x, harmonics of beta', arcsec",
-     .series = &E::position_wobble_x_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "position_wobble_z",
-     .to_si = kArcsecToRad,
-     .comment = "position platform wobble about z, harmonics of beta', arcsec",
-     .series = &E::position_wobble_z_rad,
-     .amplitude_key = "amplitude_arcsec"},
-    {.key = "position_angle_error_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "added to the commanded beta, arcsec",
-     .scalar = &E::position_angle_error_rad},
-    {.key = "mount_misalignment_arcsec",
-     .to_si = kArcsecToRad,
-     .comment = "gyro mounting misalignment about I, O, S, arcsec",
-     .triple = &E::mount_misalignment_rad},
-    {.key = "lever_arm_m",
-     .to_si = 1.0,
-     .comment = "gyro centre offset in position-platform axes (I, O, S at beta = 0), m",
-     .triple = &E::lever_arm_m},
-};
+const std::vector<ErrorKey>& error_keys() {
+  static const std::vector<ErrorKey> keys = [] {
+    std::vector<ErrorKey> out;
+    for (const MachineErrorField& f : machine_error_fields()) out.push_back({&f, f.key(), f.amplitude_key()});
+    return out;
+  }();
+  return keys;
+}
 
 // ---------------------------------------------------------------------------------------------------------
 // Numbers as text.
@@ -430,7 +339,7 @@ HarmonicSeries read_series(const Reader& reader, const toml::node& node, const s
     if (const toml::node* harmonic = item.find("harmonic")) {
       term.harmonic = static_cast<int>(reader.integer(*harmonic, item.path("harmonic"), 1, INT_MAX));
     }
-    item.number(key.amplitude_key, key.to_si, kNonNegative, term.amplitude);
+    item.number(key.amplitude_key, key.field->unit_to_si, kNonNegative, term.amplitude);
     item.number("phase_deg", kDegToRad, kAnyValue, term.phase_rad);
     item.reject_unknown();
     series.terms.push_back(term);
@@ -440,17 +349,23 @@ HarmonicSeries read_series(const Reader& reader, const toml::node& node, const s
 
 /// [centrifuge.errors] or [uncertainty] (where every value is a standard uncertainty, so >= 0).
 void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors) {
-  for (const ErrorKey& key : kErrorKeys) {
+  for (const ErrorKey& key : error_keys()) {
     const toml::node* node = section.find(key.key);
     if (node == nullptr) continue;
     const std::string path = section.path(key.key);
-    if (key.scalar != nullptr) {
-      errors.*key.scalar = reader.number(*node, path, range) * key.to_si;
-    } else if (key.series != nullptr) {
-      errors.*key.series = read_series(reader, *node, path, key);
-    } else {
-      const std::vector<double> values = reader.numbers(*node, path, range, 3);
-      errors.*key.triple = Eigen::Vector3d(values[0], values[1], values[2]) * key.to_si;
+    const MachineErrorField& f = *key.field;
+    switch (f.kind) {
+      case MachineErrorKind::kConstant:
+        errors.*f.scalar = reader.number(*node, path, range) * f.unit_to_si;
+        break;
+      case MachineErrorKind::kSeries:
+        errors.*f.series = read_series(reader, *node, path, key);
+        break;
+      case MachineErrorKind::kVector: {
+        const std::vector<double> values = reader.numbers(*node, path, range, 3);
+        errors.*f.vector = Eigen::Vector3d(values[0], values[1], values[2]) * f.unit_to_si;
+        break;
+      }
     }
   }
   section.reject_unknown();
@@ -639,8 +554,8 @@ std::string series_text(const HarmonicSeries& series, const ErrorKey& key) {
   for (std::size_t i = 0; i < series.terms.size(); ++i) {
     const HarmonicTerm& term = series.terms[i];
     text += (i == 0 ? " { " : ", { ");
-    text += "harmonic = " + std::to_string(term.harmonic) + ", " + std::string(key.amplitude_key) + " = " +
-            toml_number(in_file_unit(term.amplitude, key.to_si)) +
+    text += "harmonic = " + std::to_string(term.harmonic) + ", " + key.amplitude_key + " = " +
+            toml_number(in_file_unit(term.amplitude, key.field->unit_to_si)) +
             ", phase_deg = " + toml_number(in_file_unit(term.phase_rad, kDegToRad)) + " }";
   }
   return text + " ]";
@@ -697,17 +612,23 @@ void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& s
 }
 
 void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
-  for (const ErrorKey& key : kErrorKeys) {
+  for (const ErrorKey& key : error_keys()) {
+    const MachineErrorField& f = *key.field;
     std::string value;
-    if (key.scalar != nullptr) {
-      value = toml_number(in_file_unit(errors.*key.scalar, key.to_si));
-    } else if (key.series != nullptr) {
-      value = series_text(errors.*key.series, key);
-    } else {
-      const Eigen::Vector3d& v = errors.*key.triple;
-      value = number_array({v.x(), v.y(), v.z()}, key.to_si);
+    switch (f.kind) {
+      case MachineErrorKind::kConstant:
+        value = toml_number(in_file_unit(errors.*f.scalar, f.unit_to_si));
+        break;
+      case MachineErrorKind::kSeries:
+        value = series_text(errors.*f.series, key);
+        break;
+      case MachineErrorKind::kVector: {
+        const Eigen::Vector3d& v = errors.*f.vector;
+        value = number_array({v.x(), v.y(), v.z()}, f.unit_to_si);
+        break;
+      }
     }
-    writer.key(key.key, value, key.comment);
+    writer.key(key.key, value, f.comment);
   }
 }
 
@@ -827,6 +748,28 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
   read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
 
+  Section calibration(reader, top.table("calibration"), "calibration");
+  if (const toml::node* node = calibration.find("estimate")) {
+    const std::string path = calibration.path("estimate");
+    const toml::array& items = reader.array(*node, path);
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      const auto* name = items[i].as_string();
+      if (name == nullptr)
+        reader.fail(items[i].source(), path + "[" + std::to_string(i) +
+                                           "] must be a string naming a machine "
+                                           "error, not " +
+                                           type_name(items[i]));
+      s.estimate.push_back(name->get());
+    }
+    try {
+      parse_machine_error_names(s.estimate, path);
+    } catch (const Error& e) {
+      std::string what = e.what();
+      while (!what.empty() && what.back() == '.') what.pop_back();
+      reader.fail(node->source(), what);
+    }
+  }
+  calibration.reject_unknown();
   if (const toml::table* record_table = top.table("record")) {
     Section record(reader, record_table, "record");
     s.record = read_record(reader, record, *record_table);
@@ -938,6 +881,12 @@ std::string scenario_to_toml(const Scenario& s) {
       "and phase_deg its nominal phase.");
   write_errors(w, s.uncertainty);
 
+  w.section("calibration", "The calibration's choices; the command line's options override them.");
+  std::string names = "[";
+  for (std::size_t i = 0; i < s.estimate.size(); ++i) names += (i ? ", \"" : "\"") + s.estimate[i] + "\"";
+  w.key("estimate", names + "]",
+        "machine errors estimated from the data (--estimate; docs/self_calibration.md): NAME, NAME_I/_O/_S, "
+        "NAME:N");
   constexpr std::string_view kRecordNote =
       "How to read a rig's own record (docs/contract.md, \"Records\"; docs/records.md). Without a [record]\n"
       "section a record is gyrocal's own format, whose first line is \"# gyrocal-record 1\"; with one (even\n"

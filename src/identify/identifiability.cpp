@@ -225,11 +225,18 @@ Eigen::MatrixXd reduced_row_echelon(Eigen::MatrixXd a, const std::vector<Eigen::
 CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whitened_design,
                                 const VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
-                                const IdentifiabilityOptions& options) {
-  const Index n = static_cast<Index>(kNumCoefficients);
-  const std::vector<std::string> names(kCoefficientNames.begin(), kCoefficientNames.end());
+                                const IdentifiabilityOptions& options,
+                                const std::vector<std::string>& extra_names) {
+  // The unknowns: the ten coefficients, then the estimated machine errors (always active: their excitation
+  // is judged by the self-calibration, identify/calibration.cpp).
+  const Index n = static_cast<Index>(kNumCoefficients + extra_names.size());
+  if (whitened_design.cols() != n)
+    throw Error("fit_coefficients: the design's columns are not the coefficients and the estimated errors.");
+  std::vector<std::string> names(kCoefficientNames.begin(), kCoefficientNames.end());
+  names.insert(names.end(), extra_names.begin(), extra_names.end());
   CoefficientFit out;
   out.excited = excited_columns(regressors, options.min_regressor_level);
+  out.excited.resize(static_cast<std::size_t>(n), true);
   std::vector<Index> active;
   for (Index j = 0; j < n; ++j)
     if (out.excited[static_cast<std::size_t>(j)]) active.push_back(j);
@@ -296,7 +303,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   for (Index k = 0; k < svd_j.singularValues().size(); ++k)
     if (svd_j.singularValues()[k] > 1e-6) ++rank_j;
   const Index estimable_dim = nj - rank_j;
-  out.advice = advice_for(directions, positions, model);
+  out.advice = advice_for(directions.topRows(static_cast<Index>(kNumCoefficients)), positions, model);
   if (estimable_dim <= 0) return out;
 
   std::vector<VectorXd> chosen_scaled;  // accepted combinations, equilibrated coordinates
@@ -358,7 +365,10 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
     while (pivot < n - 1 && std::abs(z[pivot]) < 0.5) ++pivot;
     // In parameter units with the pivot coefficient 1: c = z / D, scaled back so that c[pivot] = 1.
     const VectorXd scaled = z * sol.column_scales[pivot];
-    add(fmt::format("combination {}", ++generic), std::string(kCoefficientUnits[std::size_t(pivot)]), scaled);
+    add(fmt::format("combination {}", ++generic),
+        pivot < static_cast<Index>(kNumCoefficients) ? std::string(kCoefficientUnits[std::size_t(pivot)])
+                                                     : "",
+        scaled);
   }
   return out;
 }

@@ -68,6 +68,27 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
                          {"outliers", r.data_quality.outliers},
                          {"gaps", r.data_quality.gaps}};
   j["unidentifiable"] = r.unidentifiable;
+  // The self-calibration's estimated machine errors (docs/contract.md, machine_errors).
+  if (!r.machine_errors.empty()) {
+    j["machine_errors"] = nlohmann::json::array();
+    for (const MachineErrorEstimate& e : r.machine_errors) {
+      nlohmann::json m = {{"error", e.error},
+                          {"harmonic", e.harmonic},
+                          {"value", e.identifiable ? number_or_null(e.value) : nlohmann::json(nullptr)},
+                          {"std", e.identifiable ? number_or_null(e.std) : nlohmann::json(nullptr)},
+                          {"unit", e.unit},
+                          {"configured", e.configured},
+                          {"identifiable", e.identifiable}};
+      if (!e.part.empty()) m["part"] = e.part;
+      if (!e.identifiable) m["reason"] = e.reason;
+      nlohmann::json correlations = nlohmann::json::object();
+      for (const auto& [name, r_value] : e.correlations)
+        if (std::isfinite(r_value)) correlations[name] = r_value;
+      m["correlations"] = correlations;
+      j["machine_errors"].push_back(m);
+    }
+    j["iterations"] = r.iterations;
+  }
   return j;
 }
 

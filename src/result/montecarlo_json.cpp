@@ -7,7 +7,7 @@ nlohmann::json montecarlo_to_json(const MonteCarloResult& r) {
                       {"mode", to_string(r.mode)},
                       {"seed", r.seed},
                       {"method", to_string(r.method)},
-                      {"compensation", to_string(r.compensation)}};
+                      {"compensation", r.self ? std::string("self") : to_string(r.compensation)}};
   j["coefficients"] = nlohmann::json::object();
   j["budget"] = nlohmann::json::object();
   for (const EstimateDistribution& e : r.estimates) {

@@ -27,6 +27,14 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
       j["matters"][comp] = row.closed_form_matters[c];
       j["least_squares_matters"][comp] = row.least_squares_matters[c];
     }
+    if (r.has_self) {
+      // Compensation "self" (docs/self_calibration.md): least squares only.
+      j["least_squares"]["self"] = nlohmann::json::object();
+      for (const std::string& name : r.least_squares_names)
+        if (const auto it = row.self.find(name); it != row.self.end())
+          j["least_squares"]["self"][name] = it->second;
+      j["least_squares_matters"]["self"] = row.self_matters;
+    }
     rows.push_back(std::move(j));
   }
   nlohmann::json out = {{"rows", rows}, {"threshold", r.threshold}};
@@ -36,6 +44,7 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
   out["least_squares_noise_std"] = nlohmann::json::object();
   for (const std::string& name : r.least_squares_names)
     out["least_squares_noise_std"][name] = r.least_squares_noise_std.at(name);
+  if (r.has_self) out["self_noise_std"] = r.self_noise_std;
   out["units"] = r.units;
   return out;
 }

@@ -295,7 +295,7 @@ def test_bad_record_raises_value_error_with_cli_sentence(small, tmp_path):
 def test_bad_arrays_and_options_raise_value_error(small):
     _, sc = small
     rec = gyrocal.simulate(sc, seed=1)
-    with pytest.raises(ValueError, match="not available yet"):
+    with pytest.raises(ValueError, match="estimate: unknown machine error 'counter_rate_offset'"):
         gyrocal.calibrate(rec, sc, estimate=["counter_rate_offset"])
     with pytest.raises(ValueError, match="unknown method 'fast'"):
         gyrocal.calibrate(rec, sc, method="fast")
@@ -315,3 +315,16 @@ def test_bad_arrays_and_options_raise_value_error(small):
     short["main_angle_deg"] = rec["main_angle_deg"][:-1]
     with pytest.raises(ValueError, match="column main_angle_deg has"):
         gyrocal.calibrate(short, sc)
+
+
+def test_estimate_gives_machine_errors(small):
+    # Self-calibration through the module (docs/self_calibration.md): the small test has one speed, so the
+    # counter platform's perpendicularity is reported, not identifiable, with the reason.
+    _, sc = small
+    rec = gyrocal.simulate(sc, seed=1)
+    res = gyrocal.calibrate(rec, sc, estimate="counter_perpendicularity_x")
+    (entry,) = res["machine_errors"]
+    assert entry["error"] == "counter_perpendicularity_x"
+    assert entry["unit"] == "arcsec"
+    assert entry["identifiable"] is False
+    assert "second non-zero speed" in entry["reason"]

@@ -34,6 +34,10 @@ struct MonteCarloOptions {
   int threads = 0;                 ///< worker threads; 0 = hardware concurrency
   CalibrationOptions calibration;  ///< method (default least squares), compensation (default full)
   int histogram_bins = 30;         ///< bins between the smallest and largest error
+  /// Compensation "self" (docs/self_calibration.md): least squares told every configured error but
+  /// kSelfCalibratedErrors, which each trial estimates from its data (their configured values are not used).
+  /// Needs a plan with two non-zero speeds to identify them. Default false.
+  bool self = false;
   /// Called on the calling thread with the fraction of trials done, in [0, 1], about ten times a second
   /// and once with 1 at the end. May be empty.
   std::function<void(double fraction)> progress;
@@ -51,7 +55,9 @@ struct MonteCarloSource {
 /// normal: first one per source (scaled by its uncertainty), then one per reduced position (noise).
 struct MonteCarloModel {
   Scenario scenario;
-  CalibrationOptions calibration;
+  CalibrationOptions calibration;  ///< with compensation "self": its estimate holds kSelfCalibratedErrors
+  /// The machine the calibration is told: the scenario's, with kSelfCalibratedErrors zeroed under "self".
+  Scenario told;
   std::vector<MonteCarloSource> sources;
   std::vector<std::string> names;  ///< the estimates: identifiable coefficients, alternatives, combinations
   std::vector<std::string> units;
@@ -84,6 +90,7 @@ struct MonteCarloResult {
   std::uint64_t seed = 0;
   Method method = Method::kLeastSquares;
   Compensation compensation = Compensation::kFull;
+  bool self = false;                 ///< compensation "self" (MonteCarloOptions::self)
   std::vector<std::string> sources;  ///< "noise", then each uncertainty entry's label
   std::vector<double>
       source_std;  ///< the uncertainty in its configuration unit (noise: the ARW, deg/sqrt(h))

@@ -70,7 +70,17 @@ struct SensitivityRow {
   std::array<ShiftMap, 3> least_squares;
   /// Names whose |shift| > threshold * noise std, per compensation, in the estimates' order.
   std::array<std::vector<std::string>, 3> closed_form_matters, least_squares_matters;
+  /// Compensation "self" (least squares; only when SensitivityResult::has_self): the compensation told every
+  /// error but kSelfCalibratedErrors, which are estimated from the data (docs/self_calibration.md). Shifts
+  /// and the names that matter (against self_noise_std).
+  ShiftMap self;
+  std::vector<std::string> self_matters;
 };
+
+/// The errors compensation "self" estimates instead of being told: the counter platform's perpendicularity
+/// and rate mismatch (docs/physics.md section 12).
+inline const std::vector<std::string> kSelfCalibratedErrors = {
+    "counter_perpendicularity_x", "counter_perpendicularity_y", "counter_rate_mismatch"};
 
 struct SensitivityResult {
   std::vector<SensitivityRow> rows;
@@ -79,11 +89,16 @@ struct SensitivityResult {
   std::map<std::string, std::string> units;      ///< estimate name -> unit
   /// Predicted noise std of each estimate (white rate noise through the plan), closed form and least squares.
   std::map<std::string, double> closed_form_noise_std, least_squares_noise_std;
+  /// Compensation "self" was run: the plan has two non-zero speeds, which identify the counter platform's
+  /// errors (one speed cannot, docs/physics.md section 12). Its predicted noise std per estimate.
+  bool has_self = false;
+  std::map<std::string, double> self_noise_std;
   double threshold = 0.1;
 };
 
 /// The study on `scenario`: its test, truth, noise and site; the base case has no machine error, each row
-/// one error alone, identified with compensation none, seed and full (the compensation told that error).
+/// one error alone, identified with compensation none, seed and full (the compensation told that error), and,
+/// with two non-zero speeds, "self" (SensitivityRow::self).
 /// Throws Error if the plan lacks the 16 positions of docs/physics.md section 7 (the closed forms need them).
 SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options = {});
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
@@ -21,6 +22,9 @@ struct Scenario {
   GyroNoise noise;               ///< [gyro.noise]
   TestSpec test;                 ///< [test]
   CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+  /// [calibration] estimate: machine errors estimated from the data (--estimate; docs/self_calibration.md),
+  /// names as model/machine_errors.hpp parses them. Empty by default.
+  std::vector<std::string> estimate;
   /// [record]: how to read a rig's own record (docs/records.md); nullopt (no [record] section) means
   /// gyrocal's own format, magic line required.
   std::optional<RecordLayout> record;

@@ -9,6 +9,7 @@
 
 #include "gyrocal/identify/channels.hpp"
 #include "gyrocal/identify/least_squares.hpp"
+#include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 
@@ -37,6 +38,21 @@ struct CalibrationOptions {
   /// power) at every position is not excited by the plan and never identifiable. Default 1e-3
   /// (identify/identifiability.hpp).
   double min_regressor_level = 1e-3;
+  /// Machine errors estimated together with the coefficients (self-calibration, docs/physics.md section 12;
+  /// docs/self_calibration.md), starting from their values in the model. Least squares with full
+  /// compensation only. Empty: none.
+  std::vector<MachineErrorParameter> estimate;
+  /// Self-calibration: the Gauss-Newton iteration stops when every estimated error's step is below this
+  /// fraction of its standard uncertainty (or below 1e-9 of its typical magnitude, a noise-free record's
+  /// rounding). Default 1e-3 (docs/physics.md section 12).
+  double convergence = 1e-3;
+  /// Self-calibration: at most this many Gauss-Newton iterations, else the calibration is refused.
+  /// Default 20.
+  int max_iterations = 20;
+  /// Self-calibration: bound on the model evaluations per spinning dwell of the Jacobian's channels, as
+  /// reduce_model_channels' max_samples_per_dwell (0 = every ReduceOptions::model_samples_per_revolution; a
+  /// prediction passes the bound it evaluated its channels with).
+  std::size_t max_model_samples_per_dwell = 0;
 
   bool IsValid(std::string* error) const;
 };
@@ -59,6 +75,24 @@ struct NamedEstimate {
   std::vector<double> coefficients;
 };
 
+/// One estimated machine error (docs/contract.md, machine_errors): value and std in the error's unit (arcsec,
+/// m, rad/s, m/(rad/s)^2); NaN when not identifiable, with the reason.
+struct MachineErrorEstimate {
+  MachineErrorParameter parameter;
+  std::string error;  ///< as in --estimate: the name, NAME_I for a vector's component, the series' name
+  int harmonic = 0;   ///< harmonic number of a series' part, 0 for a constant
+  std::string part;   ///< "cos" or "sin" for a series' part, empty otherwise
+  std::string unit;
+  double value = std::numeric_limits<double>::quiet_NaN();
+  double std = std::numeric_limits<double>::quiet_NaN();
+  double configured = 0.0;  ///< the configured value, the iteration's start, in unit
+  bool identifiable = false;
+  std::string reason;  ///< why not identifiable, with the advice; empty when identifiable
+  /// Correlation with each coefficient (in Coefficient order, NaN where not identifiable) and each other
+  /// estimated error (by label), from the same sandwich covariance as the uncertainties.
+  std::vector<std::pair<std::string, double>> correlations;
+};
+
 /// What the record held and what entered the estimate (docs/physics.md section 14; docs/contract.md
 /// data_quality).
 struct DataQuality {
@@ -79,6 +113,8 @@ struct CalibrationResult {
   std::vector<double> residuals_deg_h;      ///< per position: W - model at the estimate (least squares)
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
+  /// The unknowns of the least squares: the ten coefficients and the estimated machine errors' columns.
+  int unknowns = static_cast<int>(kNumCoefficients);
   /// Least squares: of its whitened, equilibrated design. Closed form: the same for its 16 positions.
   double condition_number = 0.0;
   /// Closed form only: the largest ratio of a closed form's standard uncertainty to the least-squares one
@@ -88,6 +124,9 @@ struct CalibrationResult {
   double chi2 = 0.0;
   int dof = 0;
   DataQuality data_quality;
+  /// The estimated machine errors (CalibrationOptions::estimate), in its order; empty without.
+  std::vector<MachineErrorEstimate> machine_errors;
+  int iterations = 0;  ///< Gauss-Newton iterations of a self-calibration, 0 without
   std::vector<std::string> warnings;
 
   /// One line: method, compensation, rank, condition, warnings.

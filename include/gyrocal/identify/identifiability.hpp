@@ -44,11 +44,14 @@ struct IdentifiabilityOptions {
 /// regressors: m x 10, the unwhitened regressors of each position (g units); whitened_design and
 /// whitened_observations: the same rows whitened by the positions' covariance. ar: the radial level of
 /// the first spinning rate (g), for docs/physics.md section 8's named combinations. positions and model: the
-/// plan actually run, for the advice.
+/// plan actually run, for the advice. extra_names: the estimated machine errors (self-calibration), whose
+/// columns follow the ten coefficients' in whitened_design (the unknowns: coefficients, then errors); the
+/// solution then has 10 + extra_names.size() parameters.
 CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::MatrixXd& whitened_design,
                                 const Eigen::VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
-                                const IdentifiabilityOptions& options);
+                                const IdentifiabilityOptions& options,
+                                const std::vector<std::string>& extra_names = {});
 
 /// Rows brought to reduced row echelon form with pivots taken in `order` (column indices); each pivot is 1.
 /// A column whose largest remaining entry is at most `tolerance` times the largest entry of `rows` gives no
