@@ -299,7 +299,8 @@ TEST(Revolutions, TooFewForAScatterIsARefusalSayingHowManyAreNeeded) {
   }
 }
 
-// ---- Records as a rig writes them (docs/physics.md section 14; tests/support/rig_record.hpp) -------------------
+// ---- Records as a rig writes them (docs/physics.md section 14; tests/support/rig_record.hpp)
+// -------------------
 
 /// A two-speed test of 8 dwells (every coefficient identifiable), short enough for many seeds.
 Scenario rig_scenario() {
@@ -310,7 +311,8 @@ Scenario rig_scenario() {
   return s;
 }
 
-std::vector<RecordSample> rig_record(const Scenario& s, const testing::RigImperfections& imp, std::uint64_t seed) {
+std::vector<RecordSample> rig_record(const Scenario& s, const testing::RigImperfections& imp,
+                                     std::uint64_t seed) {
   std::vector<testing::RigRow> rows;
   testing::rig_rows(s, imp, testing::RigMotion{}, seed, [&](const testing::RigRow& r) { rows.push_back(r); });
   return testing::as_samples(rows);
@@ -394,8 +396,8 @@ TEST(RigRecord, UncertaintiesDescribeTheSpreadOverSeeds) {
     mean /= static_cast<double>(z[k].size());
     for (double x : z[k]) var += (x - mean) * (x - mean);
     const double sd = std::sqrt(var / static_cast<double>(z[k].size() - 1));
-    std::printf("rig record, std of z for %s: %.3f (mean %.3f)\n", std::string(kCoefficientNames[k]).c_str(), sd,
-                mean);
+    std::printf("rig record, std of z for %s: %.3f (mean %.3f)\n", std::string(kCoefficientNames[k]).c_str(),
+                sd, mean);
     EXPECT_GT(sd, 0.85) << kCoefficientNames[k];
     EXPECT_LT(sd, 1.15) << kCoefficientNames[k];
   }

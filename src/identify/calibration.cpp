@@ -470,7 +470,8 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
     q.ended = d.quality.ended;
     r.data_quality.dwells.push_back(q);
   }
-  for (const RejectedRun& x : reduction.rejected) r.data_quality.rejected.push_back({x.start_s, x.end_s, x.reason});
+  for (const RejectedRun& x : reduction.rejected)
+    r.data_quality.rejected.push_back({x.start_s, x.end_s, x.reason});
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   if (options.method == Method::kClosedForm) {

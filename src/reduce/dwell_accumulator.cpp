@@ -294,7 +294,8 @@ void DwellAccumulator::accumulate(double t, double gamma, const double* values, 
       rev_rhs_.setZero();
       rev_samples_ = 0;
       rev_time_sum_ = 0.0;
-      if (rev_window_n_.size() > 0) rev_window_sum_.setZero(), rev_window_n_.setZero(), rev_window_t_.setZero();
+      if (rev_window_n_.size() > 0)
+        rev_window_sum_.setZero(), rev_window_n_.setZero(), rev_window_t_.setZero();
       revolution_broken_ = false;
     } else {
       close_revolution();

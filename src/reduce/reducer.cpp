@@ -101,14 +101,15 @@ struct Run {
   double beta_deg = 0.0, gamma_deg = 0.0;
   // The local lines the next rows are checked against (the last window's), on the run's clock.
   Line theta_line, psi_line;
+  bool psi_line_valid = true;  // psi_line holds the phase (false after a gap until the next window closes)
   // The current window of the rate check.
   LineSums block_theta, block_psi;
   double block_t0 = 0.0, block_theta0 = 0.0, block_psi0 = 0.0;
   // The run's clock: record time minus the gaps (each counted as one planned interval) since the
   // measurement began.
   double clock_offset = 0.0;
-  double last_t_record = 0.0;  // the last accepted row
-  double prev_row_t = 0.0;     // the last row seen, accepted or not
+  double last_t_record = 0.0;                             // the last accepted row
+  double prev_row_t = 0.0;                                // the last row seen, accepted or not
   double t_prev = 0.0, theta_prev = 0.0, psi_prev = 0.0;  // the last accepted row, run's clock, unwrapped
   std::vector<Row> held;  // rows off the line, waiting to be judged glitches or the run's end
   std::string held_reason;
@@ -151,9 +152,11 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
           "the main axis turns at {:.6g} rad/s, {:.2e} (relative) from the planned {} rad/s "
           "(rate_tolerance {:.0e})",
           main_rate_rad_s, best_rel, best, options.rate_tolerance);
-    } else if (std::abs(counter_rate_rad_s + main_rate_rad_s) > options.rate_tolerance * std::abs(main_rate_rad_s)) {
-      m.why_not = fmt::format("the counter platform turns at {:.6g} rad/s, not at minus the main rate {:.6g} rad/s",
-                              counter_rate_rad_s, main_rate_rad_s);
+    } else if (std::abs(counter_rate_rad_s + main_rate_rad_s) >
+               options.rate_tolerance * std::abs(main_rate_rad_s)) {
+      m.why_not =
+          fmt::format("the counter platform turns at {:.6g} rad/s, not at minus the main rate {:.6g} rad/s",
+                      counter_rate_rad_s, main_rate_rad_s);
     }
     m.planned_rate_rad_s = best;
   }
@@ -169,9 +172,10 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
   double b = 0.0;
   const double db = nearest(plan.beta_rad, beta_deg, b);
   if (db > options.beta_tolerance_deg) {
-    m.why_not = fmt::format("beta reads {:.3f} deg, {:.3f} deg from the nearest planned beta {:.3f} deg "
-                            "(beta_tolerance_deg {})",
-                            beta_deg, db, b * kRadToDeg, options.beta_tolerance_deg);
+    m.why_not = fmt::format(
+        "beta reads {:.3f} deg, {:.3f} deg from the nearest planned beta {:.3f} deg "
+        "(beta_tolerance_deg {})",
+        beta_deg, db, b * kRadToDeg, options.beta_tolerance_deg);
     return m;
   }
   m.beta_rad = b;
@@ -179,9 +183,10 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
     double g = 0.0;
     const double dg = nearest(plan.gamma_rad, gamma_deg, g);
     if (dg > options.beta_tolerance_deg) {
-      m.why_not = fmt::format("the static hold's gamma reads {:.3f} deg, {:.3f} deg from the nearest planned "
-                              "gamma {:.3f} deg (beta_tolerance_deg {})",
-                              gamma_deg, dg, g * kRadToDeg, options.beta_tolerance_deg);
+      m.why_not = fmt::format(
+          "the static hold's gamma reads {:.3f} deg, {:.3f} deg from the nearest planned "
+          "gamma {:.3f} deg (beta_tolerance_deg {})",
+          gamma_deg, dg, g * kRadToDeg, options.beta_tolerance_deg);
       return m;
     }
     m.gamma_rad = g;
@@ -238,7 +243,8 @@ struct Reducer::State {
     window_tested_at = window.back().t;
     Line th, ps;
     fit_lines(first, window.end(), th, ps);
-    if (th.max_residual > options.angle_tolerance_deg || ps.max_residual > options.angle_tolerance_deg) return;
+    if (th.max_residual > options.angle_tolerance_deg || ps.max_residual > options.angle_tolerance_deg)
+      return;
     std::vector<double> betas;
     for (auto it = first; it != window.end(); ++it) betas.push_back(it->beta);
     const double beta = median_of(betas);
@@ -292,8 +298,9 @@ struct Reducer::State {
                             r.gamma_deg);
     r.matched = r.match.why_not.empty();
     if (!r.matched) return;
-    r.planned_duration = r.match.is_static ? hold_duration()
-                                           : plan.revolutions * 2.0 * kPi / std::abs(r.match.planned_rate_rad_s);
+    r.planned_duration = r.match.is_static
+                             ? hold_duration()
+                             : plan.revolutions * 2.0 * kPi / std::abs(r.match.planned_rate_rad_s);
     r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad,
                   r.match.is_static, 1, r.planned_duration, true);
   }
@@ -315,7 +322,8 @@ struct Reducer::State {
     // encoders' phase is unknown (a clock jump looks like a gap), so only beta is judged there and the angles
     // continue to within half a turn of the prediction over one planned interval.
     const double step = gap ? dt_planned : t - r.t_prev;
-    const double th_pred = r.theta_prev + r.theta_line.rate * step, ps_pred = r.psi_prev + r.psi_line.rate * step;
+    const double th_pred = r.theta_prev + r.theta_line.rate * step,
+                 ps_pred = r.psi_prev + r.psi_line.rate * step;
     Row u = raw;
     u.t = t;
     u.theta = th_pred + wrap_deg(raw.theta - th_pred);
@@ -325,18 +333,22 @@ struct Reducer::State {
     if (std::abs(db) > options.beta_tolerance_deg)
       off = fmt::format("beta moves by {:.3g} deg at t = {:.3f} s", db, raw.t);
     else if (!gap && std::abs(u.theta - th_pred) > options.angle_tolerance_deg)
-      off = fmt::format("the main axis leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)", raw.t,
-                        u.theta - th_pred);
+      off = fmt::format("the main axis leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)",
+                        raw.t, u.theta - th_pred);
     else if (!gap && std::abs(u.psi - ps_pred) > options.angle_tolerance_deg)
-      off = fmt::format("the counter platform leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)",
-                        raw.t, u.psi - ps_pred);
+      off = fmt::format(
+          "the counter platform leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)", raw.t,
+          u.psi - ps_pred);
     if (!off.empty()) {
       if (r.held.empty()) r.held_reason = off;
       r.held.push_back(raw);
       if (r.held.size() > static_cast<std::size_t>(options.encoder_glitch_rows)) end_run(r.held_reason);
       return;
     }
-    if (gap) r.block_theta = r.block_psi = LineSums{};
+    if (gap) {
+      r.block_theta = r.block_psi = LineSums{};
+      r.psi_line_valid = false;
+    }
     r.theta_prev = u.theta;
     r.psi_prev = u.psi;
     r.t_prev = t;
@@ -372,9 +384,10 @@ struct Reducer::State {
         r.rate_theta = rt;
         r.rate_psi = rp;
       } else if (change > options.rate_steadiness) {
-        end_run(fmt::format("the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window ending at "
-                            "t = {:.3f} s",
-                            change, options.rate_steadiness, raw.t));
+        end_run(fmt::format(
+            "the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window ending at "
+            "t = {:.3f} s",
+            change, options.rate_steadiness, raw.t));
         return;
       }
       const auto line = [&](const LineSums& s, double rate, double y0) {
@@ -386,6 +399,7 @@ struct Reducer::State {
       };
       r.theta_line = line(r.block_theta, rt, r.block_theta0);
       r.psi_line = line(r.block_psi, rp, r.block_psi0);
+      r.psi_line_valid = true;
       if (!r.decided) r.gamma_deg = wrap_deg(-r.psi_line(t));
       r.block_theta = r.block_psi = LineSums{};
     }
@@ -411,9 +425,10 @@ struct Reducer::State {
       r.stretches.push_back({u.t, u.t, 0, 0});
     } else if (gap || r.dropped) {
       if (r.stretches.size() >= static_cast<std::size_t>(options.max_stretches_per_dwell)) {
-        end_run(fmt::format("gaps and dropped rows break it into more than {} stretches (max_stretches_per_dwell) "
-                            "by t = {:.3f} s",
-                            options.max_stretches_per_dwell, t_record));
+        end_run(fmt::format(
+            "gaps and dropped rows break it into more than {} stretches (max_stretches_per_dwell) "
+            "by t = {:.3f} s",
+            options.max_stretches_per_dwell, t_record));
         return;
       }
       if (gap) {
@@ -437,7 +452,11 @@ struct Reducer::State {
     r.phase_rel.back().add(tt, u.psi - r.psi_first + u.theta - r.theta_first);
     r.beta_sum += u.beta;
     ++r.n;
-    r.acc->add(u.t, -u.psi * kDegToRad, &u.y);
+    // The arm angle of the fit's basis from the line of the last window (smooth: a reading quantised to 0.1
+    // deg would put its rounding into every basis function), continued from the reading to within half a
+    // turn; after a gap, until a window has closed, the reading itself.
+    const double psi = r.psi_line_valid ? u.psi + wrap_deg(r.psi_line(u.t) - u.psi) : u.psi;
+    r.acc->add(u.t, -psi * kDegToRad, &u.y);
   }
 
   void reject(const Run& r, std::string reason) {
@@ -452,9 +471,9 @@ struct Reducer::State {
     x.reason = std::move(reason);
     rejected.push_back(std::move(x));
     if (rejected.size() > kRejectedKept) {
-      const auto shortest = std::min_element(rejected.begin(), rejected.end(), [](const auto& a, const auto& b) {
-        return a.end_s - a.start_s < b.end_s - b.start_s;
-      });
+      const auto shortest = std::min_element(
+          rejected.begin(), rejected.end(),
+          [](const auto& a, const auto& b) { return a.end_s - a.start_s < b.end_s - b.start_s; });
       rejected.erase(shortest);
     }
   }
@@ -526,7 +545,8 @@ struct Reducer::State {
     for (const LineSums& x : r.phase_rel) sty_r += x.sty(), stt_r += x.stt(), syy_r += x.syy(), n_r += x.n;
     const double br = stt_r > 0 ? sty_r / stt_r : 0.0;
     const double dof_r = n_r - 1.0 - static_cast<double>(r.phase_rel.size());
-    const double se_r = dof_r > 0 && stt_r > 0 ? std::sqrt(std::max(syy_r - br * sty_r, 0.0) / dof_r / stt_r) : 0.0;
+    const double se_r =
+        dof_r > 0 && stt_r > 0 ? std::sqrt(std::max(syy_r - br * sty_r, 0.0) / dof_r / stt_r) : 0.0;
     const double bt = stt_t > 0 ? sty_t / stt_t : 0.0, bp = -bt + (std::abs(br) > 3.0 * se_r ? br : 0.0);
     for (std::size_t k = 0; k < r.phase_theta.size(); ++k) {
       res_t += std::max(r.phase_theta[k].syy() - bt * r.phase_theta[k].sty(), 0.0);
@@ -575,14 +595,15 @@ struct Reducer::State {
     const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
     if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
       warnings.push_back(fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions): {}.",
-                                     at(d.first_time_s), what, measured, d.planned_duration_s, plan.revolutions,
-                                     r.quality.ended));
+                                     at(d.first_time_s), what, measured, d.planned_duration_s,
+                                     plan.revolutions, r.quality.ended));
     }
     const double wander = options.angle_tolerance_deg / 4.0;
     if (d.main.rms_residual_rad > wander * kDegToRad || d.counter.rms_residual_rad > wander * kDegToRad) {
       warnings.push_back(fmt::format(
           "{}: the rate wanders during the {}: encoder angles leave a constant-rate line by {:.4f} deg RMS.",
-          at(d.first_time_s), what, std::max(d.main.rms_residual_rad, d.counter.rms_residual_rad) * kRadToDeg));
+          at(d.first_time_s), what,
+          std::max(d.main.rms_residual_rad, d.counter.rms_residual_rad) * kRadToDeg));
     }
     if (!d.is_static) {
       const double rel = std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) / std::abs(d.planned_rate_rad_s);
@@ -606,14 +627,15 @@ struct Reducer::State {
       const double dg = is_static ? std::abs(wrap_deg(x.gamma_deg - p.gamma_rad * kRadToDeg)) : 0.0;
       if (db > 5.0 || dr > 0.05 || dg > 5.0) continue;
       const int rank = (db <= options.beta_tolerance_deg ? 2 : 0) + (dr <= options.rate_tolerance ? 1 : 0);
-      if (!best || rank > best_rank || (rank == best_rank && x.end_s - x.start_s > best->end_s - best->start_s)) {
+      if (!best || rank > best_rank ||
+          (rank == best_rank && x.end_s - x.start_s > best->end_s - best->start_s)) {
         best = &x;
         best_rank = rank;
       }
     }
     if (!best) return "no steady run of the record comes near it";
-    return fmt::format("the steady run at t = {:.3f} s to {:.3f} s gave no dwell: {}", best->start_s, best->end_s,
-                       best->reason);
+    return fmt::format("the steady run at t = {:.3f} s to {:.3f} s gave no dwell: {}", best->start_s,
+                       best->end_s, best->reason);
   }
 };
 
@@ -654,10 +676,11 @@ Reduction Reducer::finish() {
   out.samples_read = st.rows;
   out.warnings = st.warnings;
   if (st.offset_dwells > 0)
-    out.warnings.push_back(fmt::format(
-        "{}: in {} dwell{} the main axis turned up to {:.2e} (relative) off the planned rate; the measured rates "
-        "are used.",
-        st.source, st.offset_dwells, st.offset_dwells > 1 ? "s" : "", st.worst_rate_offset));
+    out.warnings.push_back(
+        fmt::format("{}: in {} dwell{} the main axis turned up to {:.2e} (relative) off the planned rate; "
+                    "the measured rates "
+                    "are used.",
+                    st.source, st.offset_dwells, st.offset_dwells > 1 ? "s" : "", st.worst_rate_offset));
   // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several.
   std::map<std::tuple<double, double, double>, int> chosen;
   for (std::size_t i = 0; i < st.dwells.size(); ++i) {

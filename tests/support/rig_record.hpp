@@ -1,15 +1,15 @@
 #pragma once
-// A record as a rig writes it (docs/physics.md section 14), for tests: independent of the simulator's timeline
-// (plan/timeline.hpp). The machine starts at rest, ramps smoothly to each rate, moves the position platform
-// smoothly between dwells, and visits the plan's (rate, beta) pairs in an order of its own, each dwell longer than
-// planned. Its drive turns at the planned rate times (1 + offset), with a sinusoidal ripple. The gyro output is
-// the exact model (model/centrifuge.hpp exact_inputs, model/gyro.hpp) at the generator's own joint states plus
-// white noise. What the acquisition then does to it: a uniform clock read with jitter and rounded, quantised angle
-// encoders, a position encoder toggling by one count, a gap, a clock jump, spikes in the output, a glitch of beta
-// in one row.
+// A record as a rig writes it (docs/physics.md section 14), for tests: independent of the simulator's
+// timeline (plan/timeline.hpp). The machine starts at rest, ramps smoothly to each rate, moves the position
+// platform smoothly between dwells, and visits the plan's (rate, beta) pairs in an order of its own, each
+// dwell longer than planned. Its drive turns at the planned rate times (1 + offset), with a sinusoidal
+// ripple. The gyro output is the exact model (model/centrifuge.hpp exact_inputs, model/gyro.hpp) at the
+// generator's own joint states plus white noise. What the acquisition then does to it: a uniform clock read
+// with jitter and rounded, quantised angle encoders, a position encoder toggling by one count, a gap, a clock
+// jump, spikes in the output, a glitch of beta in one row.
 //
-// rig_rows() yields rows of numbers (physical units); write_native() writes gyrocal's own format. Another layout
-// (encoder counts, ms, ';', mV) is another writer over the same rows.
+// rig_rows() yields rows of numbers (physical units); write_native() writes gyrocal's own format. Another
+// layout (encoder counts, ms, ';', mV) is another writer over the same rows.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -30,27 +30,27 @@ namespace gyrocal::testing {
 
 /// What the rig does to a record. Defaults: a perfect rig (but its own order, ramps and longer dwells).
 struct RigImperfections {
-  double jitter_s = 0.0;             ///< time stamps read with uniform jitter of +- this, s
-  double stamp_resolution_s = 0.0;   ///< stamps rounded to this, s (0: not rounded)
-  double angle_quantum_deg = 0.0;    ///< main and counter encoders quantised to this, deg
-  double position_count_deg = 0.0;   ///< the position encoder's count, deg; at rest it toggles by one count
-  double rate_offset = 0.0;          ///< the drive turns at planned x (1 + this)
-  double ripple = 0.0;               ///< relative amplitude of the drive's rate ripple
-  double ripple_hz = 0.37;           ///< its frequency, Hz
-  double gap_fraction = 0.0;         ///< rows missing from the middle of the third dwell: this fraction of it
-  double clock_jump_s = 0.0;         ///< the clock jumps by this in the middle of the fifth dwell
-  int spikes = 0;                    ///< output spikes of spike_deg_h, spread over the record
+  double jitter_s = 0.0;            ///< time stamps read with uniform jitter of +- this, s
+  double stamp_resolution_s = 0.0;  ///< stamps rounded to this, s (0: not rounded)
+  double angle_quantum_deg = 0.0;   ///< main and counter encoders quantised to this, deg
+  double position_count_deg = 0.0;  ///< the position encoder's count, deg; at rest it toggles by one count
+  double rate_offset = 0.0;         ///< the drive turns at planned x (1 + this)
+  double ripple = 0.0;              ///< relative amplitude of the drive's rate ripple
+  double ripple_hz = 0.37;          ///< its frequency, Hz
+  double gap_fraction = 0.0;        ///< rows missing from the middle of the third dwell: this fraction of it
+  double clock_jump_s = 0.0;        ///< the clock jumps by this in the middle of the fifth dwell
+  int spikes = 0;                   ///< output spikes of spike_deg_h, spread over the record
   double spike_deg_h = 1e6;
-  double beta_glitch_deg = 0.0;      ///< one row in the middle of the second dwell reads beta off by this
+  double beta_glitch_deg = 0.0;         ///< one row in the middle of the second dwell reads beta off by this
   double beta_move_in_dwell_deg = 0.0;  ///< beta moves by this 0.5 s into the settle time of the fourth dwell
 };
 
 /// The generator's own choices of the machine's motion.
 struct RigMotion {
-  double ramp_s = 4.0;        ///< a smooth ramp between two rates
-  double move_s = 3.0;        ///< a smooth move of the position platform
+  double ramp_s = 4.0;         ///< a smooth ramp between two rates
+  double move_s = 3.0;         ///< a smooth move of the position platform
   double extra_dwell_s = 3.0;  ///< each dwell lasts settle + planned + this
-  double noise_deg_h = 0.5;   ///< white noise on each output sample, deg/h
+  double noise_deg_h = 0.5;    ///< white noise on each output sample, deg/h
 };
 
 /// One row in physical units.
@@ -63,8 +63,12 @@ struct RigRow {
 namespace rig_detail {
 
 /// A smooth step from 0 to 1 over [0, 1] and its integral and derivatives.
-inline double step(double u) { return u <= 0 ? 0.0 : u >= 1 ? 1.0 : 0.5 * (1.0 - std::cos(kPi * u)); }
-inline double step_rate(double u) { return u <= 0 || u >= 1 ? 0.0 : 0.5 * kPi * std::sin(kPi * u); }
+inline double step(double u) {
+  return u <= 0 ? 0.0 : u >= 1 ? 1.0 : 0.5 * (1.0 - std::cos(kPi * u));
+}
+inline double step_rate(double u) {
+  return u <= 0 || u >= 1 ? 0.0 : 0.5 * kPi * std::sin(kPi * u);
+}
 
 struct Phase {
   double t0 = 0.0, t1 = 0.0;
@@ -78,8 +82,8 @@ struct Phase {
 }  // namespace rig_detail
 
 /// Calls emit(row) for each row of a rig's record of `s`'s plan (spinning rates only), in time order.
-inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion, std::uint64_t seed,
-                     const std::function<void(const RigRow&)>& emit) {
+inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion,
+                     std::uint64_t seed, const std::function<void(const RigRow&)>& emit) {
   using rig_detail::Phase;
   const CentrifugeModel model = s.model();
   const TestSpec& test = s.test;
@@ -103,9 +107,9 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     p.beta1 = beta1;
     p.theta0 = theta;
     p.dwell = dwell;
-    if (dwell) p.dwell_index = static_cast<int>(std::count_if(phases.begin(), phases.end(), [](const Phase& q) {
-                                 return q.dwell;
-                               }));
+    if (dwell)
+      p.dwell_index = static_cast<int>(
+          std::count_if(phases.begin(), phases.end(), [](const Phase& q) { return q.dwell; }));
     // The drive's angle at the end (without ripple: the ripple's angle is added where it is evaluated).
     theta += rate * duration + (rate1 - rate) * 0.5 * duration;
     if (dwell && imp.ripple != 0.0 && rate != 0.0) {
@@ -127,7 +131,9 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
   }
   add(motion.ramp_s, 0.0, beta, false);
 
-  std::mt19937_64 rng(seed);
+  // The output's noise and the acquisition's imperfections draw from separate streams: a record with and
+  // without jitter has the same noise.
+  std::mt19937_64 rng(seed), acquisition(seed ^ 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> noise(0.0, motion.noise_deg_h);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::bernoulli_distribution toggle(0.5);
@@ -164,7 +170,8 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     const double db = p.beta1 - p.beta0;
     j.position_angle_rad = p.beta0 + db * rig_detail::step(u);
     j.position_rate_rad_s = db * rig_detail::step_rate(u) / d;
-    j.position_accel_rad_s2 = db * 0.5 * kPi * kPi * std::cos(kPi * u) / (d * d) * (u > 0 && u < 1 ? 1.0 : 0.0);
+    j.position_accel_rad_s2 =
+        db * 0.5 * kPi * kPi * std::cos(kPi * u) / (d * d) * (u > 0 && u < 1 ? 1.0 : 0.0);
     double beta_read_offset = 0.0;
     if (p.dwell && p.dwell_index == 3 && imp.beta_move_in_dwell_deg != 0.0 && tau >= 0.5) {
       // The platform really moves (and stays): the model sees it too.
@@ -172,24 +179,28 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     }
     const GyroInputs in = exact_inputs(model, j);
     double y = gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) + noise(rng);
-    if (spike_every > 0 && k % spike_every == spike_every / 2 && k / spike_every <= static_cast<std::uint64_t>(imp.spikes))
+    if (spike_every > 0 && k % spike_every == spike_every / 2 &&
+        k / spike_every <= static_cast<std::uint64_t>(imp.spikes))
       y += imp.spike_deg_h;
     // The acquisition.
     const double mid = 0.5 * (p.t0 + p.t1);
-    if (p.dwell && p.dwell_index == 2 && imp.gap_fraction > 0.0 && std::abs(tk - mid) < 0.5 * imp.gap_fraction * d)
+    if (p.dwell && p.dwell_index == 2 && imp.gap_fraction > 0.0 &&
+        std::abs(tk - mid) < 0.5 * imp.gap_fraction * d)
       continue;
     if (p.dwell && p.dwell_index == 4 && imp.clock_jump_s != 0.0 && tk >= mid) jump = imp.clock_jump_s;
     if (p.dwell && p.dwell_index == 1 && imp.beta_glitch_deg != 0.0 && std::abs(tk - mid) < 0.5 / fs)
       beta_read_offset = imp.beta_glitch_deg;
-    double stamp = tk + imp.jitter_s * uniform(rng);
-    if (imp.stamp_resolution_s > 0) stamp = imp.stamp_resolution_s * std::round(stamp / imp.stamp_resolution_s);
+    double stamp = tk + imp.jitter_s * uniform(acquisition);
+    if (imp.stamp_resolution_s > 0)
+      stamp = imp.stamp_resolution_s * std::round(stamp / imp.stamp_resolution_s);
     RigRow row;
     row.time_s = stamp + jump;
     row.main_angle_deg = quantise(std::fmod(th * kRadToDeg, 360.0), imp.angle_quantum_deg);
     row.counter_angle_deg = quantise(wrap_deg(j.counter_angle_rad * kRadToDeg), imp.angle_quantum_deg);
     double b = j.position_angle_rad * kRadToDeg;
     if (imp.position_count_deg > 0)
-      b = imp.position_count_deg * (std::floor(b / imp.position_count_deg) + (toggle(rng) ? 1.0 : 0.0));
+      b = imp.position_count_deg *
+          (std::floor(b / imp.position_count_deg) + (toggle(acquisition) ? 1.0 : 0.0));
     row.position_angle_deg = b + beta_read_offset;
     row.gyro_deg_h = y;
     emit(row);
@@ -202,8 +213,8 @@ inline void write_native(std::ostream& out, const std::vector<RigRow>& rows) {
   out << "time_s,main_angle_deg,counter_angle_deg,position_angle_deg,gyro_deg_h\n";
   out.precision(17);
   for (const RigRow& r : rows)
-    out << r.time_s << ',' << r.main_angle_deg << ',' << r.counter_angle_deg << ',' << r.position_angle_deg << ','
-        << r.gyro_deg_h << '\n';
+    out << r.time_s << ',' << r.main_angle_deg << ',' << r.counter_angle_deg << ',' << r.position_angle_deg
+        << ',' << r.gyro_deg_h << '\n';
 }
 
 /// The rows as RecordSamples (what the native reader gives back).

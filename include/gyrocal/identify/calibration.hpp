@@ -72,7 +72,7 @@ struct DataQuality {
     double rate_rad_s = 0.0;  ///< planned
     double measured_rate_rad_s = 0.0;
     double beta_deg = 0.0;
-    double gamma_deg = 0.0;  ///< static holds
+    double gamma_deg = 0.0;             ///< static holds
     double start_s = 0.0, end_s = 0.0;  ///< the steady run, record time
     std::size_t rows = 0, rows_used = 0, settle_rows = 0, beyond_planned_rows = 0, encoder_glitch_rows = 0,
                 outliers = 0, gaps = 0;

@@ -20,9 +20,9 @@ struct ReduceOptions {
     kWindowMean,   ///< mean of the samples within +-window/2 of each gamma
   };
   Method method = Method::kHarmonicFit;
-  int harmonic_order = 3;            ///< harmonic fit: orders 0..harmonic_order in gamma
-  bool linear_drift = true;          ///< harmonic fit and window mean: a linear drift in time
-  double window_deg = 10.0;          ///< window mean: full width of the window around each gamma, deg
+  int harmonic_order = 3;    ///< harmonic fit: orders 0..harmonic_order in gamma
+  bool linear_drift = true;  ///< harmonic fit and window mean: a linear drift in time
+  double window_deg = 10.0;  ///< window mean: full width of the window around each gamma, deg
 
   // Finding dwells in a record as a rig writes it (docs/physics.md section 14; docs/calibration.md, "Cutting
   // a record into dwells"). Steadiness is judged on straight lines fitted to windows of encoder readings,
@@ -55,7 +55,7 @@ struct ReduceOptions {
   /// A dwell broken into more stretches than this (by gaps and glitches) is refused: the channels keep one
   /// entry per stretch, so this bounds their memory.
   int max_stretches_per_dwell = 4096;
-  int static_batches = 16;                    ///< a static hold's standard error from this many batch means
+  int static_batches = 16;  ///< a static hold's standard error from this many batch means
   /// The model's channels (identify/channels.hpp) are smooth in gamma (harmonics up to ~6), so they are
   /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
   /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0 (default):
@@ -163,8 +163,8 @@ class DwellAccumulator {
   std::size_t samples_ = 0;
   double t_first_ = 0.0, t_last_ = 0.0;
   double gamma_first_ = 0.0, gamma_last_ = 0.0;
-  int revolution_ = 0;  // of the samples accumulated
-  bool break_next_ = false;        // break_revolution() was called: the next sample follows a gap
+  int revolution_ = 0;              // of the samples accumulated
+  bool break_next_ = false;         // break_revolution() was called: the next sample follows a gap
   bool revolution_broken_ = false;  // the revolution in progress holds a gap: it does not count
   bool finished_ = false;
 

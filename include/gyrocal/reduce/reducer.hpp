@@ -4,8 +4,8 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gyrocal/plan/positions.hpp"
@@ -106,10 +106,10 @@ struct Reduction {
   std::vector<Dwell> dwells;
   std::vector<ReducedPosition> positions;  ///< every position of the plan, in order
   std::vector<std::string> warnings;
-  std::size_t samples_read = 0;  ///< rows of the record
-  std::size_t samples_used = 0;  ///< rows in the measured parts of the dwells used
-  std::size_t outliers = 0;      ///< of those, rejected as outliers (and replaced by the dwell's fit)
-  std::size_t gaps = 0;          ///< breaks in the time series inside the dwells used (Dwell::gaps)
+  std::size_t samples_read = 0;         ///< rows of the record
+  std::size_t samples_used = 0;         ///< rows in the measured parts of the dwells used
+  std::size_t outliers = 0;             ///< of those, rejected as outliers (and replaced by the dwell's fit)
+  std::size_t gaps = 0;                 ///< breaks in the time series inside the dwells used (Dwell::gaps)
   std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside the dwells used: encoders off their line
   std::vector<RejectedRun> rejected;    ///< steady runs that gave no dwell (the longest kRejectedKept)
 };
