@@ -40,6 +40,15 @@ bool ReduceOptions::IsValid(std::string* error) const {
   if (!(rate_tolerance > 0.0 && rate_tolerance < 0.5)) return fail("rate_tolerance must be in (0, 0.5)");
   if (!(static_rate_tolerance_rad_s > 0.0)) return fail("static_rate_tolerance_rad_s must be positive");
   if (static_batches < 2) return fail("static_batches must be at least 2");
+  if (!(window_s > 0.0 && window_s <= 60.0)) return fail("window_s must be in (0, 60] s");
+  if (!(angle_tolerance_deg > 0.0 && angle_tolerance_deg < 90.0))
+    return fail("angle_tolerance_deg must be in (0, 90) degrees");
+  if (!(rate_steadiness > 0.0 && rate_steadiness < 0.5)) return fail("rate_steadiness must be in (0, 0.5)");
+  if (!(gap_intervals > 1.0)) return fail("gap_intervals must be above 1");
+  if (encoder_glitch_rows < 0 || encoder_glitch_rows > 1000)
+    return fail("encoder_glitch_rows must be between 0 and 1000");
+  if (max_stretches_per_dwell < 1) return fail("max_stretches_per_dwell must be at least 1");
+  if (!(wander_warning_deg > 0.0)) return fail("wander_warning_deg must be positive");
   if (model_samples_per_revolution < 0 ||
       (model_samples_per_revolution > 0 && model_samples_per_revolution < 16))
     return fail("model_samples_per_revolution must be 0 (every sample) or at least 16");

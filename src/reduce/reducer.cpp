@@ -119,6 +119,9 @@ struct Run {
   bool measuring = false;
   double t_first = 0.0, theta_first = 0.0, psi_first = 0.0;
   std::vector<LineSums> phase_theta, phase_psi, phase_rel;  // rel: psi_r + theta
+  // Successive differences of the main encoder's deviations inside stretches: the white part of its scatter
+  // (quantisation, jitter), to tell a wandering rate from it.
+  double diff_yy = 0, diff_yt = 0, diff_tt = 0, diff_n = 0, prev_y = 0, prev_tt = 0;
   std::vector<StretchSums> stretches;
   double beta_sum = 0.0;
   std::size_t n = 0, gaps = 0;
@@ -250,12 +253,17 @@ struct Reducer::State {
     const double beta = median_of(betas);
     for (double b : betas)
       if (std::abs(wrap_deg(b - beta)) > options.beta_tolerance_deg) return;
-    // Steady: the run begins at the earliest row before the window that still lies on its lines.
+    // Steady: the run begins at the earliest row before the window that still lies on its lines as closely as
+    // the window's own rows do (twice their largest residual, and beta within their spread): the end of a
+    // ramp or a move is not taken in.
+    double beta_spread = 0.0;
+    for (double b : betas) beta_spread = std::max(beta_spread, std::abs(wrap_deg(b - beta)));
+    const double th_tol = std::max(2.0 * th.max_residual, 1e-9),
+                 ps_tol = std::max(2.0 * ps.max_residual, 1e-9);
     while (first != window.begin()) {
       const Row& q = *std::prev(first);
-      if (std::abs(q.theta - th(q.t)) > options.angle_tolerance_deg ||
-          std::abs(q.psi - ps(q.t)) > options.angle_tolerance_deg ||
-          std::abs(wrap_deg(q.beta - beta)) > options.beta_tolerance_deg)
+      if (std::abs(q.theta - th(q.t)) > th_tol || std::abs(q.psi - ps(q.t)) > ps_tol ||
+          std::abs(wrap_deg(q.beta - beta)) > beta_spread + 1e-9)
         break;
       --first;
     }
@@ -353,7 +361,8 @@ struct Reducer::State {
     r.psi_prev = u.psi;
     r.t_prev = t;
     if (!r.held.empty()) {
-      r.quality.encoder_glitch_rows += r.held.size();
+      // Dropped: as encoder glitches inside the measured part; in the settle time they are settle rows.
+      (r.measuring ? r.quality.encoder_glitch_rows : r.quality.settle_rows) += r.held.size();
       r.held.clear();
       r.dropped = true;
     }
@@ -447,7 +456,17 @@ struct Reducer::State {
     ++st.count;
     const double tt = u.t - r.t_first;
     const double planned_turn = r.match.planned_rate_rad_s * kRadToDeg * tt;
-    r.phase_theta.back().add(tt, u.theta - r.theta_first - planned_turn);
+    const double y_theta = u.theta - r.theta_first - planned_turn;
+    if (st.count > 1) {
+      const double dy = y_theta - r.prev_y, dtt = tt - r.prev_tt;
+      r.diff_yy += dy * dy;
+      r.diff_yt += dy * dtt;
+      r.diff_tt += dtt * dtt;
+      r.diff_n += 1;
+    }
+    r.prev_y = y_theta;
+    r.prev_tt = tt;
+    r.phase_theta.back().add(tt, y_theta);
     r.phase_psi.back().add(tt, u.psi - r.psi_first + planned_turn);
     r.phase_rel.back().add(tt, u.psi - r.psi_first + u.theta - r.theta_first);
     r.beta_sum += u.beta;
@@ -598,12 +617,18 @@ struct Reducer::State {
                                      at(d.first_time_s), what, measured, d.planned_duration_s,
                                      plan.revolutions, r.quality.ended));
     }
-    const double wander = options.angle_tolerance_deg / 4.0;
-    if (d.main.rms_residual_rad > wander * kDegToRad || d.counter.rms_residual_rad > wander * kDegToRad) {
-      warnings.push_back(fmt::format(
-          "{}: the rate wanders during the {}: encoder angles leave a constant-rate line by {:.4f} deg RMS.",
-          at(d.first_time_s), what,
-          std::max(d.main.rms_residual_rad, d.counter.rms_residual_rad) * kRadToDeg));
+    // A rate that wanders: the main encoder's scatter about its line beyond its white part (half the mean
+    // square of successive differences: quantisation and stamp jitter), which the channels' constant-rate
+    // line does not follow.
+    const double white2 =
+        r.diff_n > 0 ? 0.5 * (r.diff_yy - 2.0 * bt * r.diff_yt + bt * bt * r.diff_tt) / r.diff_n : 0.0;
+    const double wander_deg = std::sqrt(std::max(res_t / nd - white2, 0.0));
+    if (wander_deg > options.wander_warning_deg) {
+      warnings.push_back(
+          fmt::format("{}: the rate wanders during the {}: the main encoder leaves a constant-rate line by "
+                      "{:.4f} deg RMS "
+                      "beyond its sample-to-sample scatter.",
+                      at(d.first_time_s), what, wander_deg));
     }
     if (!d.is_static) {
       const double rel = std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) / std::abs(d.planned_rate_rad_s);

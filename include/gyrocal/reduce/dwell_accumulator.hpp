@@ -45,6 +45,9 @@ struct ReduceOptions {
   /// Each window's rate stays within this (relative) of the dwell's rate: ripple up to 2e-4, five times.
   double rate_steadiness = 1e-3;
   double static_rate_tolerance_rad_s = 0.01;  ///< below this the main axis (or platform) counts as stopped
+  /// A dwell's main encoder leaving its constant-rate line by more than this RMS, beyond its sample-to-sample
+  /// scatter (quantisation, jitter), is warned about ("the rate wanders"), deg: the channels follow the line.
+  double wander_warning_deg = 0.01;
   /// An interval between two rows longer than this many planned sample intervals is a gap (a dwell with
   /// gaps is still one dwell; inside a dwell each gap counts as one sample interval, since a clock jump
   /// looks the same).
