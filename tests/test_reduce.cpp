@@ -375,6 +375,18 @@ TEST(RigRecord, EachImperfectionAloneAndAllTogetherCalibrateToTheTruth) {
     const std::size_t gaps = (imp.gap_fraction > 0 ? 1u : 0u) + (imp.clock_jump_s > 0 ? 1u : 0u);
     EXPECT_EQ(q.gaps, gaps) << name;
     EXPECT_EQ(c.reduction.encoder_glitch_rows, imp.beta_glitch_deg != 0 ? 1u : 0u) << name;
+    // The result JSON says per dwell what was dropped and why (docs/contract.md, data_quality).
+    const nlohmann::json dq = calibration_to_json(c.result).at("data_quality");
+    ASSERT_EQ(dq.at("dwells").size(), 8u) << name;
+    std::size_t glitches = 0, used = 0;
+    for (const nlohmann::json& d : dq.at("dwells")) {
+      glitches += d.at("dropped").at("encoder_glitches").get<std::size_t>();
+      used += d.at("rows_used").get<std::size_t>();
+      EXPECT_GT(d.at("dropped").at("settle").get<std::size_t>(), 0u) << name;
+      EXPECT_FALSE(d.at("ended").get<std::string>().empty()) << name;
+    }
+    EXPECT_EQ(glitches, c.reduction.encoder_glitch_rows) << name;
+    EXPECT_EQ(used, q.rows_used) << name;
   }
 }
 
