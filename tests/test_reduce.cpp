@@ -16,6 +16,7 @@
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/rig_record.hpp"
 
 namespace gyrocal {
 namespace {
@@ -296,6 +297,187 @@ TEST(Revolutions, TooFewForAScatterIsARefusalSayingHowManyAreNeeded) {
     EXPECT_NE(m.find("revolutions"), std::string::npos) << m;
     EXPECT_NE(m.find("at least 3"), std::string::npos) << m;
   }
+}
+
+// ---- Records as a rig writes them (docs/physics.md section 14; tests/support/rig_record.hpp)
+// -------------------
+
+/// A two-speed test of 8 dwells (every coefficient identifiable), short enough for many seeds.
+Scenario rig_scenario() {
+  Scenario s = default_scenario();
+  s.test.sample_rate_hz = 50.0;
+  s.test.revolutions = 8;
+  s.test.rates_rad_s = {9.9, 7.0};
+  return s;
+}
+
+std::vector<RecordSample> rig_record(const Scenario& s, const testing::RigImperfections& imp,
+                                     std::uint64_t seed) {
+  std::vector<testing::RigRow> rows;
+  testing::rig_rows(s, imp, testing::RigMotion{}, seed, [&](const testing::RigRow& r) { rows.push_back(r); });
+  return testing::as_samples(rows);
+}
+
+/// Every imperfection of docs/physics.md section 14 at the level the reduction must take.
+std::map<std::string, testing::RigImperfections> rig_cases() {
+  std::map<std::string, testing::RigImperfections> c;
+  c["perfect"] = {};
+  c["jitter"].jitter_s = 1e-4;
+  c["stamps rounded to ms"].jitter_s = 1e-4, c["stamps rounded to ms"].stamp_resolution_s = 1e-3;
+  c["quantised angles"].angle_quantum_deg = 0.1, c["quantised angles"].position_count_deg = 0.002;
+  c["rate offset"].rate_offset = 1e-3;
+  c["ripple"].ripple = 2e-4;
+  c["gap"].gap_fraction = 0.1;
+  c["clock jump"].clock_jump_s = 1000.0;
+  c["spikes"].spikes = 6;
+  c["beta glitch"].beta_glitch_deg = 30.0;
+  testing::RigImperfections all;
+  all.jitter_s = 1e-4;
+  all.stamp_resolution_s = 1e-3;
+  all.angle_quantum_deg = 0.1;
+  all.position_count_deg = 0.002;
+  all.rate_offset = 1e-3;
+  all.ripple = 2e-4;
+  all.gap_fraction = 0.1;
+  all.clock_jump_s = 1000.0;
+  all.spikes = 6;
+  all.beta_glitch_deg = 30.0;
+  c["all together"] = all;
+  return c;
+}
+
+TEST(RigRecord, EachImperfectionAloneAndAllTogetherCalibrateToTheTruth) {
+  const Scenario s = rig_scenario();
+  for (const auto& [name, imp] : rig_cases()) {
+    const std::vector<RecordSample> rows = rig_record(s, imp, 11);
+    Calibrated c;
+    try {
+      c = calibrate_rows(s, rows);
+    } catch (const Error& e) {
+      ADD_FAILURE() << name << ": " << e.what();
+      continue;
+    }
+    EXPECT_EQ(c.reduction.dwells.size(), 8u) << name;
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      const CoefficientEstimate& e = c.result.coefficients[k];
+      ASSERT_TRUE(e.identifiable) << name << " " << kCoefficientNames[k];
+      EXPECT_NEAR(e.value, s.gyro.values[k], 4.0 * e.std) << name << " " << kCoefficientNames[k];
+    }
+    const DataQuality& q = c.result.data_quality;
+    EXPECT_EQ(q.rows_read, rows.size()) << name;
+    // Spikes in the measured parts are outliers; those in ramps, moves and settle times reach nothing.
+    if (imp.spikes > 0) {
+      EXPECT_GE(q.outliers, 1u) << name;
+      EXPECT_LE(q.outliers, static_cast<std::size_t>(imp.spikes)) << name;
+    } else {
+      EXPECT_EQ(q.outliers, 0u) << name;
+    }
+    const std::size_t gaps = (imp.gap_fraction > 0 ? 1u : 0u) + (imp.clock_jump_s > 0 ? 1u : 0u);
+    EXPECT_EQ(q.gaps, gaps) << name;
+    EXPECT_EQ(c.reduction.encoder_glitch_rows, imp.beta_glitch_deg != 0 ? 1u : 0u) << name;
+    // The result JSON says per dwell what was dropped and why (docs/contract.md, data_quality).
+    const nlohmann::json dq = calibration_to_json(c.result).at("data_quality");
+    ASSERT_EQ(dq.at("dwells").size(), 8u) << name;
+    std::size_t glitches = 0, used = 0;
+    for (const nlohmann::json& d : dq.at("dwells")) {
+      glitches += d.at("dropped").at("encoder_glitches").get<std::size_t>();
+      used += d.at("rows_used").get<std::size_t>();
+      EXPECT_GT(d.at("dropped").at("settle").get<std::size_t>(), 0u) << name;
+      EXPECT_FALSE(d.at("ended").get<std::string>().empty()) << name;
+    }
+    EXPECT_EQ(glitches, c.reduction.encoder_glitch_rows) << name;
+    EXPECT_EQ(used, q.rows_used) << name;
+  }
+}
+
+TEST(RigRecord, UncertaintiesDescribeTheSpreadOverSeeds) {
+  // Every imperfection at once: over >= 50 seeds (estimate - truth) / std has a standard deviation in
+  // 0.85..1.15 for every coefficient.
+  const Scenario s = rig_scenario();
+  const testing::RigImperfections all = rig_cases().at("all together");
+  const int seeds = sanitized() ? 100 : 250;
+  std::vector<std::vector<double>> z(kNumCoefficients);
+  for (int seed = 0; seed < seeds; ++seed) {
+    const Calibrated c = calibrate_rows(s, rig_record(s, all, 1000 + static_cast<std::uint64_t>(seed)));
+    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+      z[k].push_back((c.result.coefficients[k].value - s.gyro.values[k]) / c.result.coefficients[k].std);
+  }
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    double mean = 0, var = 0;
+    for (double x : z[k]) mean += x;
+    mean /= static_cast<double>(z[k].size());
+    for (double x : z[k]) var += (x - mean) * (x - mean);
+    const double sd = std::sqrt(var / static_cast<double>(z[k].size() - 1));
+    std::printf("rig record, std of z for %s: %.3f (mean %.3f)\n", std::string(kCoefficientNames[k]).c_str(),
+                sd, mean);
+    EXPECT_GT(sd, 0.85) << kCoefficientNames[k];
+    EXPECT_LT(sd, 1.15) << kCoefficientNames[k];
+  }
+}
+
+TEST(RigRecord, BeyondItsToleranceARecordIsRefusedNamingThePositionTheTimeAndTheReason) {
+  const Scenario s = rig_scenario();
+  struct Case {
+    std::string name;
+    testing::RigImperfections imp;
+    std::string reason;
+  };
+  std::vector<Case> cases(3);
+  cases[0].name = "beta moves 0.4 deg";
+  cases[0].imp.beta_move_in_dwell_deg = 0.4;
+  cases[0].reason = "beta moves by 0.4 deg at t = ";
+  cases[1].name = "rate 5e-3 off";
+  cases[1].imp.rate_offset = 5e-3;
+  cases[1].reason = "(relative) from the planned 9.9 rad/s";
+  cases[2].name = "ripple 5e-3";
+  cases[2].imp.ripple = 5e-3;
+  cases[2].reason = "the rate changes by";
+  for (const Case& k : cases) {
+    try {
+      calibrate_rows(s, rig_record(s, k.imp, 3));
+      ADD_FAILURE() << k.name << ": calibrated";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("position "), std::string::npos) << k.name << ": " << m;
+      EXPECT_NE(m.find("the steady run at t = "), std::string::npos) << k.name << ": " << m;
+      EXPECT_NE(m.find(k.reason), std::string::npos) << k.name << ": " << m;
+    }
+  }
+}
+
+TEST(Exactness, ANoiseFreeTwoSpeedRecordWithLargeMachineErrorsIsExactByDefault) {
+  // docs/physics.md section 4: W_red = omega_red + sum c_j x_j,red holds after reduction when the model's
+  // channels go through the data's operator on the data's samples. With a lever arm of 1 cm, runouts,
+  // wobbles to harmonic 3 and position-platform errors, a strided channel grid left 4.3e-6 deg/h/g^2 on dOS.
+  Scenario s = small_test(8);
+  s.test.sample_rate_hz = 200.0;  // 127 samples per revolution: a strided grid would skip samples
+  s.test.rates_rad_s = {9.9, 7.0};
+  s.noise = GyroNoise{};
+  CentrifugeErrors& e = s.errors;
+  e.lever_arm_m = Eigen::Vector3d(0.01, -0.01, 0.01);
+  e.main_runout_x_m.terms = {{1, 2e-4, 0.3}, {2, 1e-4, 1.0}, {3, 5e-5, 2.0}};
+  e.main_runout_y_m.terms = {{1, 1.5e-4, 0.7}, {3, 5e-5, 0.1}};
+  e.main_wobble_x_rad.terms = {{1, 2e-4, 0.2}, {2, 1e-4, 0.4}, {3, 5e-5, 0.9}};
+  e.counter_wobble_y_rad.terms = {{1, 2e-4, 1.2}, {2, 1e-4, 0.5}, {3, 5e-5, 2.5}};
+  e.position_wobble_x_rad.terms = {{1, 1e-4, 0.3}, {3, 5e-5, 1.1}};
+  e.position_perpendicularity_x_rad = 2e-4;
+  e.position_angle_error_rad = 3e-4;
+  const std::vector<RecordSample> rows = record_of(s, 1);
+  const Calibrated c = calibrate_rows(s, rows);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    ASSERT_TRUE(c.result.coefficients[k].identifiable) << kCoefficientNames[k];
+    EXPECT_NEAR(c.result.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
+  }
+  // The configuration is one that a strided channel grid (the former default, 32 per revolution) does not
+  // reduce exactly: the test can tell.
+  ReduceOptions strided;
+  strided.model_samples_per_revolution = 32;
+  const Calibrated b = calibrate_rows(s, rows, strided);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    worst = std::max(worst, std::abs(b.result.coefficients[k].value - s.gyro.values[k]));
+  std::printf("strided channel grid: largest coefficient error %.3g\n", worst);
+  EXPECT_GT(worst, 1e-7);
 }
 
 }  // namespace

@@ -69,6 +69,22 @@ std::string result_table(const CalibrationResult& r) {
     for (const NamedEstimate& c : r.alternatives)
       out += fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.value, c.std), c.unit);
   }
+  const DataQuality& q = r.data_quality;
+  if (q.rows_read > 0) {
+    out +=
+        fmt::format("\ndata quality: {} rows read, {} used, {} outliers, {} gaps, {} encoder glitch rows\n",
+                    q.rows_read, q.rows_used, q.outliers, q.gaps, q.encoder_glitch_rows);
+    out +=
+        fmt::format("{:>9} {:>9} {:>9} {:>11} {:>7} {:>7} {:>8} {:>7} {:>8} {:>5}  {}\n", "rate", "beta",
+                    "start_s", "rows used", "settle", "beyond", "glitches", "outliers", "gaps", "", "ended");
+    for (const DataQuality::Dwell& d : q.dwells)
+      out += fmt::format("{:>9.4g} {:>9.3f} {:>9.3f} {:>5}/{:<5} {:>7} {:>7} {:>8} {:>8} {:>5}  {}\n",
+                         d.rate_rad_s, d.beta_deg, d.start_s, d.rows_used, d.rows, d.settle_rows,
+                         d.beyond_planned_rows, d.encoder_glitch_rows, d.outliers, d.gaps, d.ended);
+    for (const DataQuality::Rejected& x : q.rejected)
+      out += fmt::format("- no dwell from the steady run at t = {:.3f} to {:.3f} s: {}\n", x.start_s, x.end_s,
+                         x.reason);
+  }
   if (!r.warnings.empty()) {
     out += "\nwarnings\n";
     for (const std::string& w : r.warnings) out += "- " + w + "\n";

@@ -794,7 +794,32 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   r.compensation = options.compensation;
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
-  r.data_quality = {reduction.samples_read, reduction.samples_used, reduction.outliers, reduction.gaps};
+  r.data_quality.rows_read = reduction.samples_read;
+  r.data_quality.rows_used = reduction.samples_used;
+  r.data_quality.outliers = reduction.outliers;
+  r.data_quality.gaps = reduction.gaps;
+  r.data_quality.encoder_glitch_rows = reduction.encoder_glitch_rows;
+  for (const Dwell& d : reduction.dwells) {
+    DataQuality::Dwell q;
+    q.is_static = d.is_static;
+    q.rate_rad_s = d.planned_rate_rad_s;
+    q.measured_rate_rad_s = d.main.rate_rad_s;
+    q.beta_deg = d.beta_rad * kRadToDeg;
+    q.gamma_deg = d.is_static ? d.gammas_rad.at(0) * kRadToDeg : 0.0;
+    q.start_s = d.quality.run_start_s;
+    q.end_s = d.quality.run_end_s;
+    q.rows = d.quality.rows;
+    q.rows_used = d.samples;
+    q.settle_rows = d.quality.settle_rows;
+    q.beyond_planned_rows = d.quality.beyond_planned_rows;
+    q.encoder_glitch_rows = d.quality.encoder_glitch_rows;
+    q.outliers = d.gyro.outliers;
+    q.gaps = d.gaps;
+    q.ended = d.quality.ended;
+    r.data_quality.dwells.push_back(q);
+  }
+  for (const RejectedRun& x : reduction.rejected)
+    r.data_quality.rejected.push_back({x.start_s, x.end_s, x.reason});
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   if (!options.estimate.empty()) {

@@ -49,15 +49,15 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
                                d.counter.rate_rad_s * d.sample_interval_s, per_revolution);
       }
     }
-    const auto add_sample = [&](std::size_t i) {
-      const double t = d.time_of_sample(i);
-      // The joints on the dwell's constant-rate lines fitted to the encoders.
+    const auto add_sample = [&](double t, double main_rad, double counter_rad) {
+      // The joints on the dwell's constant-rate lines fitted to the encoders (the measured rates); beta as
+      // planned (reduce/reducer.cpp: an encoder's mean at rest is biased by up to half a count).
       JointState j;
-      j.main_angle_rad = d.main.at(t, d.first_time_s);
+      j.main_angle_rad = main_rad;
       j.main_rate_rad_s = d.main.rate_rad_s;
-      j.counter_angle_rad = d.counter.at(t, d.first_time_s);
+      j.counter_angle_rad = counter_rad;
       j.counter_rate_rad_s = d.counter.rate_rad_s;
-      j.position_angle_rad = d.measured_beta_rad;
+      j.position_angle_rad = d.beta_rad;
       const GyroInputs exact = exact_inputs(model, j);
       const NominalInputs nominal = nominal_inputs(model, j, false);
       v[0] = exact.rate_rad_s.x() * kRadPerSecToDegPerHour;
@@ -71,8 +71,25 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       }
       acc.add(t, -j.counter_angle_rad, v);
     };
-    for (std::size_t i = 0; i + 1 < d.samples; i += stride) add_sample(i);
-    if (d.samples > 0) add_sample(d.samples - 1);
+    if (d.stretches.empty()) {
+      const auto at = [&](std::size_t i) {
+        const double t = d.time_of_sample(i);
+        add_sample(t, d.main.at(t, d.first_time_s), d.counter.at(t, d.first_time_s));
+      };
+      for (std::size_t i = 0; i + 1 < d.samples; i += stride) at(i);
+      if (d.samples > 0) at(d.samples - 1);
+    } else {
+      // The dwell's own samples, stretch by stretch (gaps and dropped rows as the gyro output has them).
+      for (const TimeStretch& s : d.stretches) {
+        const auto at = [&](std::size_t i) {
+          const double dt = static_cast<double>(i) * s.interval_s;
+          add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt,
+                     s.counter_at_first_rad + d.counter.rate_rad_s * dt);
+        };
+        for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
+        if (s.count > 0) at(s.count - 1);
+      }
+    }
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
   }
   std::vector<PositionChannels> out;

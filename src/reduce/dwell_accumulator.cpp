@@ -13,11 +13,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Angle difference wrapped to (-pi, pi].
-double wrap(double a) {
-  return std::remainder(a, 2.0 * kPi);
-}
-
 /// The median of v (the upper one for an even count); reorders v.
 double median(std::vector<double>& v) {
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
@@ -45,6 +40,15 @@ bool ReduceOptions::IsValid(std::string* error) const {
   if (!(rate_tolerance > 0.0 && rate_tolerance < 0.5)) return fail("rate_tolerance must be in (0, 0.5)");
   if (!(static_rate_tolerance_rad_s > 0.0)) return fail("static_rate_tolerance_rad_s must be positive");
   if (static_batches < 2) return fail("static_batches must be at least 2");
+  if (!(window_s > 0.0 && window_s <= 60.0)) return fail("window_s must be in (0, 60] s");
+  if (!(angle_tolerance_deg > 0.0 && angle_tolerance_deg < 90.0))
+    return fail("angle_tolerance_deg must be in (0, 90) degrees");
+  if (!(rate_steadiness > 0.0 && rate_steadiness < 0.5)) return fail("rate_steadiness must be in (0, 0.5)");
+  if (!(gap_intervals > 1.0)) return fail("gap_intervals must be above 1");
+  if (encoder_glitch_rows < 0 || encoder_glitch_rows > 1000)
+    return fail("encoder_glitch_rows must be between 0 and 1000");
+  if (max_stretches_per_dwell < 1) return fail("max_stretches_per_dwell must be at least 1");
+  if (!(wander_warning_deg > 0.0)) return fail("wander_warning_deg must be positive");
   if (model_samples_per_revolution < 0 ||
       (model_samples_per_revolution > 0 && model_samples_per_revolution < 16))
     return fail("model_samples_per_revolution must be 0 (every sample) or at least 16");
@@ -141,8 +145,10 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   gamma_last_ = gamma;
   ++samples_;
   if (!static_) seen_revolution_ = static_cast<int>(std::floor(std::abs(gamma - gamma_first_) / (2.0 * kPi)));
+  const bool after_break = break_next_;
+  break_next_ = false;
   if (!robust_) {
-    accumulate(t, gamma, values);
+    accumulate(t, gamma, values, after_break);
     return;
   }
   // A block closes where a revolution begins (a static hold: anywhere) once it holds enough samples.
@@ -150,7 +156,11 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   const bool boundary = static_ || seen_revolution_ != block_revolution_;
   if ((boundary && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples) test_block();
   block_revolution_ = seen_revolution_;
-  pending_.push_back({t, gamma, values[0]});
+  pending_.push_back({t, gamma, values[0], after_break});
+}
+
+void DwellAccumulator::break_revolution() {
+  if (samples_ > 0) break_next_ = true;
 }
 
 // docs/physics.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
@@ -240,7 +250,7 @@ void DwellAccumulator::test_block() {
       for (int k = j; k < p; ++k) ref_normal_(k, j) += b[k] * b[j];
       ref_rhs_[j] += b[j] * v;
     }
-    accumulate(s.t, s.gamma, &v);
+    accumulate(s.t, s.gamma, &v, s.after_break);
   }
   pending_.clear();
 }
@@ -252,7 +262,7 @@ void DwellAccumulator::flush() {
   // The last revolution counts in the scatter as every other one does: every sample that moves the estimate
   // must be able to raise its uncertainty. It is complete when the dwell's last sample is within 1.5 sample
   // steps of a whole turn.
-  if (with_std_err_ && !static_ && last_revolution_complete()) close_revolution();
+  if (with_std_err_ && !static_ && last_revolution_complete() && !revolution_broken_) close_revolution();
 }
 
 bool DwellAccumulator::last_revolution_complete() const {
@@ -266,7 +276,7 @@ int DwellAccumulator::complete_revolutions() const {
   return seen_revolution_ + (last_revolution_complete() ? 1 : 0);
 }
 
-void DwellAccumulator::accumulate(double t, double gamma, const double* values) {
+void DwellAccumulator::accumulate(double t, double gamma, const double* values, bool after_break) {
   // Time scaled to about [-0.5, 0.5] over the planned dwell, for a well-conditioned drift column.
   const double ts = (t - t_first_) / duration_s_ - 0.5;
 
@@ -287,8 +297,22 @@ void DwellAccumulator::accumulate(double t, double gamma, const double* values) 
 
   // Revolutions counted from the first sample's gamma, in either sense of rotation.
   const int rev = static_cast<int>(std::floor(std::abs(gamma - gamma_first_) / (2.0 * kPi)));
-  if (with_std_err_ && rev != revolution_) close_revolution();
+  if (with_std_err_ && rev != revolution_) {
+    if (revolution_broken_) {
+      rev_normal_.setZero();
+      rev_rhs_.setZero();
+      rev_samples_ = 0;
+      rev_time_sum_ = 0.0;
+      if (rev_window_n_.size() > 0)
+        rev_window_sum_.setZero(), rev_window_n_.setZero(), rev_window_t_.setZero();
+      revolution_broken_ = false;
+    } else {
+      close_revolution();
+    }
+  }
   revolution_ = rev;
+  // A gap inside this revolution: it is incomplete, so it counts in the dwell's fit but not in the scatter.
+  if (after_break) revolution_broken_ = true;
 
   if (options_.method == ReduceOptions::Method::kHarmonicFit) {
     // The hot loop of a calibration: raw column-major storage, lower triangles only.
@@ -323,7 +347,7 @@ void DwellAccumulator::accumulate(double t, double gamma, const double* values) 
   // Window mean.
   const double half = 0.5 * options_.window_deg * kDegToRad;
   for (std::size_t k = 0; k < gammas_.size(); ++k) {
-    if (std::abs(wrap(gamma - gammas_[k])) > half) continue;
+    if (std::abs(wrap_rad(gamma - gammas_[k])) > half) continue;
     const auto kk = static_cast<Eigen::Index>(k);
     for (int c = 0; c < columns_; ++c) {
       window_sum_(kk, c) += values[c];

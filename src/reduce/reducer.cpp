@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <map>
 #include <optional>
 
@@ -15,10 +16,6 @@
 namespace gyrocal {
 namespace {
 
-double wrap_deg(double a) {
-  return std::remainder(a, 360.0);
-}
-
 /// Straight-line fit of y against t, streaming, on deviations from a planned line (well conditioned).
 struct LineSums {
   double n = 0, t = 0, tt = 0, y = 0, ty = 0, yy = 0;
@@ -30,159 +27,579 @@ struct LineSums {
     ty += ti * yi;
     yy += yi * yi;
   }
-  /// Intercept at t = 0, slope, RMS residual.
-  void fit(double& intercept, double& slope, double& rms) const {
-    const double tbar = t / n, ybar = y / n;
-    const double stt = tt - n * tbar * tbar, sty = ty - n * tbar * ybar, syy = yy - n * ybar * ybar;
-    slope = stt > 0 ? sty / stt : 0.0;
-    intercept = ybar - slope * tbar;
-    rms = std::sqrt(std::max(syy - slope * sty, 0.0) / n);
-  }
+  double stt() const { return tt - t * t / n; }
+  double sty() const { return ty - t * y / n; }
+  double syy() const { return yy - y * y / n; }
 };
 
-/// The run in progress: consecutive samples at one steady state of the machine.
+/// One row as the reducer sees it: the encoders unwrapped (deg) where a run or a window has a phase for them.
+struct Row {
+  double t = 0.0;
+  double theta = 0.0, psi = 0.0, beta = 0.0;  // deg
+  double y = 0.0;                             // gyro output, deg/h
+};
+
+/// A line angle(t) = at + rate * (t - t0), deg and deg/s, with the largest residual of the rows it was
+/// fitted to.
+struct Line {
+  double t0 = 0.0, at = 0.0, rate = 0.0, max_residual = 0.0;
+  double operator()(double t) const { return at + rate * (t - t0); }
+};
+
+/// Least-squares lines of theta and psi over rows [first, last) (deviations from the first row).
+template <class It>
+void fit_lines(It first, It last, Line& theta, Line& psi) {
+  LineSums a, b;
+  const Row& r0 = *first;
+  for (It it = first; it != last; ++it) {
+    a.add(it->t - r0.t, it->theta - r0.theta);
+    b.add(it->t - r0.t, it->psi - r0.psi);
+  }
+  const auto make = [&](const LineSums& s, double y0) {
+    Line l;
+    l.t0 = r0.t;
+    l.rate = s.stt() > 0 ? s.sty() / s.stt() : 0.0;
+    l.at = y0 + s.y / s.n - l.rate * s.t / s.n;
+    return l;
+  };
+  theta = make(a, r0.theta);
+  psi = make(b, r0.psi);
+  for (It it = first; it != last; ++it) {
+    theta.max_residual = std::max(theta.max_residual, std::abs(it->theta - theta(it->t)));
+    psi.max_residual = std::max(psi.max_residual, std::abs(it->psi - psi(it->t)));
+  }
+}
+
+/// The median of v (reorders v).
+double median_of(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// Steady runs that gave no dwell are kept, the longest first, up to this many (bounded memory).
+constexpr std::size_t kRejectedKept = 256;
+/// The window of rows searched for a steady state never holds more than this many rows.
+constexpr std::size_t kMaxWindowRows = std::size_t{1} << 16;
+
+/// A stretch being measured, and the phase (encoder line intercepts) it shares with others until a gap.
+struct StretchSums {
+  double first = 0.0, last = 0.0;
+  std::size_t count = 0;
+  std::size_t phase = 0;
+};
+
+/// The run in progress: consecutive rows at one steady state of the machine.
 struct Run {
-  bool is_static = false;
-  double planned_rate = 0.0;  // rad/s
-  double beta0_deg = 0.0;     // encoder at the run's start
-  double psi0_deg = 0.0;      // unwrapped counter encoder at the run's start (static holds)
-  double t_start = 0.0;
+  PlanMatch match;
+  bool decided = false;  // matched to the plan (at the end of the settle time)
+  bool matched = false;
+  double start_s = 0.0, end_s = 0.0;  // record time
   double planned_duration = 0.0;
-  std::optional<DwellAccumulator> acc;
+  // The reference state from the window that established the run.
+  double rate_theta = 0.0, rate_psi = 0.0;  // deg/s
+  double beta_deg = 0.0, gamma_deg = 0.0;
+  // The local lines the next rows are checked against (the last window's), on the run's clock.
+  Line theta_line, psi_line;
+  bool psi_line_valid = true;  // psi_line holds the phase (false after a gap until the next window closes)
+  // The current window of the rate check.
+  LineSums block_theta, block_psi;
+  double block_t0 = 0.0, block_theta0 = 0.0, block_psi0 = 0.0;
+  // The run's clock: record time minus the gaps (each counted as one planned interval) since the
+  // measurement began.
+  double clock_offset = 0.0;
+  double last_t_record = 0.0;                             // the last accepted row
+  double prev_row_t = 0.0;                                // the last row seen, accepted or not
+  double t_prev = 0.0, theta_prev = 0.0, psi_prev = 0.0;  // the last accepted row, run's clock, unwrapped
+  std::vector<Row> held;  // rows off the line, waiting to be judged glitches or the run's end
+  std::string held_reason;
+  bool dropped = false;  // rows were dropped since the last accepted one
   // The measured part.
+  std::optional<DwellAccumulator> acc;
   bool measuring = false;
-  double t_first = 0.0, theta_first_deg = 0.0, psi_first_deg = 0.0;
-  LineSums theta, psi;
+  double t_first = 0.0, theta_first = 0.0, psi_first = 0.0;
+  std::vector<LineSums> phase_theta, phase_psi, phase_rel;  // rel: psi_r + theta
+  // Successive differences of the main encoder's deviations inside stretches: the white part of its scatter
+  // (quantisation, jitter), to tell a wandering rate from it.
+  double diff_yy = 0, diff_yt = 0, diff_tt = 0, diff_n = 0, prev_y = 0, prev_tt = 0;
+  std::vector<StretchSums> stretches;
   double beta_sum = 0.0;
-  std::size_t n = 0;
-  double t_prev = 0.0;   // the previous measured sample
-  std::size_t gaps = 0;  // intervals between measured samples longer than 1.5 planned sample intervals
+  std::size_t n = 0, gaps = 0;
+  DwellQuality quality;
 };
 
 }  // namespace
+
+PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, double main_rate_rad_s,
+                        double counter_rate_rad_s, double beta_deg, double gamma_deg) {
+  PlanMatch m;
+  const double tol0 = options.static_rate_tolerance_rad_s;
+  m.is_static = std::abs(main_rate_rad_s) < tol0 && std::abs(counter_rate_rad_s) < tol0;
+  if (m.is_static) {
+    if (std::find(plan.rates_rad_s.begin(), plan.rates_rad_s.end(), 0.0) == plan.rates_rad_s.end())
+      m.why_not = "the machine stands still and the plan has no static hold";
+  } else if (std::abs(main_rate_rad_s) < tol0) {
+    m.why_not = fmt::format("the main axis stands still while the counter platform turns at {:.6g} rad/s",
+                            counter_rate_rad_s);
+  } else {
+    double best = -1.0, best_rel = std::numeric_limits<double>::infinity();
+    for (double r : plan.rates_rad_s) {
+      if (r == 0.0) continue;
+      const double rel = std::abs(main_rate_rad_s - r) / std::abs(r);
+      if (rel < best_rel) best_rel = rel, best = r;
+    }
+    if (best < 0.0 && best_rel == std::numeric_limits<double>::infinity()) {
+      m.why_not = "the main axis turns and the plan has no spinning rate";
+    } else if (best_rel > options.rate_tolerance) {
+      m.why_not = fmt::format(
+          "the main axis turns at {:.6g} rad/s, {:.2e} (relative) from the planned {} rad/s "
+          "(rate_tolerance {:.0e})",
+          main_rate_rad_s, best_rel, best, options.rate_tolerance);
+    } else if (std::abs(counter_rate_rad_s + main_rate_rad_s) >
+               options.rate_tolerance * std::abs(main_rate_rad_s)) {
+      m.why_not =
+          fmt::format("the counter platform turns at {:.6g} rad/s, not at minus the main rate {:.6g} rad/s",
+                      counter_rate_rad_s, main_rate_rad_s);
+    }
+    m.planned_rate_rad_s = best;
+  }
+  if (!m.why_not.empty()) return m;
+  const auto nearest = [](const std::vector<double>& planned_rad, double deg, double& best_deg) {
+    double best = std::numeric_limits<double>::infinity();
+    for (double p : planned_rad) {
+      const double d = std::abs(wrap_deg(deg - p * kRadToDeg));
+      if (d < best) best = d, best_deg = p;
+    }
+    return best;
+  };
+  double b = 0.0;
+  const double db = nearest(plan.beta_rad, beta_deg, b);
+  if (db > options.beta_tolerance_deg) {
+    m.why_not = fmt::format(
+        "beta reads {:.3f} deg, {:.3f} deg from the nearest planned beta {:.3f} deg "
+        "(beta_tolerance_deg {})",
+        beta_deg, db, b * kRadToDeg, options.beta_tolerance_deg);
+    return m;
+  }
+  m.beta_rad = b;
+  if (m.is_static) {
+    double g = 0.0;
+    const double dg = nearest(plan.gamma_rad, gamma_deg, g);
+    if (dg > options.beta_tolerance_deg) {
+      m.why_not = fmt::format(
+          "the static hold's gamma reads {:.3f} deg, {:.3f} deg from the nearest planned "
+          "gamma {:.3f} deg (beta_tolerance_deg {})",
+          gamma_deg, dg, g * kRadToDeg, options.beta_tolerance_deg);
+      return m;
+    }
+    m.gamma_rad = g;
+  }
+  return m;
+}
 
 struct Reducer::State {
   TestSpec plan;
   ReduceOptions options;
   std::string source;
-  double reference_rate;
-  std::size_t samples = 0;
-  double t_prev = 0.0, theta_raw_prev = 0.0, psi_raw_prev = 0.0;
-  double theta_u = 0.0, psi_u = 0.0;  // unwrapped, deg
+  double reference_rate = 0.0;
+  double dt_planned = 0.0;
+  std::size_t rows = 0;
+  double t_last = 0.0;
+  // Looking for a steady state: the last rows, unwrapped from one to the next (reset at a gap).
+  std::deque<Row> window;
+  double window_tested_at = -std::numeric_limits<double>::infinity();
+  double raw_theta_prev = 0.0, raw_psi_prev = 0.0;
   std::optional<Run> run;
   std::vector<Dwell> dwells;
+  std::vector<RejectedRun> rejected;
   std::vector<std::string> warnings;
-  int short_runs = 0;
+  double worst_rate_offset = 0.0;
+  int offset_dwells = 0;
 
   double hold_duration() const { return plan.revolutions * 2.0 * kPi / std::abs(reference_rate); }
-
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
+  bool is_gap(double dt) const { return dt > options.gap_intervals * dt_planned; }
 
-  /// The plan's rate matching a sample-to-sample rate, if the machine is steady at one.
-  std::optional<double> steady_rate(double theta_rate, double psi_rate) const {
-    const double tol0 = options.static_rate_tolerance_rad_s;
-    for (double r : plan.rates_rad_s) {
-      if (r == 0.0) {
-        if (std::abs(theta_rate) < tol0 && std::abs(psi_rate) < tol0) return 0.0;
+  // ---- Looking for a steady state -------------------------------------------------------------------
+  /// Takes a row (raw encoder readings) while no run is in progress.
+  void look(const Row& raw) {
+    Row r = raw;
+    if (!window.empty()) {
+      const Row& p = window.back();
+      if (is_gap(r.t - p.t)) {
+        window.clear();
       } else {
-        const double tol = options.rate_tolerance * std::abs(r);
-        if (std::abs(theta_rate - r) <= tol && std::abs(psi_rate + theta_rate) <= tol) return r;
+        r.theta = p.theta + wrap_deg(raw.theta - raw_theta_prev);
+        r.psi = p.psi + wrap_deg(raw.psi - raw_psi_prev);
       }
     }
-    return std::nullopt;
+    raw_theta_prev = raw.theta;
+    raw_psi_prev = raw.psi;
+    window.push_back(r);
+    while (window.size() > kMaxWindowRows || window.back().t - window.front().t > 2.0 * options.window_s)
+      window.pop_front();
+    if (window.back().t - window_tested_at < 0.25 * options.window_s) return;
+    // The last window_s of rows.
+    auto first = window.end();
+    while (first != window.begin() && window.back().t - std::prev(first)->t <= options.window_s) --first;
+    if (first == window.begin() || std::distance(first, window.end()) < 8) return;
+    window_tested_at = window.back().t;
+    Line th, ps;
+    fit_lines(first, window.end(), th, ps);
+    if (th.max_residual > options.angle_tolerance_deg || ps.max_residual > options.angle_tolerance_deg)
+      return;
+    std::vector<double> betas;
+    for (auto it = first; it != window.end(); ++it) betas.push_back(it->beta);
+    const double beta = median_of(betas);
+    for (double b : betas)
+      if (std::abs(wrap_deg(b - beta)) > options.beta_tolerance_deg) return;
+    // Steady: the run begins at the earliest row before the window that still lies on its lines as closely as
+    // the window's own rows do (twice their largest residual, and beta within their spread): the end of a
+    // ramp or a move is not taken in.
+    double beta_spread = 0.0;
+    for (double b : betas) beta_spread = std::max(beta_spread, std::abs(wrap_deg(b - beta)));
+    const double th_tol = std::max(2.0 * th.max_residual, 1e-9),
+                 ps_tol = std::max(2.0 * ps.max_residual, 1e-9);
+    while (first != window.begin()) {
+      const Row& q = *std::prev(first);
+      if (std::abs(q.theta - th(q.t)) > th_tol || std::abs(q.psi - ps(q.t)) > ps_tol ||
+          std::abs(wrap_deg(q.beta - beta)) > beta_spread + 1e-9)
+        break;
+      --first;
+    }
+    start_run(*first, th, ps, beta);
+    std::vector<Row> rows_of_run(first, window.end());
+    window.clear();
+    // follow() unwraps against the run's lines: the rows' readings as the record gave them.
+    for (Row& q : rows_of_run) q.theta = wrap_deg(q.theta), q.psi = wrap_deg(q.psi);
+    for (const Row& q : rows_of_run) take(q);
   }
 
-  void start_run(double rate, double t_start, double beta_deg) {
+  void take(const Row& raw) {
+    if (run)
+      follow(raw);
+    else
+      look(raw);
+  }
+
+  void start_run(const Row& first, const Line& th, const Line& ps, double beta) {
     Run r;
-    r.is_static = rate == 0.0;
-    r.planned_rate = rate;
-    r.beta0_deg = beta_deg;
-    r.psi0_deg = psi_u;
-    r.t_start = t_start;
-    r.planned_duration = r.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate);
-    r.acc.emplace(options, r.is_static ? std::vector<double>{0.0} : plan.gamma_rad, r.is_static, 1,
-                  r.planned_duration, true);
+    r.start_s = r.end_s = first.t;
+    r.last_t_record = r.prev_row_t = r.t_prev = first.t - dt_planned;
+    r.theta_prev = th(r.t_prev);
+    r.psi_prev = ps(r.t_prev);
+    r.rate_theta = th.rate;
+    r.rate_psi = ps.rate;
+    r.beta_deg = beta;
+    r.gamma_deg = wrap_deg(-ps(first.t));
+    r.theta_line = th;
+    r.psi_line = ps;
+    r.block_t0 = first.t;
     run = std::move(r);
   }
 
-  void measure(const RecordSample& s) {
-    Run& r = *run;
-    if (s.time_s < r.t_start + plan.settle_s) return;
-    // The plan says how long a dwell is: its measured part is [t_first, t_first + planned duration).
-    if (r.measuring && s.time_s >= r.t_first + r.planned_duration - 1e-9) return;
-    if (!r.measuring) {
-      r.measuring = true;
-      r.t_first = s.time_s;
-      r.theta_first_deg = theta_u;
-      r.psi_first_deg = psi_u;
-    }
-    const double tt = s.time_s - r.t_first;
-    const double planned_turn_deg = r.planned_rate * kRadToDeg * tt;
-    r.theta.add(tt, theta_u - r.theta_first_deg - planned_turn_deg);
-    r.psi.add(tt, psi_u - r.psi_first_deg + planned_turn_deg);
-    r.beta_sum += s.position_angle_deg;
-    if (r.n > 0 && (s.time_s - r.t_prev) * plan.sample_rate_hz > 1.5) ++r.gaps;
-    r.t_prev = s.time_s;
-    ++r.n;
-    const double gamma = -psi_u * kDegToRad;
-    r.acc->add(s.time_s, gamma, &s.gyro_deg_h);
+  /// Matches the run to the plan when its settle time is over, on the rates of its last window (the ramp
+  /// that led to it has ended by then).
+  void decide(Run& r) {
+    r.decided = true;
+    r.match = match_to_plan(plan, options, r.rate_theta * kDegToRad, r.rate_psi * kDegToRad, r.beta_deg,
+                            r.gamma_deg);
+    r.matched = r.match.why_not.empty();
+    if (!r.matched) return;
+    r.planned_duration = r.match.is_static
+                             ? hold_duration()
+                             : plan.revolutions * 2.0 * kPi / std::abs(r.match.planned_rate_rad_s);
+    r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad,
+                  r.match.is_static, 1, r.planned_duration, true);
   }
 
-  void end_run() {
+  // ---- Following a steady run -----------------------------------------------------------------------
+  /// Takes a row into the run; ends the run (and hands the rows it held back to look()) when the machine
+  /// has left its steady state.
+  void follow(const Row& raw) {
+    Run& r = *run;
+    // A gap: the interval from the previous row (accepted or not) is long. Inside the measured part the
+    // dwell's clock counts it as one planned interval.
+    const bool gap = is_gap(raw.t - r.prev_row_t);
+    r.prev_row_t = raw.t;
+    const double dt = raw.t - r.last_t_record;
+    double offset = r.clock_offset;
+    if (gap && r.measuring) offset += dt - dt_planned;
+    const double t = raw.t - offset;
+    // Each reading is predicted from the last accepted one at the rate of the last window; after a gap the
+    // encoders' phase is unknown (a clock jump looks like a gap), so only beta is judged there and the angles
+    // continue to within half a turn of the prediction over one planned interval.
+    const double step = gap ? dt_planned : t - r.t_prev;
+    const double th_pred = r.theta_prev + r.theta_line.rate * step,
+                 ps_pred = r.psi_prev + r.psi_line.rate * step;
+    Row u = raw;
+    u.t = t;
+    u.theta = th_pred + wrap_deg(raw.theta - th_pred);
+    u.psi = ps_pred + wrap_deg(raw.psi - ps_pred);
+    const double db = wrap_deg(raw.beta - r.beta_deg);
+    std::string off;
+    if (std::abs(db) > options.beta_tolerance_deg)
+      off = fmt::format("beta moves by {:.3g} deg at t = {:.3f} s", db, raw.t);
+    else if (!gap && std::abs(u.theta - th_pred) > options.angle_tolerance_deg)
+      off = fmt::format("the main axis leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)",
+                        raw.t, u.theta - th_pred);
+    else if (!gap && std::abs(u.psi - ps_pred) > options.angle_tolerance_deg)
+      off = fmt::format(
+          "the counter platform leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)", raw.t,
+          u.psi - ps_pred);
+    if (!off.empty()) {
+      if (r.held.empty()) r.held_reason = off;
+      r.held.push_back(raw);
+      if (r.held.size() > static_cast<std::size_t>(options.encoder_glitch_rows)) end_run(r.held_reason);
+      return;
+    }
+    if (gap) {
+      r.block_theta = r.block_psi = LineSums{};
+      r.psi_line_valid = false;
+    }
+    r.theta_prev = u.theta;
+    r.psi_prev = u.psi;
+    r.t_prev = t;
+    if (!r.held.empty()) {
+      // Dropped: as encoder glitches inside the measured part; in the settle time they are settle rows.
+      (r.measuring ? r.quality.encoder_glitch_rows : r.quality.settle_rows) += r.held.size();
+      r.held.clear();
+      r.dropped = true;
+    }
+    r.clock_offset = offset;
+    r.last_t_record = raw.t;
+    r.end_s = raw.t;
+    ++r.quality.rows;
+    if (!r.decided && raw.t < r.start_s + plan.settle_s) {
+      ++r.quality.settle_rows;
+    } else {
+      if (!r.decided) decide(r);
+      if (r.matched) measure(u, gap, raw.t);
+      if (!run) return;
+    }
+    // The rate, window by window, against the run's.
+    if (r.block_theta.n == 0) {
+      r.block_t0 = t;
+      r.block_theta0 = u.theta;
+      r.block_psi0 = u.psi;
+    }
+    r.block_theta.add(t - r.block_t0, u.theta - r.block_theta0);
+    r.block_psi.add(t - r.block_t0, u.psi - r.block_psi0);
+    if (t - r.block_t0 >= options.window_s && r.block_theta.n >= 8) {
+      const double rt = r.block_theta.sty() / r.block_theta.stt(), rp = r.block_psi.sty() / r.block_psi.stt();
+      const double scale = std::max(std::abs(r.rate_theta), options.static_rate_tolerance_rad_s * kRadToDeg);
+      const double change = std::max(std::abs(rt - r.rate_theta), std::abs(rp - r.rate_psi)) / scale;
+      if (!r.decided) {
+        r.rate_theta = rt;
+        r.rate_psi = rp;
+      } else if (change > options.rate_steadiness) {
+        end_run(fmt::format(
+            "the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window ending at "
+            "t = {:.3f} s",
+            change, options.rate_steadiness, raw.t));
+        return;
+      }
+      const auto line = [&](const LineSums& s, double rate, double y0) {
+        Line l;
+        l.t0 = r.block_t0;
+        l.rate = rate;
+        l.at = y0 + s.y / s.n - rate * s.t / s.n;
+        return l;
+      };
+      r.theta_line = line(r.block_theta, rt, r.block_theta0);
+      r.psi_line = line(r.block_psi, rp, r.block_psi0);
+      r.psi_line_valid = true;
+      if (!r.decided) r.gamma_deg = wrap_deg(-r.psi_line(t));
+      r.block_theta = r.block_psi = LineSums{};
+    }
+  }
+
+  void measure(const Row& u, bool gap, double t_record) {
+    (void)t_record;
+    Run& r = *run;
+    // The plan says how long a dwell is: its measured part is [t_first, t_first + planned duration) on the
+    // dwell's clock.
+    if (r.measuring && u.t >= r.t_first + r.planned_duration - 1e-9) {
+      ++r.quality.beyond_planned_rows;
+      return;
+    }
+    if (!r.measuring) {
+      r.measuring = true;
+      r.t_first = u.t;
+      r.theta_first = u.theta;
+      r.psi_first = u.psi;
+      r.phase_theta.emplace_back();
+      r.phase_psi.emplace_back();
+      r.phase_rel.emplace_back();
+      r.stretches.push_back({u.t, u.t, 0, 0});
+    } else if (gap || r.dropped) {
+      if (r.stretches.size() >= static_cast<std::size_t>(options.max_stretches_per_dwell)) {
+        end_run(fmt::format(
+            "gaps and dropped rows break it into more than {} stretches (max_stretches_per_dwell) "
+            "by t = {:.3f} s",
+            options.max_stretches_per_dwell, t_record));
+        return;
+      }
+      if (gap) {
+        ++r.gaps;
+        r.acc->break_revolution();
+        r.phase_theta.emplace_back();
+        r.phase_psi.emplace_back();
+        r.phase_rel.emplace_back();
+      }
+      r.stretches.push_back({u.t, u.t, 0, r.phase_theta.size() - 1});
+    }
+    r.dropped = false;
+    StretchSums& st = r.stretches.back();
+    if (st.count == 0) st.first = u.t;
+    st.last = u.t;
+    ++st.count;
+    const double tt = u.t - r.t_first;
+    const double planned_turn = r.match.planned_rate_rad_s * kRadToDeg * tt;
+    const double y_theta = u.theta - r.theta_first - planned_turn;
+    if (st.count > 1) {
+      const double dy = y_theta - r.prev_y, dtt = tt - r.prev_tt;
+      r.diff_yy += dy * dy;
+      r.diff_yt += dy * dtt;
+      r.diff_tt += dtt * dtt;
+      r.diff_n += 1;
+    }
+    r.prev_y = y_theta;
+    r.prev_tt = tt;
+    r.phase_theta.back().add(tt, y_theta);
+    r.phase_psi.back().add(tt, u.psi - r.psi_first + planned_turn);
+    r.phase_rel.back().add(tt, u.psi - r.psi_first + u.theta - r.theta_first);
+    r.beta_sum += u.beta;
+    ++r.n;
+    // The arm angle of the fit's basis from the line of the last window (smooth: a reading quantised to 0.1
+    // deg would put its rounding into every basis function), continued from the reading to within half a
+    // turn; after a gap, until a window has closed, the reading itself.
+    const double psi = r.psi_line_valid ? u.psi + wrap_deg(r.psi_line(u.t) - u.psi) : u.psi;
+    r.acc->add(u.t, -psi * kDegToRad, &u.y);
+  }
+
+  void reject(const Run& r, std::string reason) {
+    RejectedRun x;
+    x.start_s = r.start_s;
+    x.end_s = r.end_s;
+    x.main_rate_rad_s = r.rate_theta * kDegToRad;
+    x.beta_deg = r.beta_deg;
+    x.gamma_deg = r.gamma_deg;
+    x.is_static = std::abs(r.rate_theta) * kDegToRad < options.static_rate_tolerance_rad_s &&
+                  std::abs(r.rate_psi) * kDegToRad < options.static_rate_tolerance_rad_s;
+    x.reason = std::move(reason);
+    rejected.push_back(std::move(x));
+    if (rejected.size() > kRejectedKept) {
+      const auto shortest = std::min_element(
+          rejected.begin(), rejected.end(),
+          [](const auto& a, const auto& b) { return a.end_s - a.start_s < b.end_s - b.start_s; });
+      rejected.erase(shortest);
+    }
+  }
+
+  /// Ends the run in progress: a dwell if it matched the plan and is long enough, otherwise a rejected run
+  /// with its reason. The rows it held go back to look().
+  void end_run(std::string reason) {
     if (!run) return;
     Run r = std::move(*run);
     run.reset();
+    r.quality.ended = std::move(reason);
+    r.quality.run_start_s = r.start_s;
+    r.quality.run_end_s = r.end_s;
+    finish_run(r);
+    window.clear();
+    window_tested_at = -std::numeric_limits<double>::infinity();
+    for (const Row& q : r.held) take(q);
+  }
+
+  void finish_run(Run& r) {
+    if (!r.decided) {
+      reject(r, fmt::format("it lasted {:.3f} s, less than its settle time of {} s: {}", r.end_s - r.start_s,
+                            plan.settle_s, r.quality.ended));
+      return;
+    }
+    if (!r.matched) {
+      reject(r, fmt::format("{} (the run ended: {})", r.match.why_not, r.quality.ended));
+      return;
+    }
     const bool long_enough =
-        r.n >= 2 && (r.is_static ? r.n >= static_cast<std::size_t>(2 * options.static_batches)
-                                 : r.acc->complete_revolutions() >= 1);
+        r.n >= 2 && (r.match.is_static ? r.n >= static_cast<std::size_t>(2 * options.static_batches)
+                                       : r.acc->complete_revolutions() >= 1);
     if (!long_enough) {
-      if (r.n > 0) ++short_runs;
+      reject(r, fmt::format("it measured only {:.3f} s of the {:.3f} s planned: {}",
+                            r.measuring ? r.acc->last_time_s() - r.t_first : 0.0, r.planned_duration,
+                            r.quality.ended));
       return;
     }
     Dwell d;
-    d.is_static = r.is_static;
-    d.planned_rate_rad_s = r.planned_rate;
+    d.is_static = r.match.is_static;
+    d.planned_rate_rad_s = r.match.planned_rate_rad_s;
     d.measured_beta_rad = r.beta_sum / static_cast<double>(r.n) * kDegToRad;
-    d.beta_rad = d.measured_beta_rad;
+    // The channels take the plan's beta (and a static hold's gamma): an encoder's mean reading at rest is
+    // biased by up to half a count (docs/calibration.md).
+    d.beta_rad = r.match.beta_rad;
+    d.gammas_rad = d.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad;
     d.first_time_s = r.acc->first_time_s();
     d.last_time_s = r.acc->last_time_s();
     d.samples = r.n;
     d.gaps = r.gaps;
-    d.sample_interval_s = (d.last_time_s - d.first_time_s) / static_cast<double>(r.n - 1);
     d.planned_duration_s = r.planned_duration;
-    double a, b, rms;
-    r.theta.fit(a, b, rms);
-    d.main = {(r.theta_first_deg + a) * kDegToRad, r.planned_rate + b * kDegToRad, rms * kDegToRad};
-    r.psi.fit(a, b, rms);
-    d.counter = {(r.psi_first_deg + a) * kDegToRad, -r.planned_rate + b * kDegToRad, rms * kDegToRad};
-
-    // Match to the plan.
+    d.quality = r.quality;
+    // The encoders' lines: one rate over the dwell, an intercept per phase (a gap starts one).
+    double sty_t = 0, stt_t = 0, sty_p = 0, stt_p = 0, res_t = 0, res_p = 0;
+    for (std::size_t k = 0; k < r.phase_theta.size(); ++k) {
+      sty_t += r.phase_theta[k].sty();
+      stt_t += r.phase_theta[k].stt();
+      sty_p += r.phase_psi[k].sty();
+      stt_p += r.phase_psi[k].stt();
+    }
+    // The counter platform's rate relative to the arm's (psi_r + theta, a heading drift about Up) enters
+    // omega_I whole. Fitted over a few seconds of encoders quantised to 0.1 deg it carries ~1e-5 rad/s
+    // (2 deg/h) of quantisation error, so it is used only where it is resolved: beyond 3 of its standard
+    // errors (a noise-free record always); otherwise the platform turns at exactly minus the main rate
+    // (docs/calibration.md).
+    (void)sty_p;
+    (void)stt_p;
+    double sty_r = 0, stt_r = 0, syy_r = 0, n_r = 0;
+    for (const LineSums& x : r.phase_rel) sty_r += x.sty(), stt_r += x.stt(), syy_r += x.syy(), n_r += x.n;
+    const double br = stt_r > 0 ? sty_r / stt_r : 0.0;
+    const double dof_r = n_r - 1.0 - static_cast<double>(r.phase_rel.size());
+    const double se_r =
+        dof_r > 0 && stt_r > 0 ? std::sqrt(std::max(syy_r - br * sty_r, 0.0) / dof_r / stt_r) : 0.0;
+    const double bt = stt_t > 0 ? sty_t / stt_t : 0.0, bp = -bt + (std::abs(br) > 3.0 * se_r ? br : 0.0);
+    for (std::size_t k = 0; k < r.phase_theta.size(); ++k) {
+      res_t += std::max(r.phase_theta[k].syy() - bt * r.phase_theta[k].sty(), 0.0);
+      res_p += std::max(r.phase_psi[k].syy() - bp * r.phase_psi[k].sty(), 0.0);
+    }
+    const double planned_deg_s = r.match.planned_rate_rad_s * kRadToDeg;
+    const auto intercept = [&](const LineSums& s, double b) { return (s.y - b * s.t) / s.n; };
+    const double nd = static_cast<double>(r.n);
+    d.main = {(r.theta_first + intercept(r.phase_theta[0], bt)) * kDegToRad, (planned_deg_s + bt) * kDegToRad,
+              std::sqrt(res_t / nd) * kDegToRad};
+    d.counter = {(r.psi_first + intercept(r.phase_psi[0], bp)) * kDegToRad, (-planned_deg_s + bp) * kDegToRad,
+                 std::sqrt(res_p / nd) * kDegToRad};
+    double span = 0.0;
+    std::size_t steps = 0;
+    for (const StretchSums& st : r.stretches) {
+      TimeStretch ts;
+      ts.first_time_s = st.first;
+      ts.count = st.count;
+      ts.interval_s = st.count > 1 ? (st.last - st.first) / static_cast<double>(st.count - 1) : dt_planned;
+      const double tt = st.first - r.t_first;
+      ts.main_at_first_rad =
+          (r.theta_first + intercept(r.phase_theta[st.phase], bt) + (planned_deg_s + bt) * tt) * kDegToRad;
+      ts.counter_at_first_rad =
+          (r.psi_first + intercept(r.phase_psi[st.phase], bp) + (-planned_deg_s + bp) * tt) * kDegToRad;
+      d.stretches.push_back(ts);
+      span += st.last - st.first;
+      steps += st.count - 1;
+    }
+    d.sample_interval_s = steps > 0 ? span / static_cast<double>(steps) : dt_planned;
     const double beta_deg = d.beta_rad * kRadToDeg;
-    std::optional<double> beta_plan;
-    for (double b_plan : plan.beta_rad)
-      if (std::abs(wrap_deg(beta_deg - b_plan * kRadToDeg)) <= options.beta_tolerance_deg) beta_plan = b_plan;
     const std::string what =
-        d.is_static
-            ? fmt::format("static hold at beta {:.4f} deg, gamma {:.4f} deg", beta_deg, wrap_deg(-r.psi0_deg))
-            : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
-    if (!beta_plan) {
-      warnings.push_back(fmt::format("{}: {} matches no planned beta; ignored.", at(d.first_time_s), what));
-      return;
-    }
-    d.beta_rad = *beta_plan;
-    if (d.is_static) {
-      std::optional<double> gamma_plan;
-      for (double g : plan.gamma_rad)
-        if (std::abs(wrap_deg(-r.psi0_deg - g * kRadToDeg)) <= options.beta_tolerance_deg) gamma_plan = g;
-      if (!gamma_plan) {
-        warnings.push_back(
-            fmt::format("{}: {} matches no planned gamma; ignored.", at(d.first_time_s), what));
-        return;
-      }
-      d.gammas_rad = {*gamma_plan};
-    } else {
-      d.gammas_rad = plan.gamma_rad;
-    }
+        d.is_static ? fmt::format("static hold at beta {:.4f} deg, gamma {:.4f} deg", beta_deg,
+                                  d.gammas_rad[0] * kRadToDeg)
+                    : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
     d.gyro = r.acc->finish(0);
     // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
     // at which clean noise reaches the rule's threshold).
@@ -196,89 +613,99 @@ struct Reducer::State {
     // Checks a test engineer wants to hear about.
     const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
     if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
-      warnings.push_back(fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions).",
+      warnings.push_back(fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions): {}.",
                                      at(d.first_time_s), what, measured, d.planned_duration_s,
-                                     plan.revolutions));
+                                     plan.revolutions, r.quality.ended));
     }
-    if (d.main.rms_residual_rad > 0.01 * kDegToRad || d.counter.rms_residual_rad > 0.01 * kDegToRad) {
-      warnings.push_back(fmt::format(
-          "{}: the rate wanders during the {}: encoder angles leave a constant-rate line by {:.4f} deg RMS.",
-          at(d.first_time_s), what,
-          std::max(d.main.rms_residual_rad, d.counter.rms_residual_rad) * kRadToDeg));
-    }
-    if (!d.is_static && std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) >
-                            options.rate_tolerance * 0.1 * std::abs(d.planned_rate_rad_s)) {
+    // A rate that wanders: the main encoder's scatter about its line beyond its white part (half the mean
+    // square of successive differences: quantisation and stamp jitter), which the channels' constant-rate
+    // line does not follow.
+    const double white2 =
+        r.diff_n > 0 ? 0.5 * (r.diff_yy - 2.0 * bt * r.diff_yt + bt * bt * r.diff_tt) / r.diff_n : 0.0;
+    const double wander_deg = std::sqrt(std::max(res_t / nd - white2, 0.0));
+    if (wander_deg > options.wander_warning_deg) {
       warnings.push_back(
-          fmt::format("{}: {}: the main axis turned at {:.9f} rad/s, not the planned {} rad/s.",
-                      at(d.first_time_s), what, d.main.rate_rad_s, d.planned_rate_rad_s));
+          fmt::format("{}: the rate wanders during the {}: the main encoder leaves a constant-rate line by "
+                      "{:.4f} deg RMS "
+                      "beyond its sample-to-sample scatter.",
+                      at(d.first_time_s), what, wander_deg));
+    }
+    if (!d.is_static) {
+      const double rel = std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) / std::abs(d.planned_rate_rad_s);
+      if (rel > 1e-4) {
+        ++offset_dwells;
+        worst_rate_offset = std::max(worst_rate_offset, rel);
+      }
     }
     dwells.push_back(std::move(d));
   }
+
+  /// The most telling rejected run for a planned position that has no dwell.
+  std::string why_missing(const Position& p) const {
+    const RejectedRun* best = nullptr;
+    int best_rank = 0;
+    for (const RejectedRun& x : rejected) {
+      const bool is_static = p.rate_rad_s == 0.0;
+      if (x.is_static != is_static) continue;
+      const double db = std::abs(wrap_deg(x.beta_deg - p.beta_rad * kRadToDeg));
+      const double dr = is_static ? 0.0 : std::abs(x.main_rate_rad_s - p.rate_rad_s) / std::abs(p.rate_rad_s);
+      const double dg = is_static ? std::abs(wrap_deg(x.gamma_deg - p.gamma_rad * kRadToDeg)) : 0.0;
+      if (db > 5.0 || dr > 0.05 || dg > 5.0) continue;
+      const int rank = (db <= options.beta_tolerance_deg ? 2 : 0) + (dr <= options.rate_tolerance ? 1 : 0);
+      if (!best || rank > best_rank ||
+          (rank == best_rank && x.end_s - x.start_s > best->end_s - best->start_s)) {
+        best = &x;
+        best_rank = rank;
+      }
+    }
+    if (!best) return "no steady run of the record comes near it";
+    return fmt::format("the steady run at t = {:.3f} s to {:.3f} s gave no dwell: {}", best->start_s,
+                       best->end_s, best->reason);
+  }
 };
 
-Reducer::Reducer(const TestSpec& plan, const ReduceOptions& options, std::string source_name,
-                 double reference_rate_rad_s)
+Reducer::Reducer(const PlannedTest& plan, const ReduceOptions& options, std::string source_name)
     : state_(std::make_unique<State>()) {
   std::string error;
   if (!options.IsValid(&error)) throw Error("reduction options: " + error + ".");
-  state_->plan = plan;
+  state_->plan = plan.spec;
   state_->options = options;
   state_->source = std::move(source_name);
-  state_->reference_rate = reference_rate_rad_s;
-  for (double r : plan.rates_rad_s)
+  state_->reference_rate = plan.reference_rate_rad_s;
+  state_->dt_planned = 1.0 / plan.spec.sample_rate_hz;
+  for (double r : plan.spec.rates_rad_s)
     if (r != 0.0) {
       state_->reference_rate = r;
       break;
     }
   if (state_->reference_rate == 0.0)
     throw Error("the plan has no non-zero rate and no reference rate to size the static holds.");
-  check_test_feasible(plan, options, state_->reference_rate);
+  check_test_feasible(plan.spec, options, state_->reference_rate);
 }
 
 Reducer::~Reducer() = default;
 
 void Reducer::push(const RecordSample& s) {
   State& st = *state_;
-  if (st.samples == 0) {
-    st.theta_raw_prev = s.main_angle_deg;
-    st.psi_raw_prev = s.counter_angle_deg;
-    st.theta_u = s.main_angle_deg;
-    st.psi_u = s.counter_angle_deg;
-    st.t_prev = s.time_s;
-    ++st.samples;
-    return;
-  }
-  const double dt = s.time_s - st.t_prev;
-  const double dtheta = wrap_deg(s.main_angle_deg - st.theta_raw_prev);
-  const double dpsi = wrap_deg(s.counter_angle_deg - st.psi_raw_prev);
-  if (!(dt > 0.0)) throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
-  st.theta_u += dtheta;
-  st.psi_u += dpsi;
-  st.theta_raw_prev = s.main_angle_deg;
-  st.psi_raw_prev = s.counter_angle_deg;
-  const double theta_rate = dtheta / dt * kDegToRad, psi_rate = dpsi / dt * kDegToRad;
-  const std::optional<double> rate = st.steady_rate(theta_rate, psi_rate);
-
-  if (st.run) {
-    const Run& r = *st.run;
-    const bool same =
-        rate && *rate == r.planned_rate &&
-        std::abs(wrap_deg(s.position_angle_deg - r.beta0_deg)) <= st.options.beta_tolerance_deg &&
-        (!r.is_static || std::abs(st.psi_u - r.psi0_deg) <= st.options.beta_tolerance_deg);
-    if (!same) st.end_run();
-  }
-  if (!st.run && rate) st.start_run(*rate, st.t_prev, s.position_angle_deg);
-  if (st.run) st.measure(s);
-  st.t_prev = s.time_s;
-  ++st.samples;
+  if (st.rows > 0 && !(s.time_s > st.t_last))
+    throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
+  ++st.rows;
+  st.t_last = s.time_s;
+  st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.gyro_deg_h});
 }
 
 Reduction Reducer::finish() {
   State& st = *state_;
-  st.end_run();
+  while (st.run) st.end_run("the record ends");
   Reduction out;
-  out.samples_read = st.samples;
+  out.samples_read = st.rows;
   out.warnings = st.warnings;
+  if (st.offset_dwells > 0)
+    out.warnings.push_back(
+        fmt::format("{}: in {} dwell{} the main axis turned up to {:.2e} (relative) off the planned rate; "
+                    "the measured rates "
+                    "are used.",
+                    st.source, st.offset_dwells, st.offset_dwells > 1 ? "s" : "", st.worst_rate_offset));
   // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several.
   std::map<std::tuple<double, double, double>, int> chosen;
   for (std::size_t i = 0; i < st.dwells.size(); ++i) {
@@ -305,14 +732,19 @@ Reduction Reducer::finish() {
     out.samples_used += out.dwells.back().samples;
     out.outliers += out.dwells.back().gyro.outliers;
     out.gaps += out.dwells.back().gaps;
+    out.encoder_glitch_rows += out.dwells.back().quality.encoder_glitch_rows;
   }
+  out.rejected = st.rejected;
+  std::sort(out.rejected.begin(), out.rejected.end(),
+            [](const RejectedRun& a, const RejectedRun& b) { return a.start_s < b.start_s; });
   std::vector<std::string> missing;
   for (const Position& p : test_positions(st.plan)) {
     const auto key = std::make_tuple(p.rate_rad_s, p.beta_rad, p.rate_rad_s == 0.0 ? p.gamma_rad : 0.0);
     const auto it = chosen.find(key);
     if (it == chosen.end()) {
-      missing.push_back(fmt::format("{} (rate {} rad/s, beta {} deg, gamma {} deg)", p.index, p.rate_rad_s,
-                                    p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg));
+      missing.push_back(fmt::format("position {} (rate {} rad/s, beta {} deg, gamma {} deg): {}", p.index,
+                                    p.rate_rad_s, p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg,
+                                    st.why_missing(p)));
       continue;
     }
     const int di = renumber[it->second];
@@ -325,11 +757,6 @@ Reduction Reducer::finish() {
     throw Error(fmt::format("{}: the record has no usable dwell for {} planned position{}: {}.", st.source,
                             missing.size(), missing.size() > 1 ? "s" : "", list));
   }
-  if (st.short_runs > 0)
-    out.warnings.push_back(
-        fmt::format("{}: {} steady segment{} shorter than one revolution (or hold) were "
-                    "skipped as transitions.",
-                    st.source, st.short_runs, st.short_runs > 1 ? "s" : ""));
   // A standard error is the scatter between revolutions (or batches) about a line: without a degree of
   // freedom left there is no measurement of the noise, and no number may stand in for one
   // (docs/calibration.md, "Degrees of freedom").
@@ -379,7 +806,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
 
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s) {
-  Reducer reducer(plan, options, reader.name(), reference_rate_rad_s);
+  Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
   RecordSample s;
   while (reader.next(s)) reducer.push(s);
   return reducer.finish();

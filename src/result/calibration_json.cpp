@@ -66,7 +66,34 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
     j["data_quality"] = {{"rows_read", r.data_quality.rows_read},
                          {"rows_used", r.data_quality.rows_used},
                          {"outliers", r.data_quality.outliers},
-                         {"gaps", r.data_quality.gaps}};
+                         {"gaps", r.data_quality.gaps},
+                         {"encoder_glitch_rows", r.data_quality.encoder_glitch_rows}};
+  if (r.data_quality.rows_read > 0) {
+    nlohmann::json dwells = nlohmann::json::array(), rejected = nlohmann::json::array();
+    for (const DataQuality::Dwell& d : r.data_quality.dwells) {
+      nlohmann::json j_d = {{"static", d.is_static},
+                            {"rate_rad_s", d.rate_rad_s},
+                            {"measured_rate_rad_s", d.measured_rate_rad_s},
+                            {"beta_deg", d.beta_deg},
+                            {"start_s", d.start_s},
+                            {"end_s", d.end_s},
+                            {"rows", d.rows},
+                            {"rows_used", d.rows_used},
+                            {"dropped",
+                             {{"settle", d.settle_rows},
+                              {"beyond_planned", d.beyond_planned_rows},
+                              {"encoder_glitches", d.encoder_glitch_rows},
+                              {"outliers", d.outliers}}},
+                            {"gaps", d.gaps},
+                            {"ended", d.ended}};
+      if (d.is_static) j_d["gamma_deg"] = d.gamma_deg;
+      dwells.push_back(std::move(j_d));
+    }
+    for (const DataQuality::Rejected& x : r.data_quality.rejected)
+      rejected.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"reason", x.reason}});
+    j["data_quality"]["dwells"] = std::move(dwells);
+    j["data_quality"]["rejected"] = std::move(rejected);
+  }
   j["unidentifiable"] = r.unidentifiable;
   // The self-calibration's estimated machine errors (docs/contract.md, machine_errors).
   if (!r.machine_errors.empty()) {

@@ -100,6 +100,26 @@ struct DataQuality {
   std::size_t rows_used = 0;  ///< rows inside the measured parts of the dwells that entered the estimate
   std::size_t outliers = 0;   ///< of those, rejected as outliers (replaced by the dwell's fit)
   std::size_t gaps = 0;       ///< breaks in the time series inside those dwells
+  std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside those dwells: their encoders left the line
+  /// Per dwell used, in time order: what its steady run held, what was dropped and why.
+  struct Dwell {
+    bool is_static = false;
+    double rate_rad_s = 0.0;  ///< planned
+    double measured_rate_rad_s = 0.0;
+    double beta_deg = 0.0;
+    double gamma_deg = 0.0;             ///< static holds
+    double start_s = 0.0, end_s = 0.0;  ///< the steady run, record time
+    std::size_t rows = 0, rows_used = 0, settle_rows = 0, beyond_planned_rows = 0, encoder_glitch_rows = 0,
+                outliers = 0, gaps = 0;
+    std::string ended;  ///< why its steady run ended
+  };
+  std::vector<Dwell> dwells;
+  /// Steady runs that gave no dwell: start, end (record time) and reason.
+  struct Rejected {
+    double start_s = 0.0, end_s = 0.0;
+    std::string reason;
+  };
+  std::vector<Rejected> rejected;
 };
 
 struct CalibrationResult {

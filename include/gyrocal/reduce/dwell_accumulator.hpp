@@ -20,17 +20,51 @@ struct ReduceOptions {
     kWindowMean,   ///< mean of the samples within +-window/2 of each gamma
   };
   Method method = Method::kHarmonicFit;
-  int harmonic_order = 3;            ///< harmonic fit: orders 0..harmonic_order in gamma
-  bool linear_drift = true;          ///< harmonic fit and window mean: a linear drift in time
-  double window_deg = 10.0;          ///< window mean: full width of the window around each gamma, deg
-  double beta_tolerance_deg = 1e-3;  ///< a dwell's beta stays within this of its first value, deg
-  double rate_tolerance = 1e-3;  ///< relative to the planned rate: a spinning dwell's sample-to-sample rate
+  int harmonic_order = 3;    ///< harmonic fit: orders 0..harmonic_order in gamma
+  bool linear_drift = true;  ///< harmonic fit and window mean: a linear drift in time
+  double window_deg = 10.0;  ///< window mean: full width of the window around each gamma, deg
+
+  // Finding dwells in a record as a rig writes it (docs/physics.md section 14; docs/calibration.md, "Cutting
+  // a record into dwells"). Steadiness is judged on straight lines fitted to windows of encoder readings,
+  // never from one sample to the next, so jitter, quantisation and a toggling count do not break a dwell.
+  /// Length of the windows on which a steady state is recognised and its rate re-checked, s. Physics section
+  /// 14 asks for >= 0.25 s; 0.5 s measures a 10 rad/s rate to ~4e-5 through 0.1 deg quantisation at 200 Hz.
+  double window_s = 0.5;
+  /// A reading further than this from the line of the dwell's last window leaves the steady state, deg:
+  /// ten times what 0.1 deg quantisation (+-0.05), 0.1 ms stamp jitter at 10 rad/s (+-0.06) and 2e-4 rate
+  /// ripple (0.01) can explain together; a ramp away from 10 rad/s at 2 rad/s^2 crosses it within 0.1 s.
+  double angle_tolerance_deg = 0.5;
+  /// Beta (and a static hold's gamma) matches the plan within this, and stays within it of the dwell's
+  /// value, deg: four 0.1 deg encoder quanta and a toggling count, far below any two planned positions'
+  /// separation.
+  double beta_tolerance_deg = 0.2;
+  /// A steady rate matches a planned rate within this (relative), and the counter platform turns at minus
+  /// the main rate within it: a drive may differ from its nominal rate by up to 1e-3 (the measured rate is
+  /// used), twice that for margin.
+  double rate_tolerance = 2e-3;
+  /// Each window's rate stays within this (relative) of the dwell's rate: ripple up to 2e-4, five times.
+  double rate_steadiness = 1e-3;
   double static_rate_tolerance_rad_s = 0.01;  ///< below this the main axis (or platform) counts as stopped
-  int static_batches = 16;                    ///< a static hold's standard error from this many batch means
+  /// A dwell's main encoder leaving its constant-rate line by more than this RMS, beyond its sample-to-sample
+  /// scatter (quantisation, jitter), is warned about ("the rate wanders"), deg: the channels follow the line.
+  double wander_warning_deg = 0.01;
+  /// An interval between two rows longer than this many planned sample intervals is a gap (a dwell with
+  /// gaps is still one dwell; inside a dwell each gap counts as one sample interval, since a clock jump
+  /// looks the same).
+  double gap_intervals = 1.5;
+  /// At most this many consecutive rows whose encoders leave the dwell's line (or beta its value) and come
+  /// back are dropped as encoder glitches; more end the dwell.
+  int encoder_glitch_rows = 3;
+  /// A dwell broken into more stretches than this (by gaps and glitches) is refused: the channels keep one
+  /// entry per stretch, so this bounds their memory.
+  int max_stretches_per_dwell = 4096;
+  int static_batches = 16;  ///< a static hold's standard error from this many batch means
   /// The model's channels (identify/channels.hpp) are smooth in gamma (harmonics up to ~6), so they are
   /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
-  /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0: every sample.
-  int model_samples_per_revolution = 32;
+  /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0 (default):
+  /// every sample, the only choice that is exact on any configuration (docs/calibration.md: a stride of 32
+  /// per revolution left 4.3e-6 deg/h/g^2 on dOS with large machine errors).
+  int model_samples_per_revolution = 0;
   /// Spikes (docs/physics.md section 14): a sample of the gyro output whose residual about the dwell's fit
   /// lies more than this many robust standard deviations (1.4826 x the median absolute deviation of the
   /// residuals of its block) from the block's median residual is an outlier; iterated until the set of
@@ -103,12 +137,16 @@ class DwellAccumulator {
   int complete_revolutions() const;
   /// Samples rejected as outliers so far (all of them once finish() was called).
   std::size_t outliers() const { return outliers_; }
+  /// The time series breaks here (a gap): the revolution in progress is incomplete, so it does not count in
+  /// the scatter between revolutions (its samples still enter the dwell's fit).
+  void break_revolution();
 
  private:
   struct Pending {
     double t, gamma, value;
+    bool after_break;
   };
-  void accumulate(double time_s, double gamma_rad, const double* values);
+  void accumulate(double time_s, double gamma_rad, const double* values, bool after_break);
   void test_block();
   void flush();
   bool last_revolution_complete() const;
@@ -128,7 +166,9 @@ class DwellAccumulator {
   std::size_t samples_ = 0;
   double t_first_ = 0.0, t_last_ = 0.0;
   double gamma_first_ = 0.0, gamma_last_ = 0.0;
-  int revolution_ = 0;  // of the samples accumulated
+  int revolution_ = 0;              // of the samples accumulated
+  bool break_next_ = false;         // break_revolution() was called: the next sample follows a gap
+  bool revolution_broken_ = false;  // the revolution in progress holds a gap: it does not count
   bool finished_ = false;
 
   // Outlier rejection (docs/physics.md section 14): the block waiting to be tested, and the normal equations

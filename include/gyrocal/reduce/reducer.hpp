@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gyrocal/plan/positions.hpp"
@@ -22,6 +23,28 @@ struct AngleLine {
   double at(double t, double t_first) const { return at_first_rad + rate_rad_s * (t - t_first); }
 };
 
+/// A stretch of a dwell's measured part sampled without a break: `count` samples evenly spaced from
+/// first_time_s, on the dwell's clock (docs/calibration.md: inside a dwell each gap counts as one sample
+/// interval), with the encoders' lines at its first sample. A gap or a dropped row (an encoder glitch) starts
+/// a new stretch; after a gap the encoders' phase is measured afresh (a clock jump keeps no phase).
+struct TimeStretch {
+  double first_time_s = 0.0;
+  double interval_s = 0.0;  ///< mean interval between its samples (the planned one for a single sample)
+  std::size_t count = 0;
+  double main_at_first_rad = 0.0;     ///< theta on the dwell's line at first_time_s
+  double counter_at_first_rad = 0.0;  ///< psi_r on the dwell's line at first_time_s
+};
+
+/// What a dwell's steady run held and what of it was dropped, and why (docs/contract.md, data_quality).
+struct DwellQuality {
+  double run_start_s = 0.0, run_end_s = 0.0;  ///< the steady run, record time
+  std::size_t rows = 0;                       ///< rows in the steady run
+  std::size_t settle_rows = 0;                ///< dropped: in the settle interval
+  std::size_t beyond_planned_rows = 0;        ///< dropped: after the planned duration
+  std::size_t encoder_glitch_rows = 0;        ///< dropped: encoders left the line for a few rows
+  std::string ended;                          ///< why the run ended
+};
+
 /// One measured dwell: a spinning dwell (rate, beta) or a static hold (beta, gamma).
 struct Dwell {
   bool is_static = false;
@@ -34,16 +57,30 @@ struct Dwell {
   std::size_t samples = 0;                       ///< samples in the measured part
   std::size_t gaps = 0;  ///< breaks in the measured part: intervals longer than 1.5 planned sample intervals
   double sample_interval_s = 0.0;   ///< mean interval between samples
-  AngleLine main;                   ///< theta(t), from the main-axis encoder
+  AngleLine main;                   ///< theta(t), from the main-axis encoder (its first stretch's phase)
   AngleLine counter;                ///< psi_r(t), from the counter-platform encoder
   double planned_duration_s = 0.0;  ///< what the plan asked for the measured part
   DwellValues gyro;                 ///< the reduced gyro output, deg/h, per gamma
+  /// The samples of the measured part, stretch by stretch: the grid on which the model's channels are
+  /// evaluated and reduced like the gyro output. Empty: `samples` evenly spaced instants (time_of_sample)
+  /// on the lines `main` and `counter` (a planned dwell, identify/predict).
+  std::vector<TimeStretch> stretches;
+  DwellQuality quality;
 
-  /// theta, psi_r, beta and rates at the i-th of `samples` evenly spaced instants of the measured part: the
-  /// grid on which the model's channels are evaluated and reduced like the gyro output.
+  /// The i-th of `samples` evenly spaced instants of the measured part (a dwell without stretches).
   double time_of_sample(std::size_t i) const {
     return first_time_s + static_cast<double>(i) * sample_interval_s;
   }
+};
+
+/// A steady run of the record that gave no dwell, and why (for the message naming a planned position that
+/// has none).
+struct RejectedRun {
+  double start_s = 0.0, end_s = 0.0;  ///< record time
+  double main_rate_rad_s = 0.0;       ///< measured
+  double beta_deg = 0.0, gamma_deg = 0.0;
+  bool is_static = false;
+  std::string reason;
 };
 
 /// One reduced position, in the plan's order.
@@ -69,19 +106,42 @@ struct Reduction {
   std::vector<Dwell> dwells;
   std::vector<ReducedPosition> positions;  ///< every position of the plan, in order
   std::vector<std::string> warnings;
-  std::size_t samples_read = 0;  ///< rows of the record
-  std::size_t samples_used = 0;  ///< rows in the measured parts of the dwells used
-  std::size_t outliers = 0;      ///< of those, rejected as outliers (and replaced by the dwell's fit)
-  std::size_t gaps = 0;          ///< breaks in the time series inside the dwells used (Dwell::gaps)
+  std::size_t samples_read = 0;         ///< rows of the record
+  std::size_t samples_used = 0;         ///< rows in the measured parts of the dwells used
+  std::size_t outliers = 0;             ///< of those, rejected as outliers (and replaced by the dwell's fit)
+  std::size_t gaps = 0;                 ///< breaks in the time series inside the dwells used (Dwell::gaps)
+  std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside the dwells used: encoders off their line
+  std::vector<RejectedRun> rejected;    ///< steady runs that gave no dwell (the longest kRejectedKept)
 };
+
+/// The test the reducer expects: the configured plan and the rate that sizes a static hold when the plan
+/// has none spinning (the configured centrifuge rate). One value, built once (docs/calibration.md).
+struct PlannedTest {
+  TestSpec spec;
+  double reference_rate_rad_s = 0.0;
+};
+
+/// What a steady state of the machine matches in the plan: the one place where a found dwell is matched
+/// to a planned position (by beta, gamma and the measured rates). Empty `why_not` when it matches.
+struct PlanMatch {
+  bool is_static = false;
+  double planned_rate_rad_s = 0.0;
+  double beta_rad = 0.0;
+  double gamma_rad = 0.0;  ///< static holds
+  std::string why_not;
+};
+PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, double main_rate_rad_s,
+                        double counter_rate_rad_s, double beta_deg, double gamma_deg);
 
 /// Streaming reducer: push every sample of a record in order, then finish(). Memory is independent of the
 /// record's length. Errors (gyrocal::Error) name the source and, where it applies, the time in the record.
 class Reducer {
  public:
   /// plan: the configured test (rates, betas, gammas, revolutions, settle); source_name for messages.
+  Reducer(const PlannedTest& plan, const ReduceOptions& options, std::string source_name);
   Reducer(const TestSpec& plan, const ReduceOptions& options, std::string source_name,
-          double reference_rate_rad_s);
+          double reference_rate_rad_s)
+      : Reducer(PlannedTest{plan, reference_rate_rad_s}, options, std::move(source_name)) {}
   ~Reducer();
   Reducer(const Reducer&) = delete;
   Reducer& operator=(const Reducer&) = delete;
