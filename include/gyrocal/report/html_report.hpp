@@ -36,6 +36,11 @@ std::string render_html_report(const nlohmann::json& result, const HtmlReportOpt
 /// The names of the sections of `result` that the report shows, in report order (empty if none).
 std::vector<std::string> report_sections_present(const nlohmann::json& result);
 
+/// The first bytes of every report (of a result or of a noise characterisation): an existing file that
+/// starts with them is an earlier report, which `gyrocal report` and `gyrocal noise --html` replace without
+/// --force (docs/report.md).
+inline constexpr std::string_view kReportMarker = "<!DOCTYPE html>\n<!-- gyrocal-report:";
+
 /// The plotting library's bundle as inlined into every report (Chart.js, from libjs-chart.js).
 std::string_view embedded_plot_library();
 
