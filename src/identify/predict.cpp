@@ -1,15 +1,18 @@
 #include "gyrocal/identify/predict.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <utility>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <limits>
 
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
+#include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
 
@@ -209,6 +212,32 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
           std::sqrt(d.gyro.covariance(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
 }
 
+NoiseAllanVariances noise_allan_variances(const GyroNoise& noise, double tau_s) {
+  const double white = 60.0 * noise.angle_random_walk_deg_rt_h / std::sqrt(tau_s);
+  const double flicker = bias_instability_allan_deviation_deg_h(noise.bias_instability_deg_h, tau_s);
+  const double walk = noise.rate_random_walk_deg_h_rt_h / 60.0 * std::sqrt(tau_s / 3.0);
+  return {white * white, flicker * flicker, walk * walk};
+}
+
+std::string dominant_noise_warning(const GyroNoise& noise, double dwell_s) {
+  if (!(dwell_s > 0.0)) return "";
+  const NoiseAllanVariances v = noise_allan_variances(noise, dwell_s);
+  const bool flicker = v.bias_instability > v.angle_random_walk;
+  const bool walk = v.rate_random_walk > v.angle_random_walk;
+  if (!flicker && !walk) return "";
+  const char* which = flicker && walk ? "bias instability and rate random walk"
+                      : flicker       ? "bias instability"
+                                      : "rate random walk";
+  return fmt::format(
+      "at the dwell's duration of {:.3g} s, {} dominate{} the white noise: the Allan deviations there are "
+      "{:.3g} deg/h (bias instability), {:.3g} deg/h (rate random walk) and {:.3g} deg/h (angle random "
+      "walk), "
+      "docs/physics.md section 13. More revolutions per position will not reduce the uncertainty; more "
+      "positions or repeated sets will.",
+      dwell_s, which, flicker && walk ? "" : "s", std::sqrt(v.bias_instability),
+      std::sqrt(v.rate_random_walk), std::sqrt(v.angle_random_walk));
+}
+
 CalibrationResult predict_calibration(const Scenario& s, const CalibrationOptions& options) {
   // What calibrate would refuse, plan refuses too, by the same check (issue 11, item 6).
   check_test_feasible(s.test, options.reduce, s.centrifuge.rate_rad_s);
@@ -224,6 +253,12 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
   CalibrationResult result = identify(r, channels, model, identify_options);
+  // The Allan variances compared at the longest dwell's duration: where the colored noise dominates,
+  // averaging longer stops paying (issue 10, item 2).
+  double longest_dwell_s = 0.0;
+  for (const Dwell& d : r.dwells) longest_dwell_s = std::max(longest_dwell_s, d.planned_duration_s);
+  if (std::string w = dominant_noise_warning(s.noise, longest_dwell_s); !w.empty())
+    result.warnings.push_back(std::move(w));
   if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0)
     result.warnings.push_back(
         "the predicted uncertainties count the angle random walk only; bias instability "

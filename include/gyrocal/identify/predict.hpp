@@ -2,6 +2,7 @@
 // Before a test is run: the reduction a record of the plan will give, its noise-free outputs for a given
 // truth, and the standard errors the configured noise predicts. `gyrocal plan`, the sensitivity study and
 // the fast Monte Carlo stand on this, with the same reduction operator as a real calibration.
+#include <string>
 #include <vector>
 
 #include "gyrocal/config/scenario.hpp"
@@ -38,6 +39,22 @@ Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const 
 /// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it.
 void set_predicted_std_errors(Reduction& reduction, const GyroNoise& noise, double sample_rate_hz,
                               const ReduceOptions& options = {});
+
+/// The Allan variances, (deg/h)^2, of the noise terms of `noise` at averaging time tau_s (s), each alone
+/// (docs/physics.md section 13, docs/noise.md): angle random walk (60 N)^2/tau_s, bias instability
+/// bias_instability_allan_deviation_deg_h(B, tau_s)^2 (the simulator's Gauss-Markov sum, about (0.664 B)^2),
+/// rate random walk (K/60)^2 tau_s/3.
+struct NoiseAllanVariances {
+  double angle_random_walk = 0.0;
+  double bias_instability = 0.0;
+  double rate_random_walk = 0.0;
+};
+NoiseAllanVariances noise_allan_variances(const GyroNoise& noise, double tau_s);
+
+/// The warning `plan` gives when bias instability or rate random walk, not white noise, dominates the Allan
+/// variance at a dwell's duration `dwell_s` (then more revolutions per position do not help); empty
+/// otherwise.
+std::string dominant_noise_warning(const GyroNoise& noise, double dwell_s);
 
 /// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
 /// (least squares, full compensation, noise-free outputs of the configured truth).
