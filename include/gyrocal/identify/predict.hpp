@@ -35,8 +35,25 @@ Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& dwell, const ReduceOpt
 Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                               double sample_std_deg_h);
 
+/// Covariance (deg/h)^2 of the reduced positions under the bias instability and the rate random walk of
+/// `noise`, across dwells as well as within them (docs/noise.md, "Coloured noise in the prediction"): the
+/// reduction operator of each dwell applied to the samples' covariance as the simulator makes the noise
+/// (a sum of Gauss-Markov processes; a random walk from the record's start). Dwells whose operator is not
+/// formed (a spinning dwell reduced by the window mean) are left out, and *complete (if given) is set to
+/// false.
+Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
+                                                   const GyroNoise& noise, double sample_rate_hz,
+                                                   bool* complete = nullptr);
+
+/// The whole predicted covariance of the reduced positions: white noise (predicted_position_covariance) plus
+/// coloured_noise_position_covariance.
+Eigen::MatrixXd predicted_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
+                                                    const GyroNoise& noise, double sample_rate_hz,
+                                                    bool* complete = nullptr);
+
 /// Set each dwell's covariance and each position's std_err_deg_h to what white rate noise (the angle random
-/// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it.
+/// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it: these
+/// are the weights (predict_calibration counts the rest in the uncertainties).
 void set_predicted_std_errors(Reduction& reduction, const GyroNoise& noise, double sample_rate_hz,
                               const ReduceOptions& options = {});
 
@@ -57,7 +74,11 @@ NoiseAllanVariances noise_allan_variances(const GyroNoise& noise, double tau_s);
 std::string dominant_noise_warning(const GyroNoise& noise, double dwell_s);
 
 /// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
-/// (least squares, full compensation, noise-free outputs of the configured truth).
+/// (least squares, full compensation, noise-free outputs of the configured truth). The weights are the
+/// white noise's (as a calibration of a record weights its dwells); the uncertainties count the whole
+/// configured noise, bias instability and rate random walk across dwells included
+/// (predicted_noise_position_covariance through the estimator's gain). Warns when bias instability or rate
+/// random walk dominates at the dwell's duration (dominant_noise_warning).
 CalibrationResult predict_calibration(const Scenario& scenario, const CalibrationOptions& options);
 
 }  // namespace gyrocal
