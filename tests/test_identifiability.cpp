@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "gyrocal/analysis/predict.hpp"
@@ -336,6 +337,42 @@ TEST(Messages, APlanThatRepeatsAPositionInCodeIsNamedNotASolverInternal) {
   EXPECT_NE(message.find("one and the same measurement"), std::string::npos) << message;
   EXPECT_NE(message.find("gamma 90 deg"), std::string::npos) << message;
   EXPECT_EQ(message.find("positive definite"), std::string::npos) << message;
+}
+
+// plan warns when bias instability or rate random walk, not white noise, dominates the Allan variance at the
+// dwell's duration (issue 10, item 2): exactly past the crossover of the terms' Allan deviations, computed
+// here from their definitions (docs/physics.md section 13: 60 N/sqrt(tau_s), 0.6643 B, (K/60) sqrt(tau_s/3)).
+TEST(PlanNoise, WarnsWhenColouredNoiseDominatesAtTheDwellsDuration) {
+  Scenario s = default_scenario();
+  s.test.revolutions = 40;
+  s.noise = GyroNoise{};
+  s.noise.angle_random_walk_deg_rt_h = 0.002;
+  const double tau = s.test.revolutions * 2.0 * M_PI / std::fabs(s.test.rates_rad_s.at(0));  // 25.4 s
+  const double white = 60.0 * 0.002 / std::sqrt(tau);
+  const double b_cross = white / 0.6643, k_cross = 60.0 * white / std::sqrt(tau / 3.0);
+  const auto warning_of = [&](double b, double k) {
+    s.noise.bias_instability_deg_h = b;
+    s.noise.rate_random_walk_deg_h_rt_h = k;
+    for (const auto& w : predict_calibration(s, CalibrationOptions{}).warnings)
+      if (w.find("dominate") != std::string::npos) return w;
+    return std::string();
+  };
+  EXPECT_EQ(warning_of(0.0, 0.0), "");
+  EXPECT_EQ(warning_of(0.95 * b_cross, 0.95 * k_cross), "");
+  const std::string flicker = warning_of(1.05 * b_cross, 0.0);
+  EXPECT_NE(flicker.find("bias instability dominates"), std::string::npos) << flicker;
+  EXPECT_NE(flicker.find(fmt::format("duration of {:.3g} s", tau)), std::string::npos) << flicker;
+  EXPECT_NE(flicker.find("More revolutions per position will not reduce"), std::string::npos) << flicker;
+  EXPECT_NE(warning_of(0.0, 1.05 * k_cross).find("rate random walk dominates"), std::string::npos);
+  EXPECT_NE(warning_of(1.05 * b_cross, 1.05 * k_cross).find("bias instability and rate random walk dominate"),
+            std::string::npos);
+  // The Allan variances themselves, against the definitions.
+  const NoiseAllanVariances v = noise_allan_variances(s.noise, tau);
+  EXPECT_NEAR(v.angle_random_walk, white * white, 1e-15);
+  EXPECT_NEAR(std::sqrt(v.bias_instability), 0.6643 * s.noise.bias_instability_deg_h,
+              0.012 * 0.6643 * s.noise.bias_instability_deg_h);
+  EXPECT_NEAR(std::sqrt(v.rate_random_walk),
+              s.noise.rate_random_walk_deg_h_rt_h / 60.0 * std::sqrt(tau / 3.0), 1e-15);
 }
 
 }  // namespace

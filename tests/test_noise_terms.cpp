@@ -22,6 +22,7 @@
 #include "gyrocal/core/noise_terms.hpp"
 #include "gyrocal/core/random.hpp"
 #include "gyrocal/record/record.hpp"
+#include "gyrocal/report/html_report.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
@@ -258,6 +259,81 @@ TEST_F(NoiseCommand, WritesTheContractsJsonAndAConfigurationSection) {
   ASSERT_EQ(t.status, 0) << t.err;
   const Scenario s = parse_scenario(t.out, "noise --toml");
   EXPECT_EQ(s.noise.angle_random_walk_deg_rt_h, n);
+}
+
+// noise --html: a self-contained report of the same characterisation as --json, written atomically; bad paths
+// are refused and leave nothing behind.
+TEST_F(NoiseCommand, WritesASelfContainedHtmlReportAndRefusesBadPaths) {
+  const auto record = dir_ / "static.csv";
+  write_static_record(record, 8000);
+  const auto html = dir_ / "noise.html", json_path = dir_ / "noise.json";
+  const Outcome o = test::run_cli(
+      "noise " + record.string() + " --json " + json_path.string() + " --html " + html.string(), dir_);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string page = test::slurp(html);
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(json_path));
+  // The plot description holds every point of --json with its bounds, and the table every fitted term.
+  const std::string open = "<script type=\"application/json\" id=\"gyrocal-plots\">";
+  const std::size_t at = page.find(open);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t start = at + open.size();
+  const nlohmann::json plots =
+      nlohmann::json::parse(page.substr(start, page.find("</script>", start) - start));
+  ASSERT_EQ(plots.size(), 1u);
+  ASSERT_EQ(plots[0]["points"].size(), j["allan"].size());
+  for (std::size_t k = 0; k < j["allan"].size(); ++k) {
+    EXPECT_EQ(plots[0]["points"][k]["x"], j["allan"][k]["tau_s"]);
+    EXPECT_EQ(plots[0]["points"][k]["y"], j["allan"][k]["adev"]);
+    EXPECT_EQ(plots[0]["low"][k], j["allan"][k]["adev_low"]);
+    EXPECT_EQ(plots[0]["high"][k], j["allan"][k]["adev_high"]);
+  }
+  ASSERT_FALSE(j["terms"].empty());
+  for (const auto& [key, term] : j["terms"].items())
+    EXPECT_NE(page.find("<td>" + key + "</td>"), std::string::npos) << key;
+  // Nothing loaded from outside: the only addresses are in the inlined library's licence comments.
+  EXPECT_EQ(page.find("<script src"), std::string::npos);
+  EXPECT_EQ(page.find("<link"), std::string::npos);
+  EXPECT_NE(page.find("Content-Security-Policy\" content=\"default-src 'none'"), std::string::npos);
+  std::string outside = page;
+  const std::string library(embedded_plot_library());
+  ASSERT_NE(outside.find(library), std::string::npos);
+  outside.erase(outside.find(library), library.size());
+  EXPECT_EQ(outside.find("http://"), std::string::npos);
+  EXPECT_EQ(outside.find("https://"), std::string::npos);
+
+  // An earlier report is replaced without --force.
+  EXPECT_EQ(test::run_cli("noise " + record.string() + " --html " + html.string(), dir_).status, 0);
+  // The record itself is never the output.
+  const std::string record_bytes = test::slurp(record);
+  Outcome bad = test::run_cli("noise " + record.string() + " --html " + record.string(), dir_);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("it is the input"), std::string::npos) << bad.err;
+  EXPECT_EQ(test::slurp(record), record_bytes);
+  // Another existing file only with --force; refused, neither it nor --json is written.
+  const auto other = dir_ / "notes.txt", json2 = dir_ / "second.json";
+  { std::ofstream(other) << "my notes\n"; }
+  bad = test::run_cli("noise " + record.string() + " --json " + json2.string() + " --html " + other.string(),
+                      dir_);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find(other.string()), std::string::npos) << bad.err;
+  EXPECT_EQ(test::slurp(other), "my notes\n");
+  EXPECT_FALSE(std::filesystem::exists(json2));
+  EXPECT_EQ(test::run_cli("noise " + record.string() + " --html " + other.string() + " --force", dir_).status,
+            0);
+  EXPECT_EQ(test::slurp(other).rfind("<!DOCTYPE html>", 0), 0u);
+  // A folder that does not exist: refused, nothing left behind.
+  bad = test::run_cli("noise " + record.string() + " --html " + (dir_ / "no" / "r.html").string(), dir_);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "no"));
+  // --json and --html naming one file.
+  bad = test::run_cli("noise " + record.string() + " --json " + json2.string() + " --html " + json2.string(),
+                      dir_);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("both name"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(json2));
+  // No temporary left in the folder.
+  for (const auto& entry : std::filesystem::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
 }
 
 TEST_F(NoiseCommand, RefusesUnevenSamplingWithItsTime) {

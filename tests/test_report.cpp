@@ -5,18 +5,24 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/report/html_report.hpp"
+#include "gyrocal/report/noise_report.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -95,7 +101,9 @@ std::string shell_quoted(const fs::path& p) {
 
 const std::vector<std::string> kHeadings = {"<h2>Summary</h2>",
                                             "<h2>Test plan</h2>",
+                                            "<h2>Data quality</h2>",
                                             "<h2>Drift coefficients</h2>",
+                                            "<h2>Estimated machine errors</h2>",
                                             "<h2>Identifiable combinations</h2>",
                                             "<h2>Alternative closed forms</h2>",
                                             "<h2>Methods and compensations compared</h2>",
@@ -200,6 +208,255 @@ TEST(Report, MalformedSectionIsReportedNotFatal) {
 
 TEST(Report, NonObjectIsRefused) {
   EXPECT_THROW(gyrocal::render_html_report(json::array({1, 2})), gyrocal::Error);
+}
+
+/// (anchor, text) of every link in the page's navigation, in order.
+std::vector<std::pair<std::string, std::string>> navigation_links(const std::string& html) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const std::size_t begin = html.find("<nav>"), end = html.find("</nav>");
+  if (begin == std::string::npos || end == std::string::npos) return out;
+  const std::string nav = html.substr(begin, end - begin);
+  const std::regex link("<a href=\"#([^\"]*)\">([^<]*)</a>");
+  for (auto it = std::sregex_iterator(nav.begin(), nav.end(), link); it != std::sregex_iterator(); ++it)
+    out.emplace_back((*it)[1].str(), (*it)[2].str());
+  return out;
+}
+
+/// (id, heading) of every section drawn in the page's main part, in order.
+std::vector<std::pair<std::string, std::string>> sections_drawn(const std::string& html) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const std::size_t begin = html.find("<main>"), end = html.find("</main>");
+  if (begin == std::string::npos || end == std::string::npos) return out;
+  const std::string main = html.substr(begin, end - begin);
+  const std::regex section("<section id=\"([^\"]*)\">\n<h2>([^<]*)</h2>");
+  for (auto it = std::sregex_iterator(main.begin(), main.end(), section); it != std::sregex_iterator(); ++it)
+    out.emplace_back((*it)[1].str(), (*it)[2].str());
+  return out;
+}
+
+/// The plot descriptions the page hands to Chart.js.
+json plot_descriptions(const std::string& html) {
+  const std::string open = "<script type=\"application/json\" id=\"gyrocal-plots\">";
+  const std::size_t begin = html.find(open);
+  if (begin == std::string::npos) return json::array();
+  const std::size_t start = begin + open.size();
+  return json::parse(html.substr(start, html.find("</script>", start) - start));
+}
+
+TEST(Report, NavigationListsExactlyTheSectionsDrawn) {
+  json malformed = sample();
+  malformed["positions"] = "sixteen";  // drawn, with its problem, so listed
+  json only_quality = {{"data_quality", sample()["data_quality"]}};
+  for (const json& r :
+       {sample(), json{{"coefficients", sample()["coefficients"]}}, malformed, only_quality}) {
+    const std::string html = gyrocal::render_html_report(r);
+    const auto drawn = sections_drawn(html);
+    EXPECT_EQ(navigation_links(html), drawn);
+    // One section per name report_sections_present gives, none twice.
+    EXPECT_EQ(drawn.size(), gyrocal::report_sections_present(r).size());
+    std::set<std::string> ids;
+    for (const auto& [id, heading] : drawn) ids.insert(id);
+    EXPECT_EQ(ids.size(), drawn.size());
+  }
+  EXPECT_EQ(sections_drawn(gyrocal::render_html_report(sample())).size(), kHeadings.size());
+  EXPECT_EQ(navigation_links(gyrocal::render_html_report(only_quality)),
+            (std::vector<std::pair<std::string, std::string>>{{"data-quality", "Data quality"}}));
+  // The noise report draws its sections through the same page.
+  json noise = {
+      {"samples", 4096}, {"sample_rate_hz", 10.0}, {"allan", json::array()}, {"terms", json::object()}};
+  const std::string nhtml = gyrocal::render_noise_html_report(noise, {});
+  EXPECT_EQ(navigation_links(nhtml), sections_drawn(nhtml));
+  EXPECT_EQ(sections_drawn(nhtml).size(), 3u);
+}
+
+TEST(Report, DataQualityShowsCountsAndEveryFieldOfTheDwells) {
+  const json r = json::parse(R"({
+    "data_quality": {"rows_read": 100000, "rows_used": 80000, "outliers": 7, "gaps": 2, "clock": "steady",
+      "dwells": [{"index": 3, "reason": "gap of 0.5 s <inside>", "rows_dropped": 5000, "at_s": [12.5, 13.0]},
+                 {"index": 9, "reason": "7 outliers", "limit": {"sigma": 6}}]}})");
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string html = gyrocal::render_html_report(r, options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  EXPECT_NE(html.find("<td class=\"num\">100000</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num\">80000</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num\">7</td>"), std::string::npos);
+  EXPECT_NE(html.find("80.0 %"), std::string::npos);                         // 80000 of 100000 rows used
+  EXPECT_NE(html.find("<td>clock</td><td>steady</td>"), std::string::npos);  // a field not known here
+  // The dwells: index and reason first, then the fields this gyrocal does not know, alphabetically.
+  EXPECT_NE(
+      html.find("<th>index</th><th>reason</th><th>at_<wbr>s</th><th>limit</th><th>rows_<wbr>dropped</th>"),
+      std::string::npos);
+  EXPECT_NE(html.find("<td>gap of 0.5 s &lt;inside&gt;</td><td>12.5, 13</td><td>\xE2\x80\x94</td>"
+                      "<td class=\"num\">5000</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>sigma: 6</td>"), std::string::npos);
+
+  const json bad = {{"data_quality", {{"rows_read", 10}, {"dwells", json::array({1, 2})}}}};
+  problems.clear();
+  gyrocal::render_html_report(bad, options);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("data_quality.dwells[0] is a JSON number, not an object"), std::string::npos)
+      << problems[0];
+}
+
+TEST(Report, MachineErrorsShowEstimateConfiguredValueAndCorrelations) {
+  const json r = json::parse(R"({"machine_errors": [
+    {"error": "counter_perpendicularity_x", "harmonic": 0, "value": 4.87, "std": 0.35, "unit": "arcsec",
+     "configured": 5.0, "correlations": {"dO": -0.41, "counter_wobble_x:2 cos": 0.12}},
+    {"error": "counter_wobble_x", "harmonic": 2, "part": "cos", "value": 1.93, "std": 0.5, "unit": "arcsec",
+     "configured": 0.0, "identifiable": true},
+    {"error": "counter_wobble_x", "harmonic": 2, "part": "sin", "value": -0.2, "std": 0.5, "unit": "arcsec"}]})");
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string html = gyrocal::render_html_report(r, options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  EXPECT_NE(html.find("<h2>Estimated machine errors</h2>"), std::string::npos);
+  // counter_perpendicularity_x: configured 5, estimate 4.87 +- 0.35: change -0.13 = -0.37 sigma.
+  EXPECT_NE(html.find("<td>counter_perpendicularity_x</td><td>arcsec</td><td class=\"num\">5</td>"
+                      "<td class=\"num\">4.87</td><td class=\"num\">0.35</td><td class=\"num\">-0.13</td>"
+                      "<td class=\"num\">-0.37</td>"),
+            std::string::npos);
+  // The cosine part of the second harmonic moved 1.93/0.5 = 3.86 sigma from its configured 0: shaded.
+  EXPECT_NE(html.find("<td>counter_wobble_x h2 cos</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num far\">+3.86</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td>counter_wobble_x h2 sin</td>"), std::string::npos);
+  // A field this gyrocal does not know gets its own column.
+  EXPECT_NE(html.find("<th>identifiable</th>"), std::string::npos);
+  // Correlations, strongest first.
+  EXPECT_NE(html.find("<td>dO -0.41, counter_wobble_x:2 cos 0.12</td>"), std::string::npos);
+}
+
+TEST(Report, CoefficientsTableShowsWhateverCoefficientsTheResultHolds) {
+  const json r = json::parse(R"({
+    "coefficients": {
+      "zz_new": {"value": 1.0, "std": 0.1, "unit": "u", "source": "later"},
+      "input_axis_misalignment_S_arcsec": {"value": -3.2, "std": 0.4, "unit": "arcsec", "identifiable": true},
+      "scale_factor_error_ppm": {"value": 120.0, "std": 5.0, "unit": "ppm", "identifiable": true},
+      "input_axis_misalignment_O_arcsec": {"value": 2.5, "std": 0.4, "unit": "arcsec", "identifiable": true},
+      "dOS": {"value": 0.01, "std": 0.001, "unit": "deg/h/g^2", "identifiable": true},
+      "dI": {"value": 0.5, "std": 0.002, "unit": "deg/h/g", "identifiable": true}},
+    "truth": {"scale_factor_error_ppm": 100.0, "dI": 0.5}})");
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string html = gyrocal::render_html_report(r, options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  // Every coefficient has a row, in the order of docs/physics.md, then the unknown name.
+  std::vector<std::size_t> at;
+  for (const char* name : {"dI", "dOS", "scale_factor_error_ppm", "input_axis_misalignment_O_arcsec",
+                           "input_axis_misalignment_S_arcsec", "zz_new"}) {
+    at.push_back(html.find(std::string("<tr><td>") + name + "</td>"));
+    EXPECT_NE(at.back(), std::string::npos) << name;
+  }
+  EXPECT_TRUE(std::is_sorted(at.begin(), at.end()));
+  // The scale factor error against its truth: (120 - 100)/5 = +4 sigma, shaded; the unknown field has a
+  // column.
+  EXPECT_NE(html.find("<td class=\"num far\">+4.00</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>source</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>later</td>"), std::string::npos);
+  // Both coefficients with a truth are plotted.
+  const json plots = plot_descriptions(html);
+  ASSERT_EQ(plots.size(), 1u);
+  EXPECT_EQ(plots[0]["labels"], json::array({"dI", "scale_factor_error_ppm"}));
+}
+
+/// A hand-written result of `gyrocal noise --json`: N = 0.01 deg/sqrt(h), B = 0.05 deg/h, K = 0.3
+/// deg/h/sqrt(h).
+json noise_sample() {
+  return json::parse(R"({"record": "static <1>.csv", "sample_rate_hz": 20.0, "samples": 400000,
+    "allan": [{"tau_s": 0.05, "adev": 2.71, "adev_low": 2.70, "adev_high": 2.72, "clusters": 400000, "dof": 3e5,
+               "dominant": "angle_random_walk_deg_rt_h"},
+              {"tau_s": 12.8, "adev": 0.181, "adev_low": 0.17, "adev_high": 0.19, "clusters": 1562, "dof": 900,
+               "dominant": "angle_random_walk_deg_rt_h"},
+              {"tau_s": 3276.8, "adev": 0.205, "adev_low": 0.16, "adev_high": 0.27, "clusters": 6, "dof": 4,
+               "dominant": "rate_random_walk_deg_h_rt_h"}],
+    "terms": {"angle_random_walk_deg_rt_h": {"value": 0.01, "std": 0.0002},
+              "bias_instability_deg_h": {"value": 0.05, "std": 0.01},
+              "rate_random_walk_deg_h_rt_h": {"value": 0.3, "std": 0.06}},
+    "chi2_per_dof": 1.1})");
+}
+
+TEST(NoiseReport, PlotsThePointsTheirBoundsAndTheFittedTermsLines) {
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.title = "gyrocal noise report";
+  options.source = "static.csv";
+  options.problems = &problems;
+  const std::string html = gyrocal::render_noise_html_report(noise_sample(), options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  const json plots = plot_descriptions(html);
+  ASSERT_EQ(plots.size(), 1u);
+  const json& p = plots[0];
+  EXPECT_EQ(p["kind"], "loglog");
+  ASSERT_EQ(p["points"].size(), 3u);
+  EXPECT_EQ(p["points"][1], (json{{"x", 12.8}, {"y", 0.181}}));
+  EXPECT_EQ(p["low"][2], 0.16);
+  EXPECT_EQ(p["high"][2], 0.27);
+  // The terms' lines from their definitions (docs/physics.md section 13; tau in s, sigma in deg/h):
+  // N: N/sqrt(tau_h) = 60 N/sqrt(tau_s); B: sqrt(2 ln 2/pi) B; K: K sqrt(tau_h/3) = (K/60) sqrt(tau_s/3).
+  const auto line = [&](const std::string& starts) -> const json& {
+    for (const auto& l : p["lines"])
+      if (l["name"].get<std::string>().rfind(starts, 0) == 0) return l;
+    static const json none;
+    ADD_FAILURE() << "no line " << starts;
+    return none;
+  };
+  const double b_floor = std::sqrt(2.0 * std::log(2.0) / M_PI);
+  for (const double tau : {0.05, 3276.8}) {
+    const std::size_t k = tau < 1 ? 0 : 1;
+    const json& n = line("N/");
+    const json& b = line("0.664 B");
+    const json& kk = line("K ");
+    ASSERT_FALSE(n.is_null() || b.is_null() || kk.is_null());
+    EXPECT_DOUBLE_EQ(n["points"][k]["x"].get<double>(), tau);
+    EXPECT_NEAR(n["points"][k]["y"].get<double>(), 60 * 0.01 / std::sqrt(tau), 1e-12);
+    EXPECT_NEAR(b["points"][k]["y"].get<double>(), b_floor * 0.05, 1e-12);
+    EXPECT_NEAR(kk["points"][k]["y"].get<double>(), 0.3 / 60 * std::sqrt(tau / 3), 1e-12);
+  }
+  // The model line is the root sum of squares of the three.
+  const json& model = line("fitted model");
+  ASSERT_FALSE(model.is_null());
+  for (const auto& q : model["points"]) {
+    const double tau = q["x"].get<double>();
+    const double expected = std::sqrt(std::pow(0.6 / std::sqrt(tau), 2) + std::pow(b_floor * 0.05, 2) +
+                                      std::pow(0.005 * std::sqrt(tau / 3), 2));
+    EXPECT_NEAR(q["y"].get<double>(), expected, 1e-12 * expected);
+  }
+  // The table of terms with their uncertainties, the table of points, the record's name escaped.
+  EXPECT_NE(html.find("<td>angle_random_walk_deg_rt_h</td><td class=\"num\">0.01000 \xC2\xB1 0.00020</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>bias_instability_deg_h</td><td class=\"num\">0.050 \xC2\xB1 0.010</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>rate_random_walk_deg_h_rt_h</td><td class=\"num\">0.300 \xC2\xB1 0.060</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num\">3276.8</td><td class=\"num\">0.205</td><td class=\"num\">0.16</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("static &lt;1&gt;.csv"), std::string::npos);
+  // Self-contained as the calibration report: the library inlined, nothing loaded.
+  std::string page = html;
+  const std::string library(gyrocal::embedded_plot_library());
+  ASSERT_NE(page.find(library), std::string::npos);
+  page.erase(page.find(library), library.size());
+  for (const char* loader : {"<script src", "<link", "url(", "<img", " src=", "http://", "https://"})
+    EXPECT_EQ(lower(page).find(loader), std::string::npos) << loader;
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>\n<!-- gyrocal-report:", 0), 0u);
+}
+
+TEST(NoiseReport, MalformedPointsAreReportedNotFatal) {
+  json n = noise_sample();
+  n["allan"][1]["adev"] = "big";
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string html = gyrocal::render_noise_html_report(n, options);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("allan[1].adev is a JSON string, not a number"), std::string::npos)
+      << problems[0];
+  EXPECT_NE(html.find("<h2>Fitted noise terms</h2>"), std::string::npos);
+  EXPECT_THROW(gyrocal::render_noise_html_report(json::array(), options), gyrocal::Error);
 }
 
 // --- the command line -------------------------------------------------------------------------
@@ -307,11 +564,35 @@ std::string body_attribute(const std::string& dom, const std::string& name) {
   return m[1].str();
 }
 
-TEST(ReportBrowser, ChromiumDrawsEveryPlotWithoutError) {
+/// Opens `url` in headless Chromium and checks that the page recorded no error and drew all `plots` plots,
+/// each with marks, and that Chromium's log has no script error or refused load.
+void expect_drawn_in_browser(const std::string& url, std::size_t plots, const fs::path& dir) {
+  const Outcome dom = run(chromium_command(dir / "profile-dom") + " --dump-dom " + shell_quoted(url), dir);
+  ASSERT_EQ(dom.status, 0) << dom.err;
+  EXPECT_EQ(body_attribute(dom.out, "data-js-errors"), "[]") << "errors recorded by the page";
+  EXPECT_EQ(body_attribute(dom.out, "data-plots-expected"), std::to_string(plots));
+  EXPECT_EQ(body_attribute(dom.out, "data-plots-rendered"), std::to_string(plots));
+  // Every canvas has marks on it (the script counts Chart.js's elements per plot).
+  const std::regex marks("<canvas[^>]*data-marks=\"([0-9]+)\"");
+  std::size_t with_marks = 0;
+  for (auto it = std::sregex_iterator(dom.out.begin(), dom.out.end(), marks); it != std::sregex_iterator();
+       ++it)
+    if (std::stoul((*it)[1].str()) > 0) ++with_marks;
+  EXPECT_EQ(with_marks, plots);
+  for (const char* bad : {"Uncaught", "Content Security Policy", "Refused to"})
+    EXPECT_EQ(dom.err.find(bad), std::string::npos) << bad << " in chromium's log:\n" << dom.err;
+}
+
+void expect_chromium() {
   ASSERT_EQ(access(chromium().c_str(), X_OK), 0)
       << "chromium is not installed (" << chromium()
       << "): this test opens the report in a real browser. scripts/test installs it; or run "
          "`apt-get install -y chromium` (or set GYROCAL_CHROMIUM to a Chromium binary).";
+}
+
+TEST(ReportBrowser, ChromiumDrawsEveryPlotWithoutError) {
+  expect_chromium();
+  if (HasFatalFailure()) return;
   TempDir dir;
   // The report and its screenshot stay in the test's working directory (the build tree) for a human to look
   // at.
@@ -328,21 +609,7 @@ TEST(ReportBrowser, ChromiumDrawsEveryPlotWithoutError) {
   ASSERT_EQ(plots, 16u);
   const std::string url = "file://" + html.string();
 
-  const Outcome dom =
-      run(chromium_command(dir.path() / "profile-dom") + " --dump-dom " + shell_quoted(url), dir.path());
-  ASSERT_EQ(dom.status, 0) << dom.err;
-  EXPECT_EQ(body_attribute(dom.out, "data-js-errors"), "[]") << "errors recorded by the page";
-  EXPECT_EQ(body_attribute(dom.out, "data-plots-expected"), std::to_string(plots));
-  EXPECT_EQ(body_attribute(dom.out, "data-plots-rendered"), std::to_string(plots));
-  // Every canvas has marks on it (the script counts Chart.js's elements per plot).
-  const std::regex marks("<canvas[^>]*data-marks=\"([0-9]+)\"");
-  std::size_t with_marks = 0;
-  for (auto it = std::sregex_iterator(dom.out.begin(), dom.out.end(), marks); it != std::sregex_iterator();
-       ++it)
-    if (std::stoul((*it)[1].str()) > 0) ++with_marks;
-  EXPECT_EQ(with_marks, plots);
-  for (const char* bad : {"Uncaught", "Content Security Policy", "Refused to"})
-    EXPECT_EQ(dom.err.find(bad), std::string::npos) << bad << " in chromium's log:\n" << dom.err;
+  expect_drawn_in_browser(url, plots, dir.path());
 
   const Outcome shot =
       run(chromium_command(dir.path() / "profile-shot") +
@@ -355,6 +622,18 @@ TEST(ReportBrowser, ChromiumDrawsEveryPlotWithoutError) {
   EXPECT_EQ(image.substr(1, 3), "PNG");
   // A 1200 x 3000 page of tables and plots; a blank or unstyled page compresses to far less.
   EXPECT_GT(image.size(), 100000u) << "screenshot " << png << " looks empty";
+}
+
+// The noise report's log-log plot (error bars as broken lines, term lines) is drawn by the same page.
+TEST(ReportBrowser, ChromiumDrawsTheNoiseReport) {
+  expect_chromium();
+  if (HasFatalFailure()) return;
+  TempDir dir;
+  const fs::path html = fs::absolute("noise_report_browser_test.html");
+  gyrocal::HtmlReportOptions options;
+  options.title = "gyrocal noise report";
+  write_file(html, gyrocal::render_noise_html_report(noise_sample(), options));
+  expect_drawn_in_browser("file://" + html.string(), 1, dir.path());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
+#include "gyrocal/report/html_report.hpp"
 
 namespace gyrocal::cli {
 
@@ -51,6 +53,14 @@ void refuse_to_overwrite_input(const std::string& output, const std::string& inp
   std::error_code ec;
   if (std::filesystem::equivalent(output, input, ec))
     throw Error("refusing to write " + output + ": it is the input " + input + ".");
+}
+
+bool is_earlier_report(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::string head(kReportMarker.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return in.gcount() == static_cast<std::streamsize>(head.size()) && head == kReportMarker;
 }
 
 void ProgressBar::operator()(double fraction) {

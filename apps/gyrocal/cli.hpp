@@ -32,6 +32,11 @@ void write_output(const std::string& path, std::string_view content, bool overwr
 /// Refuse an output path that names one of the inputs (no input is ever overwritten).
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
 
+/// True when `path` is an earlier gyrocal report (it starts with kReportMarker, report/html_report.hpp),
+/// which `report` and `noise --html` replace without --force: a report is derived from its input and cheap to
+/// write again (docs/report.md).
+bool is_earlier_report(const std::string& path);
+
 /// A progress bar on standard error ("label [####    ]  42%"), redrawn when the whole percentage changes.
 /// Commands install it only when standard error is a terminal; it draws nothing during the first second, so
 /// that work shorter than a second shows no bar.

@@ -3,6 +3,8 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/record_noise.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/report/noise_report.hpp"
 #include "gyrocal/result/noise_json.hpp"
 #include "tables.hpp"
 
@@ -10,8 +12,8 @@ namespace gyrocal::cli {
 
 void register_noise(CLI::App& app) {
   struct Options {
-    std::string record, config, json;
-    bool toml = false;
+    std::string record, config, json, html;
+    bool toml = false, force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -21,16 +23,42 @@ void register_noise(CLI::App& app) {
   sub->add_option("--config", opt->config,
                   "Configuration file (TOML); only its [record] section (the record's layout) is used");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  sub->add_option(
+      "--html", opt->html,
+      "Write a self-contained HTML report (log-log Allan plot, fitted terms) to FILE ('-' = standard "
+      "output)");
+  sub->add_flag("--force", opt->force,
+                "Let --html replace an existing file that is not an earlier gyrocal report");
   sub->add_flag("--toml", opt->toml, "Print the fitted terms as a [gyro.noise] configuration section");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
+    refuse_to_overwrite_input(opt->html, opt->record);
+    refuse_to_overwrite_input(opt->html, opt->config);
+    if (!opt->json.empty() && opt->json == opt->html && opt->json != "-")
+      throw Error(fmt::format("--json and --html both name {}: give each its own file.", opt->json));
+    if (opt->json == "-" && opt->html == "-")
+      throw Error("--json and --html cannot both write to standard output.");
     const Scenario s = load_configuration(opt->config);
     const RecordNoise r = characterise_record_noise(opt->record, {}, s.record);
-    if (!opt->json.empty()) write_output(opt->json, noise_to_json(r).dump(2) + "\n", true);
+    const nlohmann::json j = noise_to_json(r);
+    // The report first: a refused --html path (an existing file that is not a report) leaves no --json
+    // output.
+    if (!opt->html.empty()) {
+      HtmlReportOptions options;
+      options.title = "gyrocal noise report";
+      options.source = opt->record;
+      std::vector<std::string> problems;
+      options.problems = &problems;
+      const std::string html = render_noise_html_report(j, options);
+      if (!problems.empty())
+        throw Error(fmt::format("the noise report of {} is incomplete: {}", opt->record, problems.front()));
+      write_output(opt->html, html, opt->force || is_earlier_report(opt->html));
+    }
+    if (!opt->json.empty()) write_output(opt->json, j.dump(2) + "\n", true);
     if (opt->toml) {
       fmt::print("{}", noise_to_toml(r));
-    } else if (opt->json != "-") {
+    } else if (opt->json != "-" && opt->html != "-") {
       fmt::print("{}", noise_table(r));
     }
   });

@@ -12,10 +12,6 @@
 namespace gyrocal::cli {
 namespace {
 
-/// The first bytes of every report (html_report.cpp); an existing file that starts with them is an
-/// earlier report and may be replaced without --force.
-constexpr std::string_view kReportMarker = "<!DOCTYPE html>\n<!-- gyrocal-report:";
-
 nlohmann::json read_result(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("cannot open the result file {}.", path));
@@ -23,14 +19,6 @@ nlohmann::json read_result(const std::string& path) {
   bytes << in.rdbuf();
   if (in.bad()) throw Error(fmt::format("cannot read the result file {}.", path));
   return parse_result_json(bytes.str(), path);
-}
-
-bool is_earlier_report(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::string head(kReportMarker.size(), '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  return in.gcount() == static_cast<std::streamsize>(head.size()) && head == kReportMarker;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
@@ -163,14 +164,24 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     ju.col(static_cast<Eigen::Index>(s)) = 0.5 * (wp - wm);
   });
 
-  // White rate noise through the reduction, as a Cholesky factor: n = L xi.
-  const double sigma = white_noise_sample_std_deg_h(scenario.noise, scenario.test.sample_rate_hz);
+  // The gyro's noise through the reduction as a factor L of its covariance, n = L xi: white noise, bias
+  // instability and rate random walk, within and across dwells (predict.hpp, docs/noise.md).
+  const Eigen::MatrixXd noise_covariance =
+      predicted_noise_position_covariance(r0, ro, scenario.noise, scenario.test.sample_rate_hz);
   Eigen::MatrixXd chol = Eigen::MatrixXd::Zero(np, np);
-  if (sigma > 0) {
-    const Eigen::LLT<Eigen::MatrixXd> llt(predicted_position_covariance(r0, ro, sigma));
-    if (llt.info() != Eigen::Success)
-      throw Error("Monte Carlo: the noise covariance is not positive definite.");
-    chol = llt.matrixL();
+  if (!noise_covariance.isZero(0.0)) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(noise_covariance);
+    if (llt.info() == Eigen::Success) {
+      chol = llt.matrixL();
+    } else {
+      // Without white noise the covariance may be singular (a random walk common to all positions): a
+      // symmetric square root instead.
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(noise_covariance);
+      if (eigen.info() != Eigen::Success ||
+          eigen.eigenvalues().minCoeff() < -1e-9 * eigen.eigenvalues().maxCoeff())
+        throw Error("Monte Carlo: the noise covariance is not positive semi-definite.");
+      chol = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    }
   }
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> g(ne, ns + np);
   g.leftCols(ns) = map * ju;

@@ -233,13 +233,24 @@ DeviationBounds deviation_confidence_bounds(double deviation, double dof, double
           deviation * std::sqrt(dof / chi_squared_quantile(tail, dof))};
 }
 
+std::optional<NoiseTerm> noise_term_from_key(std::string_view key) {
+  for (NoiseTerm t : kAllTerms)
+    if (noise_term_key(t) == key) return t;
+  return std::nullopt;
+}
+
+double noise_term_deviation(NoiseTerm term, double value, double tau_s) {
+  const double root = value / value_per_sqrt_coefficient(term);
+  return std::sqrt(root * root * basis(term, tau_s));
+}
+
 double NoiseCharacterisation::model_deviation(double tau_s) const {
   double variance = 0.0;
   for (NoiseTerm t : kAllTerms) {
     const FittedNoiseTerm& fitted = term(t);
     if (!fitted.present) continue;
-    const double root = fitted.value / value_per_sqrt_coefficient(t);
-    variance += root * root * basis(t, tau_s);
+    const double sigma = noise_term_deviation(t, fitted.value, tau_s);
+    variance += sigma * sigma;
   }
   return std::sqrt(variance);
 }

@@ -2,6 +2,7 @@
 // Before a test is run: the reduction a record of the plan will give, its noise-free outputs for a given
 // truth, and the standard errors the configured noise predicts. `gyrocal plan`, the sensitivity study and
 // the fast Monte Carlo stand on this, with the same reduction operator as a real calibration.
+#include <string>
 #include <vector>
 
 #include "gyrocal/config/scenario.hpp"
@@ -34,13 +35,50 @@ Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& dwell, const ReduceOpt
 Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                               double sample_std_deg_h);
 
+/// Covariance (deg/h)^2 of the reduced positions under the bias instability and the rate random walk of
+/// `noise`, across dwells as well as within them (docs/noise.md, "Coloured noise in the prediction"): the
+/// reduction operator of each dwell applied to the samples' covariance as the simulator makes the noise
+/// (a sum of Gauss-Markov processes; a random walk from the record's start). Dwells whose operator is not
+/// formed (a spinning dwell reduced by the window mean) are left out, and *complete (if given) is set to
+/// false.
+Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
+                                                   const GyroNoise& noise, double sample_rate_hz,
+                                                   bool* complete = nullptr);
+
+/// The whole predicted covariance of the reduced positions: white noise (predicted_position_covariance) plus
+/// coloured_noise_position_covariance.
+Eigen::MatrixXd predicted_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
+                                                    const GyroNoise& noise, double sample_rate_hz,
+                                                    bool* complete = nullptr);
+
 /// Set each dwell's covariance and each position's std_err_deg_h to what white rate noise (the angle random
-/// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it.
+/// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it: these
+/// are the weights (predict_calibration counts the rest in the uncertainties).
 void set_predicted_std_errors(Reduction& reduction, const GyroNoise& noise, double sample_rate_hz,
                               const ReduceOptions& options = {});
 
+/// The Allan variances, (deg/h)^2, of the noise terms of `noise` at averaging time tau_s (s), each alone
+/// (docs/physics.md section 13, docs/noise.md): angle random walk (60 N)^2/tau_s, bias instability
+/// bias_instability_allan_deviation_deg_h(B, tau_s)^2 (the simulator's Gauss-Markov sum, about (0.664 B)^2),
+/// rate random walk (K/60)^2 tau_s/3.
+struct NoiseAllanVariances {
+  double angle_random_walk = 0.0;
+  double bias_instability = 0.0;
+  double rate_random_walk = 0.0;
+};
+NoiseAllanVariances noise_allan_variances(const GyroNoise& noise, double tau_s);
+
+/// The warning `plan` gives when bias instability or rate random walk, not white noise, dominates the Allan
+/// variance at a dwell's duration `dwell_s` (then more revolutions per position do not help); empty
+/// otherwise.
+std::string dominant_noise_warning(const GyroNoise& noise, double dwell_s);
+
 /// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
-/// (least squares, full compensation, noise-free outputs of the configured truth).
+/// (least squares, full compensation, noise-free outputs of the configured truth). The weights are the
+/// white noise's (as a calibration of a record weights its dwells); the uncertainties count the whole
+/// configured noise, bias instability and rate random walk across dwells included
+/// (predicted_noise_position_covariance through the estimator's gain). Warns when bias instability or rate
+/// random walk dominates at the dwell's duration (dominant_noise_warning).
 CalibrationResult predict_calibration(const Scenario& scenario, const CalibrationOptions& options);
 
 }  // namespace gyrocal

@@ -7,6 +7,7 @@
 // in the units of `[gyro.noise]`.
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -31,6 +32,14 @@ inline constexpr std::size_t kNoiseTermCount = 5;
 /// bias_instability_deg_h, rate_random_walk_deg_h_rt_h), else a name with its unit (angle_quantization_deg,
 /// rate_ramp_deg_h_per_h).
 std::string_view noise_term_key(NoiseTerm term);
+
+/// The term whose noise_term_key() is `key`, or nothing.
+std::optional<NoiseTerm> noise_term_from_key(std::string_view key);
+
+/// The Allan deviation (deg/h) at tau_s (s) of the term `term` alone, of value `value` in its unit
+/// (noise_term_key): physics.md section 13, e.g. 60 N/sqrt(tau_s) for the angle random walk N in deg/sqrt(h),
+/// 0.6643 B for the bias instability, (K/60) sqrt(tau_s/3) for the rate random walk.
+double noise_term_deviation(NoiseTerm term, double value, double tau_s);
 
 /// Equivalent degrees of freedom of the overlapping Allan variance at cluster size m from rate_samples
 /// samples when `term` dominates: NIST SP 1065 (2008) table 5 (after Stein 1985), with the phase-point count

@@ -28,13 +28,20 @@ struct HtmlReportOptions {
 nlohmann::json parse_result_json(std::string_view text, const std::string& source_name);
 
 /// Renders the HTML report of `result` (a JSON object with any of the sections of docs/report.md:
-/// coefficients, truth, comparison, combinations, alternatives, warnings, positions, sensitivity,
-/// montecarlo, plan). Sections that are absent are left out. Every string from `result` is escaped.
+/// method/compensation/g_level/warnings, plan, data_quality, coefficients with truth, machine_errors,
+/// combinations, alternatives, comparison, positions, sensitivity, montecarlo). Sections that are absent are
+/// left out; the navigation lists exactly the sections drawn. Every string from `result` is escaped.
 /// Throws gyrocal::Error if `result` is not a JSON object.
 std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options = {});
 
-/// The names of the sections of `result` that the report shows, in report order (empty if none).
+/// The names of the report's sections that `result` has (summary, plan, data_quality, coefficients,
+/// machine_errors, ...), in report order (empty if none: `gyrocal report` then refuses the file).
 std::vector<std::string> report_sections_present(const nlohmann::json& result);
+
+/// The first bytes of every report (of a result or of a noise characterisation): an existing file that
+/// starts with them is an earlier report, which `gyrocal report` and `gyrocal noise --html` replace without
+/// --force (docs/report.md).
+inline constexpr std::string_view kReportMarker = "<!DOCTYPE html>\n<!-- gyrocal-report:";
 
 /// The plotting library's bundle as inlined into every report (Chart.js, from libjs-chart.js).
 std::string_view embedded_plot_library();
