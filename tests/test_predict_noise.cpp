@@ -8,12 +8,12 @@
 #include <cstdlib>
 #include <vector>
 
+#include "gyrocal/analysis/montecarlo.hpp"
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/montecarlo.hpp"
-#include "gyrocal/identify/predict.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 

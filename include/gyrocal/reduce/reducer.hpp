@@ -63,7 +63,7 @@ struct Dwell {
   DwellValues gyro;                 ///< the reduced gyro output, deg/h, per gamma
   /// The samples of the measured part, stretch by stretch: the grid on which the model's channels are
   /// evaluated and reduced like the gyro output. Empty: `samples` evenly spaced instants (time_of_sample)
-  /// on the lines `main` and `counter` (a planned dwell, identify/predict).
+  /// on the lines `main` and `counter` (a planned dwell, analysis/predict).
   std::vector<TimeStretch> stretches;
   DwellQuality quality;
 
