@@ -4,6 +4,7 @@
 #include "cli.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/record_check.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -12,6 +13,7 @@ namespace gyrocal::cli {
 void register_calibrate(CLI::App& app) {
   struct Options {
     std::string record, config, json, method = "least-squares", compensation = "full", reduction = "harmonic";
+    std::string gyro_model;  // empty: [calibration] gyro_model
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
@@ -25,6 +27,11 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--reduction", opt->reduction,
                   "harmonic (default: harmonic fit in gamma with drift) or window (mean around each gamma)")
       ->check(CLI::IsMember({"harmonic", "window"}));
+  sub->add_option(
+         "--gyro-model", opt->gyro_model,
+         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
+         "misalignments); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
@@ -33,6 +40,7 @@ void register_calibrate(CLI::App& app) {
     CalibrationOptions options;
     options.method = parse_method(opt->method);
     options.compensation = parse_compensation(opt->compensation);
+    options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
     options.reduce.method =
         opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
     check_feasible(s, opt->config, options.reduce);

@@ -43,9 +43,10 @@ struct LineSums {
 /// The run in progress: consecutive samples at one steady state of the machine.
 struct Run {
   bool is_static = false;
-  double planned_rate = 0.0;  // rad/s
-  double beta0_deg = 0.0;     // encoder at the run's start
-  double psi0_deg = 0.0;      // unwrapped counter encoder at the run's start (static holds)
+  double planned_rate = 0.0;    // rad/s
+  double planned_offset = 0.0;  // counter rate offset, rad/s (docs/physics.md section 15)
+  double beta0_deg = 0.0;       // encoder at the run's start
+  double psi0_deg = 0.0;        // unwrapped counter encoder at the run's start (static holds)
   double t_start = 0.0;
   double planned_duration = 0.0;
   std::optional<DwellAccumulator> acc;
@@ -78,28 +79,37 @@ struct Reducer::State {
 
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
 
-  /// The plan's rate matching a sample-to-sample rate, if the machine is steady at one.
-  std::optional<double> steady_rate(double theta_rate, double psi_rate) const {
+  /// The plan's (rate, counter rate offset) matching a sample-to-sample rate, if the machine is steady at
+  /// one: the main axis at the rate, the platform's heading (theta + psi_r) turning at the offset
+  /// (docs/physics.md section 15; at rate 0 and offset 0 both stopped).
+  std::optional<std::pair<double, double>> steady_rate(double theta_rate, double psi_rate) const {
     const double tol0 = options.static_rate_tolerance_rad_s;
-    for (double r : plan.rates_rad_s) {
-      if (r == 0.0) {
-        if (std::abs(theta_rate) < tol0 && std::abs(psi_rate) < tol0) return 0.0;
-      } else {
-        const double tol = options.rate_tolerance * std::abs(r);
-        if (std::abs(theta_rate - r) <= tol && std::abs(psi_rate + theta_rate) <= tol) return r;
+    for (double r : plan.rates_rad_s)
+      for (double o : plan.counter_rate_offsets_rad_s) {
+        if (r == 0.0 && o == 0.0) {
+          if (std::abs(theta_rate) < tol0 && std::abs(psi_rate) < tol0) return std::make_pair(r, o);
+        } else {
+          const double tol = options.rate_tolerance * std::max(std::abs(r), std::abs(o));
+          const bool main_steady = r == 0.0 ? std::abs(theta_rate) < tol0 : std::abs(theta_rate - r) <= tol;
+          if (main_steady && std::abs(psi_rate + theta_rate - o) <= tol) return std::make_pair(r, o);
+        }
       }
-    }
     return std::nullopt;
   }
 
-  void start_run(double rate, double t_start, double beta_deg) {
+  void start_run(std::pair<double, double> rate_offset, double t_start, double beta_deg) {
+    const auto [rate, offset] = rate_offset;
     Run r;
-    r.is_static = rate == 0.0;
+    r.is_static = rate == 0.0 && offset == 0.0;
     r.planned_rate = rate;
+    r.planned_offset = offset;
     r.beta0_deg = beta_deg;
     r.psi0_deg = psi_u;
     r.t_start = t_start;
-    r.planned_duration = r.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate);
+    // A spinning dwell: whole revolutions of gamma, which turns at rate - offset (docs/physics.md section
+    // 15).
+    r.planned_duration =
+        r.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate - offset);
     r.acc.emplace(options, r.is_static ? std::vector<double>{0.0} : plan.gamma_rad, r.is_static, 1,
                   r.planned_duration, true);
     run = std::move(r);
@@ -119,7 +129,7 @@ struct Reducer::State {
     const double tt = s.time_s - r.t_first;
     const double planned_turn_deg = r.planned_rate * kRadToDeg * tt;
     r.theta.add(tt, theta_u - r.theta_first_deg - planned_turn_deg);
-    r.psi.add(tt, psi_u - r.psi_first_deg + planned_turn_deg);
+    r.psi.add(tt, psi_u - r.psi_first_deg + planned_turn_deg - r.planned_offset * kRadToDeg * tt);
     r.beta_sum += s.position_angle_deg;
     if (r.n > 0 && (s.time_s - r.t_prev) * plan.sample_rate_hz > 1.5) ++r.gaps;
     r.t_prev = s.time_s;
@@ -142,6 +152,7 @@ struct Reducer::State {
     Dwell d;
     d.is_static = r.is_static;
     d.planned_rate_rad_s = r.planned_rate;
+    d.planned_counter_rate_offset_rad_s = r.planned_offset;
     d.measured_beta_rad = r.beta_sum / static_cast<double>(r.n) * kDegToRad;
     d.beta_rad = d.measured_beta_rad;
     d.first_time_s = r.acc->first_time_s();
@@ -154,7 +165,8 @@ struct Reducer::State {
     r.theta.fit(a, b, rms);
     d.main = {(r.theta_first_deg + a) * kDegToRad, r.planned_rate + b * kDegToRad, rms * kDegToRad};
     r.psi.fit(a, b, rms);
-    d.counter = {(r.psi_first_deg + a) * kDegToRad, -r.planned_rate + b * kDegToRad, rms * kDegToRad};
+    d.counter = {(r.psi_first_deg + a) * kDegToRad, -r.planned_rate + r.planned_offset + b * kDegToRad,
+                 rms * kDegToRad};
 
     // Match to the plan.
     const double beta_deg = d.beta_rad * kRadToDeg;
@@ -164,6 +176,9 @@ struct Reducer::State {
     const std::string what =
         d.is_static
             ? fmt::format("static hold at beta {:.4f} deg, gamma {:.4f} deg", beta_deg, wrap_deg(-r.psi0_deg))
+        : r.planned_offset != 0.0
+            ? fmt::format("dwell at {} rad/s, counter rate offset {} rad/s, beta {:.4f} deg",
+                          d.planned_rate_rad_s, r.planned_offset, beta_deg)
             : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
     if (!beta_plan) {
       warnings.push_back(fmt::format("{}: {} matches no planned beta; ignored.", at(d.first_time_s), what));
@@ -206,8 +221,9 @@ struct Reducer::State {
           at(d.first_time_s), what,
           std::max(d.main.rms_residual_rad, d.counter.rms_residual_rad) * kRadToDeg));
     }
-    if (!d.is_static && std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) >
-                            options.rate_tolerance * 0.1 * std::abs(d.planned_rate_rad_s)) {
+    if (!d.is_static && d.planned_rate_rad_s != 0.0 &&
+        std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) >
+            options.rate_tolerance * 0.1 * std::abs(d.planned_rate_rad_s)) {
       warnings.push_back(
           fmt::format("{}: {}: the main axis turned at {:.9f} rad/s, not the planned {} rad/s.",
                       at(d.first_time_s), what, d.main.rate_rad_s, d.planned_rate_rad_s));
@@ -257,12 +273,12 @@ void Reducer::push(const RecordSample& s) {
   st.theta_raw_prev = s.main_angle_deg;
   st.psi_raw_prev = s.counter_angle_deg;
   const double theta_rate = dtheta / dt * kDegToRad, psi_rate = dpsi / dt * kDegToRad;
-  const std::optional<double> rate = st.steady_rate(theta_rate, psi_rate);
+  const std::optional<std::pair<double, double>> rate = st.steady_rate(theta_rate, psi_rate);
 
   if (st.run) {
     const Run& r = *st.run;
     const bool same =
-        rate && *rate == r.planned_rate &&
+        rate && rate->first == r.planned_rate && rate->second == r.planned_offset &&
         std::abs(wrap_deg(s.position_angle_deg - r.beta0_deg)) <= st.options.beta_tolerance_deg &&
         (!r.is_static || std::abs(st.psi_u - r.psi0_deg) <= st.options.beta_tolerance_deg);
     if (!same) st.end_run();
@@ -280,10 +296,12 @@ Reduction Reducer::finish() {
   out.samples_read = st.samples;
   out.warnings = st.warnings;
   // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several.
-  std::map<std::tuple<double, double, double>, int> chosen;
+  // The key of a dwell: rate, counter rate offset (docs/physics.md section 15), beta and a hold's gamma.
+  std::map<std::tuple<double, double, double, double>, int> chosen;
   for (std::size_t i = 0; i < st.dwells.size(); ++i) {
     const Dwell& d = st.dwells[i];
-    const auto key = std::make_tuple(d.planned_rate_rad_s, d.beta_rad, d.is_static ? d.gammas_rad[0] : 0.0);
+    const auto key = std::make_tuple(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, d.beta_rad,
+                                     d.is_static ? d.gammas_rad[0] : 0.0);
     auto it = chosen.find(key);
     if (it == chosen.end()) {
       chosen[key] = static_cast<int>(i);
@@ -308,11 +326,17 @@ Reduction Reducer::finish() {
   }
   std::vector<std::string> missing;
   for (const Position& p : test_positions(st.plan)) {
-    const auto key = std::make_tuple(p.rate_rad_s, p.beta_rad, p.rate_rad_s == 0.0 ? p.gamma_rad : 0.0);
+    const bool is_static = p.rate_rad_s == 0.0 && p.counter_rate_offset_rad_s == 0.0;
+    const auto key =
+        std::make_tuple(p.rate_rad_s, p.counter_rate_offset_rad_s, p.beta_rad, is_static ? p.gamma_rad : 0.0);
     const auto it = chosen.find(key);
     if (it == chosen.end()) {
-      missing.push_back(fmt::format("{} (rate {} rad/s, beta {} deg, gamma {} deg)", p.index, p.rate_rad_s,
-                                    p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg));
+      missing.push_back(
+          fmt::format("{} (rate {} rad/s, {}beta {} deg, gamma {} deg)", p.index, p.rate_rad_s,
+                      p.counter_rate_offset_rad_s != 0.0
+                          ? fmt::format("counter rate offset {} rad/s, ", p.counter_rate_offset_rad_s)
+                          : std::string(),
+                      p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg));
       continue;
     }
     const int di = renumber[it->second];
@@ -368,6 +392,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.rate_rad_s = p.rate_rad_s;
   rp.beta_rad = p.beta_rad;
   rp.gamma_rad = p.gamma_rad;
+  rp.counter_rate_offset_rad_s = p.counter_rate_offset_rad_s;
   rp.mean_deg_h = d.gyro.value[k];
   rp.std_err_deg_h = d.gyro.std_err[k];
   rp.samples = d.gyro.samples[k];

@@ -45,10 +45,14 @@ struct IdentifiabilityOptions {
 /// whitened_observations: the same rows whitened by the positions' covariance. ar: the radial level of
 /// the first spinning rate (g), for docs/physics.md section 8's named combinations. positions and model: the
 /// plan actually run, for the advice.
+/// names: one per column (identify/unknowns.hpp): the ten coefficients first, then any further unknowns (the
+/// rate errors of docs/physics.md section 15), which count as excited wherever their regressor is not zero;
+/// empty = the ten coefficients.
 CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::MatrixXd& whitened_design,
                                 const Eigen::VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
-                                const IdentifiabilityOptions& options);
+                                const IdentifiabilityOptions& options,
+                                const std::vector<std::string>& names = {});
 
 /// Rows brought to reduced row echelon form with pivots taken in `order` (column indices); each pivot is 1.
 /// A column whose largest remaining entry is at most `tolerance` times the largest entry of `rows` gives no
