@@ -33,7 +33,9 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
   for (std::size_t di = 0; di < reduction.dwells.size(); ++di) {
     const Dwell& d = reduction.dwells[di];
-    DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
+    // The reducer's operator, the heading's sweep at a counter rate offset included (docs/physics.md 15).
+    const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
+    DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false, sweep);
     double v[kColumns];
     // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always: for the harmonic
     // fit and a static hold's mean, which see the channels' smooth shape; a window holds a few samples only,

@@ -60,6 +60,13 @@ struct Run {
   std::size_t gaps = 0;  // intervals between measured samples longer than 1.5 planned sample intervals
 };
 
+/// The rate at which the platform's heading sweeps the Earth rate through a spinning dwell at a counter rate
+/// offset (docs/physics.md section 15); 0 without an offset, and at rate 0, where the heading turns with
+/// gamma.
+double heading_sweep_rad_s(double rate_rad_s, double offset_rad_s) {
+  return rate_rad_s != 0.0 ? offset_rad_s : 0.0;
+}
+
 }  // namespace
 
 struct Reducer::State {
@@ -111,7 +118,7 @@ struct Reducer::State {
     r.planned_duration =
         r.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate - offset);
     r.acc.emplace(options, r.is_static ? std::vector<double>{0.0} : plan.gamma_rad, r.is_static, 1,
-                  r.planned_duration, true);
+                  r.planned_duration, true, heading_sweep_rad_s(rate, offset));
     run = std::move(r);
   }
 
@@ -360,7 +367,13 @@ Reduction Reducer::finish() {
   int zero = 0;
   for (const Dwell& d : out.dwells) {
     if (d.gyro.dof > 0.0) continue;
-    const int needed = d.is_static ? 2 : (st.options.linear_drift ? 3 : 2);
+    // The scatter is about a mean (and a drift), and at a counter rate offset also the heading's sweep.
+    const int needed =
+        d.is_static
+            ? 2
+            : (st.options.linear_drift ? 3 : 2) +
+                  (heading_sweep_rad_s(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s) != 0.0 ? 2
+                                                                                                         : 0);
     throw Error(fmt::format(
         "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
         "error from the scatter between them; it needs at least {}{}.",
