@@ -244,7 +244,7 @@ TEST(RatePlatformCalibrate, UncertaintiesOfScaleFactorAndMisalignmentTowardSAreH
   s.noise = default_scenario().noise;  // white rate noise, 0.002 deg/rt(h)
   s.test.revolutions = 30;
   s.test.sample_rate_hz = sanitized() ? 30.0 : 50.0;
-  const int trials = sanitized() ? 40 : 120;
+  const int trials = sanitized() ? 100 : 120;  // the spread of sd is about 1/sqrt(2 trials) = 0.07
   const std::vector<PositionChannels> channels = run(s, 1).channels;
   std::vector<double> z_e, z_s;
   for (int trial = 0; trial < trials; ++trial) {
