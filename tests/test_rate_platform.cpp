@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
@@ -317,6 +318,25 @@ TEST(RatePlatformCalibrate, WithoutOffsetsPlanSaysTheScaleFactorIsBarelyIdentifi
   const Pipeline p = run(s);
   const CalibrationResult r = identify_with(s, p, GyroModel::kDriftRate);
   EXPECT_TRUE(has_warning(r, "barely identifiable"));
+}
+
+TEST(RatePlatformPlan, PlanStatesThePredictedUncertaintyOfTheScaleFactorWithAndWithoutOffsets) {
+  Scenario s = rate_platform_scenario();
+  s.noise = default_scenario().noise;
+  CalibrationOptions o;
+  o.gyro_model = GyroModel::kDriftRate;
+  const CalibrationResult with = predict_calibration(s, o);
+  s.test.counter_rate_offsets_rad_s = {0.0};
+  const CalibrationResult without = predict_calibration(s, o);
+  ASSERT_TRUE(with.rate_terms[0].identifiable);
+  // Offsets of 0.25 rad/s put 0.25 rad/s on I or S, the Earth rate at most 7e-5 rad/s: e's uncertainty
+  // shrinks by orders of magnitude (more than 100 here), and plan says why it is large without them.
+  EXPECT_GT(without.rate_terms[0].std, 100.0 * with.rate_terms[0].std);
+  EXPECT_TRUE(has_warning(without, "barely identifiable"));
+  EXPECT_FALSE(has_warning(with, "barely identifiable"));
+  // dO is weak either way, and said so with its uncertainty.
+  EXPECT_TRUE(has_warning(with, "input_axis_misalignment_O_arcsec"));
+  EXPECT_GT(with.rate_terms[1].std, 100.0 * with.rate_terms[2].std);
 }
 
 TEST(RatePlatformCalibrate, ClosedFormUsesTheSixteenPositionsAtOffsetZeroAndSaysWhatItLeftOut) {

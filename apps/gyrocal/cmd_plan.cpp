@@ -3,6 +3,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -11,6 +12,7 @@ namespace gyrocal::cli {
 void register_plan(CLI::App& app) {
   struct Options {
     std::string config, json, method = "least-squares", compensation = "full";
+    std::string gyro_model;  // empty: [calibration] gyro_model
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -20,6 +22,11 @@ void register_plan(CLI::App& app) {
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
       ->check(CLI::IsMember({"none", "seed", "full"}));
+  sub->add_option(
+         "--gyro-model", opt->gyro_model,
+         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
+         "misalignments); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -27,6 +34,7 @@ void register_plan(CLI::App& app) {
     CalibrationOptions options;
     options.method = parse_method(opt->method);
     options.compensation = parse_compensation(opt->compensation);
+    options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {
