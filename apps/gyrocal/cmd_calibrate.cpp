@@ -4,6 +4,7 @@
 #include "cli.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/record_check.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -13,6 +14,7 @@ void register_calibrate(CLI::App& app) {
   struct Options {
     std::string record, config, json, method = "least-squares", compensation = "full", estimate,
                                       reduction = "harmonic";
+    std::string gyro_model;  // empty: [calibration] gyro_model
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
@@ -32,6 +34,11 @@ void register_calibrate(CLI::App& app) {
       "--estimate", opt->estimate,
       "Machine errors estimated from the data with the coefficients, NAME[,NAME...] (NAME, NAME_I/_O/_S, "
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
+  sub->add_option(
+         "--gyro-model", opt->gyro_model,
+         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
+         "misalignments); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
@@ -43,6 +50,7 @@ void register_calibrate(CLI::App& app) {
     options.estimate = opt->estimate.empty()
                            ? parse_machine_error_names(s.estimate, "[calibration] estimate")
                            : parse_machine_error_names(split_names(opt->estimate), "--estimate");
+    options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
     options.reduce.method =
         opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
     check_feasible(s, opt->config, options.reduce);

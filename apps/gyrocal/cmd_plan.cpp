@@ -3,6 +3,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -11,6 +12,7 @@ namespace gyrocal::cli {
 void register_plan(CLI::App& app) {
   struct Options {
     std::string config, json, method = "least-squares", compensation = "full", estimate;
+    std::string gyro_model;  // empty: [calibration] gyro_model
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -24,6 +26,11 @@ void register_plan(CLI::App& app) {
       "--estimate", opt->estimate,
       "Machine errors estimated from the data with the coefficients, NAME[,NAME...] (NAME, NAME_I/_O/_S, "
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
+  sub->add_option(
+         "--gyro-model", opt->gyro_model,
+         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
+         "misalignments); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -34,6 +41,7 @@ void register_plan(CLI::App& app) {
     options.estimate = opt->estimate.empty()
                            ? parse_machine_error_names(s.estimate, "[calibration] estimate")
                            : parse_machine_error_names(split_names(opt->estimate), "--estimate");
+    options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {

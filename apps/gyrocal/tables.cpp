@@ -43,6 +43,14 @@ std::string result_table(const CalibrationResult& r) {
   for (std::size_t k = 0; k < kNumCoefficients; ++k)
     out += fmt::format("{:<16} {:>30}  {}\n", kCoefficientNames[k],
                        value_std(r.coefficients[k].value, r.coefficients[k].std), kCoefficientUnits[k]);
+  if (r.gyro_model == GyroModel::kDriftRate) {  // docs/physics.md section 15
+    out += "\nrate errors (gyro model drift+rate)\n";
+    for (std::size_t k = 0; k < kNumRateTerms; ++k)
+      out += fmt::format(
+          "{:<34} {:>30}  {}\n", kRateTermNames[k],
+          value_std(r.rate_terms[k].identifiable ? r.rate_terms[k].value : NAN, r.rate_terms[k].std),
+          kRateTermUnits[k]);
+  }
   if (!r.combinations.empty()) {
     out += "\nidentifiable combinations\n";
     for (const NamedEstimate& c : r.combinations)

@@ -27,6 +27,7 @@ Reduction planned_reduction(const Scenario& s) {
     Dwell d;
     d.is_static = m.kind == SegmentKind::kHold;
     d.planned_rate_rad_s = m.rate_rad_s;
+    d.planned_counter_rate_offset_rad_s = m.counter_rate_offset_rad_s;
     d.beta_rad = d.measured_beta_rad = m.beta_rad;
     d.gammas_rad = d.is_static ? std::vector<double>{m.gamma_rad} : s.test.gamma_rad;
     // The samples t_k = k / fs inside [start, end).
@@ -47,7 +48,9 @@ Reduction planned_reduction(const Scenario& s) {
   for (const Position& p : test_positions(s.test)) {
     for (std::size_t di = 0; di < out.dwells.size(); ++di) {
       const Dwell& d = out.dwells[di];
-      if (d.planned_rate_rad_s != p.rate_rad_s || d.beta_rad != p.beta_rad) continue;
+      if (d.planned_rate_rad_s != p.rate_rad_s || d.beta_rad != p.beta_rad ||
+          d.planned_counter_rate_offset_rad_s != p.counter_rate_offset_rad_s)
+        continue;
       if (d.is_static && d.gammas_rad[0] != p.gamma_rad) continue;
       out.positions.push_back(reduced_position(p, d, static_cast<int>(di)));
       break;
@@ -61,11 +64,18 @@ double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_h
 }
 
 void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& channels,
-                            const DriftCoefficients& truth) {
+                            const DriftCoefficients& truth, const GyroRateErrors& rate_errors) {
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const PositionChannels& ch = channels[i];
     double w = ch.omega_exact_deg_h;
     for (std::size_t k = 0; k < kNumCoefficients; ++k) w += truth.values[k] * ch.regressors_exact[k];
+    if (!rate_errors.is_zero()) {
+      const double e = rate_errors.scale_factor_error_ppm * 1e-6;
+      w += e * ch.omega_exact_deg_h +
+           (1.0 + e) * kArcsecToRad *
+               (rate_errors.input_axis_misalignment_O_arcsec * ch.omega_O_exact_deg_h +
+                rate_errors.input_axis_misalignment_S_arcsec * ch.omega_S_exact_deg_h);
+    }
     r.positions[i].mean_deg_h = w;
   }
 }
@@ -452,7 +462,7 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   // A bounded number of model evaluations per dwell: the prediction's cost does not grow with the test.
   const std::vector<PositionChannels> channels =
       reduce_model_channels(r, model, options.reduce, kMaxModelSamplesPerDwell);
-  set_noise_free_outputs(r, channels, s.gyro);
+  set_noise_free_outputs(r, channels, s.gyro, s.gyro_rate);
   set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz, options.reduce);
   // The predicted outputs are noise-free, so chi2 is ~0 by construction: its test against the degrees of
   // freedom says nothing about a plan and must not warn.

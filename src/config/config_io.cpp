@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <system_error>
 #include <vector>
@@ -41,6 +42,9 @@ constexpr Range kAnyValue{};
 constexpr Range kPositive{0.0, kInf, true};
 constexpr Range kNonNegative{0.0, kInf, false};
 constexpr Range kLatitude{-90.0, 90.0, false};
+/// A gyro's scale-factor error (ppm) or input-axis misalignment (arcsec): within 10 % (1e5 ppm, 5.7 deg),
+/// where the first-order model of docs/physics.md section 15 still describes a gyro.
+constexpr Range kRateError{-1e5, 1e5, false};
 
 /// A number key of section struct S: the file holds member / to_si.
 template <class S>
@@ -404,6 +408,8 @@ void reject_repeats(const Reader& reader, const toml::node& node, const std::str
 /// at the 14 samples per revolution a fit needs exceed the most samples a test may hold
 /// (reduce/feasibility.hpp), which is checked on the whole test before anything is run.
 constexpr Range kSampleRate{0.0, 1e6, true};
+/// Counter rate offsets (docs/physics.md section 15): up to the counter platform's plausible top rate.
+constexpr Range kCounterOffset{-100.0, 100.0, false};
 constexpr std::int64_t kMaxRevolutions = 100000000;
 
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
@@ -426,6 +432,12 @@ void read_test(const Reader& reader, Section& section, TestSpec& test) {
   if (const toml::node* node = section.find("rates_rad_s")) {
     test.rates_rad_s = reader.numbers(*node, section.path("rates_rad_s"), kAnyValue, 0);
     reject_repeats(reader, *node, section.path("rates_rad_s"), test.rates_rad_s, false);
+  }
+  if (const toml::node* node = section.find("counter_rate_offsets_rad_s")) {
+    test.counter_rate_offsets_rad_s =
+        reader.numbers(*node, section.path("counter_rate_offsets_rad_s"), kCounterOffset, 0);
+    reject_repeats(reader, *node, section.path("counter_rate_offsets_rad_s"), test.counter_rate_offsets_rad_s,
+                   false);
   }
   if (const toml::node* node = section.find("seed")) {
     test.seed = static_cast<std::uint64_t>(reader.integer(*node, section.path("seed"), 0, INT64_MAX));
@@ -736,6 +748,14 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   const toml::table* noise_table = gyro.table("noise");
   for (std::size_t i = 0; i < kNumCoefficients; ++i)
     gyro.number(kCoefficientNames[i], 1.0, kAnyValue, s.gyro.values[i]);
+  // docs/physics.md section 15: the scale-factor error and the input axis' tilts toward O and S.
+  gyro.number("scale_factor_error_ppm", 1.0, kRateError, s.gyro_rate.scale_factor_error_ppm);
+  if (const toml::node* node = gyro.find("input_axis_misalignment_arcsec")) {
+    const std::vector<double> v =
+        reader.numbers(*node, gyro.path("input_axis_misalignment_arcsec"), kRateError, 2);
+    s.gyro_rate.input_axis_misalignment_O_arcsec = v[0];
+    s.gyro_rate.input_axis_misalignment_S_arcsec = v[1];
+  }
   gyro.reject_unknown();
   Section noise(reader, noise_table, "gyro.noise");
   read_numbers(noise, kNoiseKeys, s.noise);
@@ -768,6 +788,12 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
       while (!what.empty() && what.back() == '.') what.pop_back();
       reader.fail(node->source(), what);
     }
+  }
+  if (const toml::node* node = calibration.find("gyro_model")) {
+    const std::optional<std::string> text = node->value<std::string>();
+    if (!text || (*text != "drift" && *text != "drift+rate"))
+      reader.fail(node->source(), "calibration.gyro_model must be \"drift\" or \"drift+rate\"");
+    s.gyro_model = *text == "drift" ? GyroModel::kDrift : GyroModel::kDriftRate;
   }
   calibration.reject_unknown();
   if (const toml::table* record_table = top.table("record")) {
@@ -858,6 +884,14 @@ std::string scenario_to_toml(const Scenario& s) {
           std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
   }
 
+  w.key("scale_factor_error_ppm", toml_number(s.gyro_rate.scale_factor_error_ppm),
+        "e: sensed rate (1 + e)(wI + dO wO + dS wS) (physics.md section 15), ppm");
+  w.key(
+      "input_axis_misalignment_arcsec",
+      number_array(
+          {s.gyro_rate.input_axis_misalignment_O_arcsec, s.gyro_rate.input_axis_misalignment_S_arcsec}, 1.0),
+      "[dO, dS]: the input axis tilted toward O and toward S, arcsec");
+
   w.section("gyro.noise", "");
   write_numbers(w, kNoiseKeys, s.noise);
 
@@ -872,6 +906,8 @@ std::string scenario_to_toml(const Scenario& s) {
   w.key("gamma_deg", number_array(t.gamma_rad, kDegToRad), "arm angles read out at each beta, deg");
   w.key("rates_rad_s", number_array(t.rates_rad_s, 1.0),
         "main rates, rad/s; absent = [centrifuge rate_rad_s]");
+  w.key("counter_rate_offsets_rad_s", number_array(t.counter_rate_offsets_rad_s, 1.0),
+        "rate platform: per rate, one set per offset, counter at -rate + offset, rad/s");
   w.key("seed", std::to_string(t.seed), "random seed of the simulation, integer >= 0");
 
   w.section(
@@ -887,6 +923,8 @@ std::string scenario_to_toml(const Scenario& s) {
   w.key("estimate", names + "]",
         "machine errors estimated from the data (--estimate; docs/self_calibration.md): NAME, NAME_I/_O/_S, "
         "NAME:N");
+  w.key("gyro_model", s.gyro_model == GyroModel::kDrift ? "\"drift\"" : "\"drift+rate\"",
+        "\"drift\" or \"drift+rate\" (docs/physics.md section 15)");
   constexpr std::string_view kRecordNote =
       "How to read a rig's own record (docs/contract.md, \"Records\"; docs/records.md). Without a [record]\n"
       "section a record is gyrocal's own format, whose first line is \"# gyrocal-record 1\"; with one (even\n"

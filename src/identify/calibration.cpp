@@ -12,6 +12,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/closed_form.hpp"
 #include "gyrocal/identify/identifiability.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
@@ -111,11 +112,35 @@ Eigen::MatrixXd pooled_position_covariance(const Reduction& r, double floor) {
 void closed_form_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                           const CentrifugeModel& model, const CalibrationOptions& options,
                           CalibrationResult& r) {
+  if (options.gyro_model != GyroModel::kDrift)
+    throw Error(
+        "the closed forms identify the ten drift coefficients only, not the scale-factor error and the input "
+        "axis' misalignments of --gyro-model drift+rate (docs/physics.md section 15): use --method "
+        "least-squares.");
   const std::vector<int> k16 = sixteen_positions(reduction.positions);
   if (k16.empty())
     throw Error(
         "the closed forms need the 16 positions of docs/physics.md section 7 (beta and gamma in {0, 90, 180, "
-        "270} deg at one spinning rate); this plan does not have them: use --method least-squares.");
+        "270} deg at one spinning rate, counter rate offset 0); this plan does not have them: use --method "
+        "least-squares.");
+  if (options.method == Method::kClosedForm && k16.size() < reduction.positions.size()) {
+    // docs/physics.md section 15: the closed forms keep their meaning on the 16 positions at offset 0 alone.
+    std::size_t left_offset = 0, left_other = 0;
+    for (std::size_t i = 0; i < reduction.positions.size(); ++i) {
+      if (std::find(k16.begin(), k16.end(), static_cast<int>(i)) != k16.end()) continue;
+      if (reduction.positions[i].counter_rate_offset_rad_s != 0.0)
+        ++left_offset;
+      else
+        ++left_other;
+    }
+    r.warnings.push_back(fmt::format(
+        "closed form: it uses the 16 positions at {} rad/s with counter rate offset 0 and leaves out the "
+        "other "
+        "{} position{} of the plan ({} at a counter rate offset, {} at other rates, betas or gammas); "
+        "--method least-squares uses them all.",
+        reduction.positions[static_cast<std::size_t>(k16[0])].rate_rad_s, left_offset + left_other,
+        left_offset + left_other == 1 ? "" : "s", left_offset, left_other));
+  }
   std::array<double, 16> w{};
   const Eigen::MatrixXd all = position_covariance(reduction, 0.0);
   Eigen::Matrix<double, 16, 16> se;
@@ -297,15 +322,60 @@ struct ErrorColumnsSolution {
   Eigen::MatrixXd null_space;      ///< the unidentifiable directions of all unknowns, parameter units
   std::vector<std::string> names;  ///< the unknowns' names
 };
+/// docs/physics.md section 15: the misalignments' unknowns carry (1 + e) dO and (1 + e) dS; the factor is
+/// divided out here. Then what the plan makes of the rate errors is said, not assumed: dO is excited only by
+/// the Earth rate's horizontal part, e without counter rate offsets only by the Earth rate.
+void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
+  CoefficientEstimate& e = r.rate_terms[0];
+  CoefficientEstimate& d_o = r.rate_terms[1];
+  CoefficientEstimate& d_s = r.rate_terms[2];
+  const double e_ppm = e.identifiable ? e.value : 0.0;
+  rate_terms_from_solution(e_ppm, d_o.value, d_s.value, d_o.std, d_s.std);
+  bool offsets = false, positive = false, negative = false;
+  for (const ReducedPosition& p : reduction.positions) {
+    offsets |= p.counter_rate_offset_rad_s != 0.0;
+    positive |= p.counter_rate_offset_rad_s > 0.0;
+    negative |= p.counter_rate_offset_rad_s < 0.0;
+  }
+  if (!offsets)
+    r.warnings.push_back(fmt::format(
+        "scale_factor_error_ppm: without counter rate offsets only the Earth rate (at most 15 deg/h) reaches "
+        "the input axis, so the scale-factor error is barely identifiable{}; add offsets of both signs "
+        "([test] "
+        "counter_rate_offsets_rad_s, docs/physics.md section 15).",
+        e.identifiable ? fmt::format(" (standard uncertainty {:.3g} ppm)", e.std) : std::string(" here")));
+  else if (!(positive && negative))
+    r.warnings.push_back(
+        "the counter rate offsets are all of one sign: the scale-factor error and the misalignment toward S "
+        "then separate from the counter rate mismatch and the drift less well than with offsets of both "
+        "signs "
+        "(docs/physics.md section 15).");
+  if (d_o.identifiable)
+    r.warnings.push_back(fmt::format(
+        "input_axis_misalignment_O_arcsec is weakly identifiable (standard uncertainty {:.3g} arcsec): a "
+        "rotation about Up never turns the gyro about O, which stays horizontal, so only the Earth rate's "
+        "horizontal part (about 11 deg/h at 39 deg latitude) reaches it (docs/physics.md section 15).",
+        d_o.std));
+  else
+    r.warnings.push_back(
+        "input_axis_misalignment_O_arcsec is not identifiable from this plan: only the Earth rate's "
+        "horizontal "
+        "part reaches O (a rotation about Up never does), and this plan cannot separate it (docs/physics.md "
+        "section 15).");
+}
 
 void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                             const CentrifugeModel& model, const CalibrationOptions& options,
                             CalibrationResult& r, const ErrorColumns& extra = {},
                             ErrorColumnsSolution* extra_solution = nullptr) {
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
-  const auto nc = static_cast<Eigen::Index>(kNumCoefficients);
-  // The unknowns, in this one place: the ten coefficients, then the estimated machine errors.
+  const Unknowns unknowns = least_squares_unknowns(options.gyro_model);
+  // The unknowns, in this one place: the ten coefficients, the rate terms of the gyro model
+  // (identify/unknowns.hpp), then the estimated machine errors of a self-calibration.
+  const auto nc = static_cast<Eigen::Index>(unknowns.size());
   const auto n = nc + extra.columns.cols();
+  std::vector<std::string> names = unknowns.names;
+  names.insert(names.end(), extra.names.begin(), extra.names.end());
   // Generalised least squares: the positions of one dwell are correlated, so rows and observations are
   // whitened by the Cholesky factor of their covariance and solved with unit (known) weights.
   Eigen::MatrixXd design(m, n);
@@ -313,7 +383,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   for (Eigen::Index i = 0; i < m; ++i) {
     const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
     const PositionChannels& ch = channels[static_cast<std::size_t>(i)];
-    const auto& x = ch.regressors(options.compensation);
+    const std::vector<double> x = design_row(ch, options.compensation, unknowns);
     for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
     for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
     observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
@@ -340,7 +410,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   const Eigen::MatrixXd whitened_design = llt.matrixL().solve(design);
   const CoefficientFit fit =
       fit_coefficients(design.leftCols(nc), whitened_design, llt.matrixL().solve(observations), r.g_level,
-                       reduction.positions, model, io, extra.names);
+                       reduction.positions, model, io, names);
   const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
   r.unknowns = static_cast<int>(n);
@@ -359,10 +429,15 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     warn_few_dof(nu, name, r);
     return std::sqrt(g.dot(covariance * g)) * factor;
   };
-  for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+  for (std::size_t c = 0; c < unknowns.size(); ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
-    if (sol.identifiable[c])
-      r.coefficients[c] = {sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true};
+    if (!sol.identifiable[c]) continue;
+    const CoefficientEstimate estimate = {sol.estimate[ci],
+                                          sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true};
+    if (c < kNumCoefficients)
+      r.coefficients[c] = estimate;
+    else
+      r.rate_terms[c - kNumCoefficients] = estimate;
   }
   if (extra_solution != nullptr) {
     ErrorColumnsSolution& e = *extra_solution;
@@ -380,6 +455,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
       e.std[j] = sandwich_std(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
     }
   }
+  if (options.gyro_model == GyroModel::kDriftRate) state_rate_terms(reduction, r);
   // Residuals in deg/h, not in whitened units.
   const Eigen::VectorXd residuals = observations - design * sol.estimate;
   r.residuals_deg_h.clear();
@@ -587,7 +663,8 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     CalibrationResult trial = base;
     ErrorColumnsSolution es;
     least_squares_identify(reduction, channels, model, options, trial, columns_of(active), &es);
-    const auto nc = static_cast<Eigen::Index>(kNumCoefficients);
+    // The errors' columns follow the gyro model's unknowns (identify/unknowns.hpp).
+    const auto nc = static_cast<Eigen::Index>(least_squares_unknowns(options.gyro_model).size());
     std::size_t drop = k;
     // The last-named unidentifiable error yields first: earlier names take precedence.
     for (std::size_t a = active.size(); a-- > 0 && drop == k;) {
@@ -692,7 +769,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     converged = (converged && settled) || active.empty();
   }
   r.iterations = iteration;
-  const auto nc = static_cast<Eigen::Index>(kNumCoefficients);
+  const auto nc = static_cast<Eigen::Index>(least_squares_unknowns(options.gyro_model).size());
   for (std::size_t a = 0; a < active.size(); ++a) {
     const std::size_t j = active[a];
     const auto ai = static_cast<Eigen::Index>(a);
@@ -775,7 +852,8 @@ std::vector<int> sixteen_positions(const std::vector<ReducedPosition>& positions
       int found = -1;
       for (std::size_t i = 0; i < positions.size(); ++i) {
         const ReducedPosition& p = positions[i];
-        if (p.rate_rad_s == rate && same_angle(p.beta_rad, b) && same_angle(p.gamma_rad, g))
+        if (p.rate_rad_s == rate && p.counter_rate_offset_rad_s == 0.0 && same_angle(p.beta_rad, b) &&
+            same_angle(p.gamma_rad, g))
           found = static_cast<int>(i);
       }
       if (found < 0) return {};
@@ -792,6 +870,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   CalibrationResult r;
   r.method = options.method;
   r.compensation = options.compensation;
+  r.gyro_model = options.gyro_model;
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
   r.data_quality.rows_read = reduction.samples_read;
@@ -833,7 +912,9 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
     if (!sixteen_positions(reduction.positions).empty()) {
       CalibrationResult cf;
       cf.g_level = r.g_level;
-      closed_form_identify(reduction, channels, model, options, cf);
+      CalibrationOptions drift_only = options;
+      drift_only.gyro_model = GyroModel::kDrift;
+      closed_form_identify(reduction, channels, model, drift_only, cf);
       r.alternatives = cf.alternatives;
     }
   }

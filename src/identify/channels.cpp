@@ -25,21 +25,36 @@ std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samp
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                     const ReduceOptions& options,
                                                     std::size_t max_samples_per_dwell) {
-  // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors.
-  constexpr int kColumns = 3 + 2 * static_cast<int>(kNumCoefficients);
+  // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors, then the exact
+  // omega_O and omega_S (deg/h; docs/physics.md section 15).
+  constexpr int kFirstRegressor = 3;
+  constexpr int kOmegaO = kFirstRegressor + 2 * static_cast<int>(kNumCoefficients);
+  constexpr int kColumns = kOmegaO + 2;
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
   for (std::size_t di = 0; di < reduction.dwells.size(); ++di) {
     const Dwell& d = reduction.dwells[di];
-    DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false);
+    // The reducer's operator, the heading's sweep at a counter rate offset included (docs/physics.md 15).
+    const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
+    DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false, sweep);
     double v[kColumns];
     // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always: for the harmonic
     // fit and a static hold's mean, which see the channels' smooth shape; a window holds a few samples only,
     // so window means take every sample.
     std::size_t stride = 1;
-    const bool smooth_operator = d.is_static || options.method == ReduceOptions::Method::kHarmonicFit;
+    // A spinning dwell at a counter rate offset: the Earth rate's horizontal part sweeps with the platform's
+    // heading (docs/physics.md section 15), a term outside the fit's harmonics of gamma, whose projection a
+    // subsample does not reproduce; every sample is evaluated (at rate 0 the heading is gamma's own
+    // harmonic).
+    const bool sweeps = d.planned_counter_rate_offset_rad_s != 0.0 && d.planned_rate_rad_s != 0.0;
+    const bool smooth_operator =
+        !sweeps && (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
     if (smooth_operator && options.model_samples_per_revolution > 0 && d.samples > 1) {
+      // A revolution is one of gamma: of the main axis without an offset, else at the main rate minus the
+      // offset (docs/physics.md section 15).
+      const double gamma_rate =
+          d.planned_counter_rate_offset_rad_s == 0.0 ? d.main.rate_rad_s : -d.counter.rate_rad_s;
       const double per_period = d.is_static ? static_cast<double>(d.samples) / 64.0
-                                            : 2.0 * kPi / std::abs(d.main.rate_rad_s) / d.sample_interval_s /
+                                            : 2.0 * kPi / std::abs(gamma_rate) / d.sample_interval_s /
                                                   static_cast<double>(options.model_samples_per_revolution);
       stride = static_cast<std::size_t>(std::max(1.0, std::floor(per_period)));
       if (!d.is_static && max_samples_per_dwell > 0 && d.samples / stride > max_samples_per_dwell) {
@@ -59,15 +74,18 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       j.counter_rate_rad_s = d.counter.rate_rad_s;
       j.position_angle_rad = d.beta_rad;
       const GyroInputs exact = exact_inputs(model, j);
-      const NominalInputs nominal = nominal_inputs(model, j, false);
+      const double offset = d.planned_counter_rate_offset_rad_s;
+      const NominalInputs nominal = nominal_inputs(model, j, false, offset);
       v[0] = exact.rate_rad_s.x() * kRadPerSecToDegPerHour;
       v[1] = nominal.omega_I_rad_s * kRadPerSecToDegPerHour;
-      v[2] = nominal_inputs(model, j, true).omega_I_rad_s * kRadPerSecToDegPerHour;
+      v[2] = nominal_inputs(model, j, true, offset).omega_I_rad_s * kRadPerSecToDegPerHour;
+      v[kOmegaO] = exact.rate_rad_s.y() * kRadPerSecToDegPerHour;
+      v[kOmegaO + 1] = exact.rate_rad_s.z() * kRadPerSecToDegPerHour;
       const auto re = drift_regressors(exact.specific_force_g);
       const auto rn = drift_regressors(Eigen::Vector3d(nominal.a_I_g, nominal.a_O_g, nominal.a_S_g));
       for (std::size_t k = 0; k < kNumCoefficients; ++k) {
-        v[3 + k] = re[k];
-        v[3 + kNumCoefficients + k] = rn[k];
+        v[kFirstRegressor + k] = re[k];
+        v[kFirstRegressor + kNumCoefficients + k] = rn[k];
       }
       acc.add(t, -j.counter_angle_rad, v);
     };
@@ -102,9 +120,11 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     ch.omega_exact_deg_h = at(0);
     ch.omega_nominal_deg_h = at(1);
     ch.omega_seed_deg_h = at(2);
+    ch.omega_O_exact_deg_h = at(kOmegaO);
+    ch.omega_S_exact_deg_h = at(kOmegaO + 1);
     for (std::size_t k = 0; k < kNumCoefficients; ++k) {
-      ch.regressors_exact[k] = at(3 + static_cast<int>(k));
-      ch.regressors_nominal[k] = at(3 + static_cast<int>(kNumCoefficients + k));
+      ch.regressors_exact[k] = at(kFirstRegressor + static_cast<int>(k));
+      ch.regressors_nominal[k] = at(kFirstRegressor + static_cast<int>(kNumCoefficients + k));
     }
     out.push_back(ch);
   }

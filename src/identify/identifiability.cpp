@@ -35,9 +35,13 @@ std::vector<bool> excited_columns(const MatrixXd& x, double level) {
   std::vector<bool> out(static_cast<std::size_t>(x.cols()), false);
   for (Index i = 0; i < x.rows(); ++i) {
     const double f = std::sqrt(std::max(0.0, x(i, 4) + x(i, 5) + x(i, 6)));
-    for (Index j = 0; j < x.cols(); ++j)
-      if (j == 0 || std::abs(x(i, j)) > level * std::pow(f, degree(j)))
-        out[static_cast<std::size_t>(j)] = true;
+    for (Index j = 0; j < x.cols(); ++j) {
+      // Beyond the ten coefficients (the rate errors, docs/physics.md section 15): any non-zero regressor.
+      const bool excited = j >= static_cast<Index>(kNumCoefficients)
+                               ? x(i, j) != 0.0
+                               : j == 0 || std::abs(x(i, j)) > level * std::pow(f, degree(j));
+      if (excited) out[static_cast<std::size_t>(j)] = true;
+    }
   }
   return out;
 }
@@ -138,6 +142,14 @@ std::string join(const std::vector<std::string>& items, const std::string& last_
   return out;
 }
 
+/// Extra data that might identify a direction: what to add, and its nominal regressor rows.
+struct Candidate {
+  std::string text;
+  MatrixXd rows;
+};
+
+std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& candidates);
+
 /// Which extra data would identify the directions v (parameter units), derived from the plan run: another
 /// speed, a static set, or the missing quarter angles, alone or in pairs.
 std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& positions,
@@ -151,10 +163,6 @@ std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& po
   double spin = 0.0;
   for (double w : rates) spin = std::max(spin, std::abs(w));
   const bool is_static = std::find(rates.begin(), rates.end(), 0.0) != rates.end();
-  struct Candidate {
-    std::string text;
-    MatrixXd rows;
-  };
   std::vector<Candidate> candidates;
   if (spin > 0.0) {
     candidates.push_back({fmt::format("a second speed (another spinning rate, e.g. {:.3g} rad/s)", spin / 2),
@@ -173,6 +181,24 @@ std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& po
   if (!(has_angle(betas, 0) && has_angle(betas, 90) && has_angle(betas, 180) && has_angle(betas, 270)))
     candidates.push_back({"beta at 0, 90, 180 and 270 deg", nominal_rows(model, rates, quarters, gammas)});
 
+  // The rate errors (docs/physics.md section 15) are excited by rates, not by speeds or angles: a direction
+  // that holds one asks for counter rate offsets of both signs.
+  std::string rate_advice;
+  if (v.rows() > static_cast<Index>(kNumCoefficients)) {
+    const MatrixXd rate_part = v.bottomRows(v.rows() - static_cast<Index>(kNumCoefficients));
+    if (rate_part.cwiseAbs().maxCoeff() > 1e-6 * v.cwiseAbs().maxCoeff())
+      rate_advice =
+          " Rate errors need rates about the input axis: counter rate offsets of both signs ([test] "
+          "counter_rate_offsets_rad_s, docs/physics.md section 15); the misalignment toward O only sees the "
+          "Earth rate's horizontal part.";
+  }
+  const MatrixXd drift_part = v.topRows(std::min<Index>(v.rows(), static_cast<Index>(kNumCoefficients)));
+  if (drift_part.cwiseAbs().maxCoeff() <= 1e-6 * std::max(v.cwiseAbs().maxCoeff(), 1e-300))
+    return rate_advice.empty() ? std::string() : rate_advice.substr(1);
+  return advice_for_drift(drift_part, candidates) + rate_advice;
+}
+
+std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& candidates) {
   const int k = static_cast<int>(v.cols());
   std::vector<std::string> alone;
   int best = 0;
@@ -226,14 +252,12 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
                                 const VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
                                 const IdentifiabilityOptions& options,
-                                const std::vector<std::string>& extra_names) {
-  // The unknowns: the ten coefficients, then the estimated machine errors (always active: their excitation
-  // is judged by the self-calibration, identify/calibration.cpp).
-  const Index n = static_cast<Index>(kNumCoefficients + extra_names.size());
-  if (whitened_design.cols() != n)
-    throw Error("fit_coefficients: the design's columns are not the coefficients and the estimated errors.");
-  std::vector<std::string> names(kCoefficientNames.begin(), kCoefficientNames.end());
-  names.insert(names.end(), extra_names.begin(), extra_names.end());
+                                const std::vector<std::string>& names_in) {
+  const Index n = whitened_design.cols();
+  std::vector<std::string> names = names_in;
+  if (names.empty()) names.assign(kCoefficientNames.begin(), kCoefficientNames.end());
+  if (static_cast<Index>(names.size()) != n || n < static_cast<Index>(kNumCoefficients))
+    throw Error("fit_coefficients: one name per column, the ten coefficients first.");
   CoefficientFit out;
   out.excited = excited_columns(regressors, options.min_regressor_level);
   out.excited.resize(static_cast<std::size_t>(n), true);
@@ -282,7 +306,8 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
     for (Index j = 0; j < n; ++j)
       if (std::abs(shown[j]) < 1e-6 * largest) shown[j] = 0.0;
     const bool single = (shown.array() != 0.0).count() == 1;
-    if (single && !out.excited[static_cast<std::size_t>(pivot)]) {
+    if (single && pivot < static_cast<Index>(kNumCoefficients) &&
+        !out.excited[static_cast<std::size_t>(pivot)]) {
       out.direction_texts.push_back(fmt::format("{}: its regressor {} is zero at every position of this plan",
                                                 names[std::size_t(pivot)],
                                                 kRegressorNames[static_cast<std::size_t>(pivot)]));

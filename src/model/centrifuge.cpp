@@ -190,8 +190,9 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
 }
 
 JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,
-                                double time_s) {
-  const double delta_omega = model.errors().counter_rate_mismatch_rad_s;
+                                double time_s, double counter_rate_offset_rad_s) {
+  // docs/physics.md section 15: the commanded offset adds to the servo's rate as the mismatch does.
+  const double delta_omega = model.errors().counter_rate_mismatch_rad_s + counter_rate_offset_rad_s;
   JointState j;
   j.main_angle_rad = model.geometry().initial_main_angle_rad + rate_rad_s * time_s;
   j.main_rate_rad_s = rate_rad_s;
@@ -209,10 +210,12 @@ JointState static_joint_state(const CentrifugeModel& model, double beta_rad, dou
   return j;
 }
 
-double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution) {
-  // gamma(t) = -psi_r(t) = theta0 - psi0 + (omega - delta_omega) t.
-  const double gamma_rate = rate_rad_s - model.errors().counter_rate_mismatch_rad_s;
-  const double t_start = revolution * 2.0 * kPi / std::abs(rate_rad_s);
+double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution,
+                     double counter_rate_offset_rad_s) {
+  // gamma(t) = -psi_r(t) = theta0 - psi0 + (omega - delta_omega - offset) t.
+  const double gamma_rate =
+      rate_rad_s - model.errors().counter_rate_mismatch_rad_s - counter_rate_offset_rad_s;
+  const double t_start = revolution * 2.0 * kPi / std::abs(rate_rad_s - counter_rate_offset_rad_s);
   const double gamma_start =
       model.geometry().initial_main_angle_rad - model.geometry().heading_rad + gamma_rate * t_start;
   const double ahead = gamma_rate > 0 ? gamma_rad - gamma_start : gamma_start - gamma_rad;

@@ -18,4 +18,11 @@ double gyro_output_deg_h(const DriftCoefficients& c, double omega_I_rad_s, const
   return omega_I_rad_s * kRadPerSecToDegPerHour + drift_deg_h(c, f);
 }
 
+double sensed_rate_deg_h(const GyroRateErrors& e, const Eigen::Vector3d& w) {
+  const double scale = 1.0 + e.scale_factor_error_ppm * 1e-6;
+  const double d_o = e.input_axis_misalignment_O_arcsec * kArcsecToRad;
+  const double d_s = e.input_axis_misalignment_S_arcsec * kArcsecToRad;
+  return scale * (w.x() + d_o * w.y() + d_s * w.z()) * kRadPerSecToDegPerHour;
+}
+
 }  // namespace gyrocal

@@ -32,12 +32,14 @@ NominalInputs nominal_inputs(const Site& site, double radius_m, double rate_rad_
   return n;
 }
 
-NominalInputs nominal_inputs(const CentrifugeModel& model, const JointState& j, bool with_seed_terms) {
+NominalInputs nominal_inputs(const CentrifugeModel& model, const JointState& j, bool with_seed_terms,
+                             double counter_rate_offset_rad_s) {
   // The platform's heading from the encoders: psi0 + delta_omega*t while spinning, theta0 - gamma when
   // the main axis is stopped and the platform indexed.
   const double heading = j.main_angle_rad + j.counter_angle_rad;
-  const SeedErrorTerms terms =
+  SeedErrorTerms terms =
       with_seed_terms ? seed_error_terms(model.errors(), j.counter_angle_rad) : SeedErrorTerms{};
+  if (counter_rate_offset_rad_s != 0.0) terms.delta_omega_rad_s += counter_rate_offset_rad_s;
   return nominal_inputs(model.site(), model.geometry().radius_m, j.main_rate_rad_s, heading,
                         j.position_angle_rad, j.gamma_rad(), terms);
 }

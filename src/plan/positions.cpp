@@ -6,8 +6,9 @@ std::vector<Position> test_positions(const TestSpec& test) {
   std::vector<Position> out;
   int index = 1;
   for (double rate : test.rates_rad_s)
-    for (double beta : test.beta_rad)
-      for (double gamma : test.gamma_rad) out.push_back({index++, rate, beta, gamma});
+    for (double offset : test.counter_rate_offsets_rad_s)
+      for (double beta : test.beta_rad)
+        for (double gamma : test.gamma_rad) out.push_back({index++, rate, beta, gamma, offset});
   return out;
 }
 

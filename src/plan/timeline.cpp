@@ -84,6 +84,16 @@ void validate(const TestSpec& test, const CentrifugeModel& model, const MotionLi
     check(std::isfinite(v), "[test] rates_rad_s holds a non-finite value");
   for (const double v : test.beta_rad) check(std::isfinite(v), "[test] beta_deg holds a non-finite value");
   for (const double v : test.gamma_rad) check(std::isfinite(v), "[test] gamma_deg holds a non-finite value");
+  check(!test.counter_rate_offsets_rad_s.empty(), "[test] counter_rate_offsets_rad_s is empty");
+  for (const double o : test.counter_rate_offsets_rad_s) {
+    check(std::isfinite(o), "[test] counter_rate_offsets_rad_s holds a non-finite value");
+    for (const double r : test.rates_rad_s)
+      check(
+          o == 0.0 || r != o,
+          fmt::format("[test] counter_rate_offsets_rad_s holds {} rad/s, equal to a rate: the platform would "
+                      "turn with the arm and gamma would stand still",
+                      o));
+  }
   check(limits.main_accel_rad_s2 > 0.0 && limits.platform_rate_rad_s > 0.0 &&
             limits.platform_accel_rad_s2 > 0.0,
         "the motion limits must be > 0");
@@ -110,32 +120,39 @@ class Builder {
 
     // The test starts in its first position: spinning, or stopped and indexed to the first gamma.
     rate_ = test.rates_rad_s.front();
+    offset_ = test.counter_rate_offsets_rad_s.front();
     main_ = {0.0, model.geometry().initial_main_angle_rad, rate_, 0.0};
+    offset_motion_ = {0.0, 0.0, offset_, 0.0};
     position_ = PlatformMotion::hold(test.beta_rad.front());
-    servoed_ = rate_ != 0.0;
+    servoed_ = rate_ != 0.0 || offset_ != 0.0;
     counter_ = PlatformMotion::hold(-test.gamma_rad.front());
   }
 
   Timeline build() {
     const std::vector<Position> positions = test_positions(test_);
+    const std::size_t n_offset = test_.counter_rate_offsets_rad_s.size();
     const std::size_t n_beta = test_.beta_rad.size();
     const std::size_t n_gamma = test_.gamma_rad.size();
     for (std::size_t i = 0; i < test_.rates_rad_s.size(); ++i) {
       const double rate = test_.rates_rad_s[i];
-      for (std::size_t j = 0; j < n_beta; ++j) {
-        const double beta = test_.beta_rad[j];
-        const std::size_t first = (i * n_beta + j) * n_gamma;
-        if (rate != 0.0) {
-          transition(rate, beta);
-          add(SegmentKind::kSettle, test_.settle_s);
-          measure(SegmentKind::kDwell, revolutions_s(rate), positions[first], 0.0);
-          continue;
-        }
-        for (std::size_t k = 0; k < n_gamma; ++k) {
-          transition(rate, beta);
-          index_counter(-test_.gamma_rad[k]);
-          add(SegmentKind::kSettle, test_.settle_s);
-          measure(SegmentKind::kHold, timeline_.hold_s, positions[first + k], test_.gamma_rad[k]);
+      for (std::size_t o = 0; o < n_offset; ++o) {
+        const double offset = test_.counter_rate_offsets_rad_s[o];
+        for (std::size_t j = 0; j < n_beta; ++j) {
+          const double beta = test_.beta_rad[j];
+          const std::size_t first = ((i * n_offset + o) * n_beta + j) * n_gamma;
+          if (rate != 0.0 || offset != 0.0) {
+            transition(rate, offset, beta);
+            add(SegmentKind::kSettle, test_.settle_s);
+            // Whole revolutions of gamma, which turns at rate - offset (docs/physics.md section 15).
+            measure(SegmentKind::kDwell, revolutions_s(rate - offset), positions[first], 0.0);
+            continue;
+          }
+          for (std::size_t k = 0; k < n_gamma; ++k) {
+            transition(rate, offset, beta);
+            index_counter(-test_.gamma_rad[k]);
+            add(SegmentKind::kSettle, test_.settle_s);
+            measure(SegmentKind::kHold, timeline_.hold_s, positions[first + k], test_.gamma_rad[k]);
+          }
         }
       }
     }
@@ -149,7 +166,7 @@ class Builder {
   /// The counter platform's servo law at t (docs/physics.md section 3), on the current branch.
   double servo_angle(double t) const {
     return -main_at(main_, t).angle_rad + timeline_.psi0_rad + timeline_.counter_rate_mismatch_rad_s * t +
-           servo_offset_rad_;
+           main_at(offset_motion_, t).angle_rad + servo_offset_rad_;
   }
 
   double counter_angle_now() const {
@@ -159,30 +176,43 @@ class Builder {
   void add(SegmentKind kind, double duration_s) {
     if (!(duration_s > 0.0)) return;
     timeline_.segments.push_back(
-        {kind, t_, t_ + duration_s, main_, position_, servoed_, servo_offset_rad_, counter_});
+        {kind, t_, t_ + duration_s, main_, position_, servoed_, servo_offset_rad_, offset_motion_, counter_});
     t_ += duration_s;
   }
 
   void measure(SegmentKind kind, double duration_s, const Position& position, double gamma_rad) {
-    timeline_.measurements.push_back(
-        {kind, position.index, position.rate_rad_s, position.beta_rad, gamma_rad, t_, t_ + duration_s});
+    timeline_.measurements.push_back({kind, position.index, position.rate_rad_s, position.beta_rad, gamma_rad,
+                                      position.counter_rate_offset_rad_s, t_, t_ + duration_s});
     add(kind, duration_s);
   }
 
-  void transition(double rate, double beta) {
+  void transition(double rate, double offset, double beta) {
     if (beta != position_.end_angle_rad) {
       const double from = position_.end_angle_rad;
       position_ = make_move(t_, from, beta, shortest_move_s(beta - from, limits_), limits_);
       add(SegmentKind::kPositionMove, position_.duration_s);
       position_ = PlatformMotion::hold(beta);
     }
-    if (rate == rate_) return;
+    if (rate == rate_ && offset == offset_) return;
     if (!servoed_) engage_counter();
-    const double ramp_s = std::abs(rate - rate_) / limits_.main_accel_rad_s2;
-    main_ = {t_, main_at(main_, t_).angle_rad, rate_, std::copysign(limits_.main_accel_rad_s2, rate - rate_)};
-    add(SegmentKind::kMainRamp, ramp_s);
-    main_ = {t_, main_at(main_, t_).angle_rad, rate, 0.0};
-    rate_ = rate;
+    if (rate != rate_) {
+      const double ramp_s = std::abs(rate - rate_) / limits_.main_accel_rad_s2;
+      main_ = {t_, main_at(main_, t_).angle_rad, rate_,
+               std::copysign(limits_.main_accel_rad_s2, rate - rate_)};
+      add(SegmentKind::kMainRamp, ramp_s);
+      main_ = {t_, main_at(main_, t_).angle_rad, rate, 0.0};
+      rate_ = rate;
+    }
+    if (offset != offset_) {
+      // docs/physics.md section 15: the counter platform changes its rate offset as a platform accelerates;
+      // phi and its rate stay continuous.
+      const double ramp_s = std::abs(offset - offset_) / limits_.platform_accel_rad_s2;
+      offset_motion_ = {t_, main_at(offset_motion_, t_).angle_rad, offset_,
+                        std::copysign(limits_.platform_accel_rad_s2, offset - offset_)};
+      add(SegmentKind::kOffsetRamp, ramp_s);
+      offset_motion_ = {t_, main_at(offset_motion_, t_).angle_rad, offset, 0.0};
+      offset_ = offset;
+    }
   }
 
   /// From rest: the counter platform moves onto its servo law (which drifts at delta omega meanwhile).
@@ -220,7 +250,9 @@ class Builder {
   Timeline timeline_;
   double t_ = 0.0;
   double rate_ = 0.0;
+  double offset_ = 0.0;  ///< the counter rate offset commanded now, rad/s
   MainMotion main_;
+  MainMotion offset_motion_;  ///< phi(t), the servo's integral of the offset
   PlatformMotion position_;
   bool servoed_ = true;
   double servo_offset_rad_ = 0.0;
@@ -248,9 +280,11 @@ JointState joint_state_at(const Timeline& timeline, double time_s) {
   const AngleRate position = platform_at(s.position, t);
   AngleRate counter;
   if (s.counter_servoed) {
+    const AngleRate phi = main_at(s.counter_offset, t);
     counter = {-main.angle_rad + timeline.psi0_rad + timeline.counter_rate_mismatch_rad_s * t +
-                   s.counter_servo_offset_rad,
-               -main.rate_rad_s + timeline.counter_rate_mismatch_rad_s, -main.accel_rad_s2};
+                   phi.angle_rad + s.counter_servo_offset_rad,
+               -main.rate_rad_s + timeline.counter_rate_mismatch_rad_s + phi.rate_rad_s,
+               -main.accel_rad_s2 + phi.accel_rad_s2};
   } else {
     counter = platform_at(s.counter, t);
   }

@@ -60,7 +60,8 @@ bool ReduceOptions::IsValid(std::string* error) const {
 }
 
 DwellAccumulator::DwellAccumulator(const ReduceOptions& options, std::vector<double> gammas_rad,
-                                   bool is_static, int columns, double planned_duration_s, bool with_std_err)
+                                   bool is_static, int columns, double planned_duration_s, bool with_std_err,
+                                   double sweep_rate_rad_s)
     : options_(options),
       gammas_(std::move(gammas_rad)),
       static_(is_static),
@@ -68,6 +69,9 @@ DwellAccumulator::DwellAccumulator(const ReduceOptions& options, std::vector<dou
       duration_s_(planned_duration_s),
       with_std_err_(with_std_err),
       trend_() {
+  // docs/physics.md section 15: the heading's sweep, spinning only (held, the platform does not turn).
+  if (!static_ && sweep_rate_rad_s != 0.0) sweep_scaled_ = sweep_rate_rad_s * duration_s_;
+  trend_.sweep = sweep_scaled_;
   robust_ = with_std_err_ && columns_ == 1 && options_.outlier_threshold > 0.0;
   if (robust_) {
     const int nd = detection_size();
@@ -121,11 +125,11 @@ void DwellAccumulator::basis(double gamma_rad, double t_scaled, double* out) con
 }
 
 int DwellAccumulator::detection_size() const {
-  return static_ ? 2 : 2 * options_.harmonic_order + 2;
+  return static_ ? 2 : 2 * options_.harmonic_order + 2 + (sweep_scaled_ != 0.0 ? 2 : 0);
 }
 
 // The outlier rule's fit: harmonics and a linear drift (a static hold: mean and drift), whatever the
-// reduction.
+// reduction; and the heading's sweep at a counter rate offset (docs/physics.md section 15).
 void DwellAccumulator::detection_basis(double gamma_rad, double t_scaled, double* out) const {
   if (static_) {
     out[0] = 1.0;
@@ -134,6 +138,10 @@ void DwellAccumulator::detection_basis(double gamma_rad, double t_scaled, double
   }
   harmonic_basis(gamma_rad, options_.harmonic_order, out);
   out[2 * options_.harmonic_order + 1] = t_scaled;
+  if (sweep_scaled_ != 0.0) {
+    out[2 * options_.harmonic_order + 2] = std::cos(sweep_scaled_ * (t_scaled + 0.5));
+    out[2 * options_.harmonic_order + 3] = std::sin(sweep_scaled_ * (t_scaled + 0.5));
+  }
 }
 
 void DwellAccumulator::add(double t, double gamma, const double* values) {
@@ -404,6 +412,15 @@ void DwellAccumulator::RevolutionSums::add(double ti, const Eigen::VectorXd& vi)
     vv = Eigen::MatrixXd::Zero(vi.size(), vi.size());
   }
   const Eigen::VectorXd d = vi - v0;
+  if (sweep != 0.0) {
+    if (bb.size() == 0) {
+      bb = Eigen::MatrixXd::Zero(4, 4);
+      bv = Eigen::MatrixXd::Zero(4, vi.size());
+    }
+    const Eigen::Vector4d b(1.0, ti, std::cos(sweep * (ti + 0.5)), std::sin(sweep * (ti + 0.5)));
+    bb += b * b.transpose();
+    bv += b * d.transpose();
+  }
   n += 1;
   t += ti;
   tt += ti * ti;
@@ -415,8 +432,34 @@ void DwellAccumulator::RevolutionSums::add(double ti, const Eigen::VectorXd& vi)
 Eigen::MatrixXd DwellAccumulator::RevolutionSums::covariance_at(double t_mid, bool drift) const {
   // Residual cross products of straight-line fits in time (deviations from the means without drift),
   // divided by the degrees of freedom, times the variance factor of the line's value at t_mid.
-  const double dof = n - (drift ? 2.0 : 1.0);
+  const double dof = n - parameters(drift);
   if (v.size() == 0 || dof < 1.0) return Eigen::MatrixXd::Constant(v.size(), v.size(), kNaN);
+  if (sweep != 0.0) {
+    // The same with the sweep's cos and sin beside the mean (and drift): a general linear fit in time.
+    std::vector<Eigen::Index> keep = {0};
+    if (drift) keep.push_back(1);
+    keep.push_back(2);
+    keep.push_back(3);
+    const auto p = static_cast<Eigen::Index>(keep.size());
+    Eigen::MatrixXd a(p, p), r(p, v.size());
+    Eigen::VectorXd b_mid(p);
+    const Eigen::Vector4d mid(1.0, t_mid, std::cos(sweep * (t_mid + 0.5)), std::sin(sweep * (t_mid + 0.5)));
+    for (Eigen::Index i = 0; i < p; ++i) {
+      const Eigen::Index ki = keep[static_cast<std::size_t>(i)];
+      for (Eigen::Index j = 0; j < p; ++j) a(i, j) = bb(ki, keep[static_cast<std::size_t>(j)]);
+      r.row(i) = bv.row(ki);
+      b_mid[i] = mid[ki];
+    }
+    const auto ldlt = a.ldlt();
+    const Eigen::MatrixXd residual = vv - r.transpose() * ldlt.solve(r);
+    // The scatter is measured about the fit with the sweep; the values it is the level of are the plain
+    // fit's (without the sweep's terms), whose variance factor is that of the mean and drift alone.
+    const Eigen::Index q = drift ? 2 : 1;
+    const Eigen::MatrixXd plain = a.topLeftCorner(q, q);
+    const Eigen::VectorXd b_plain = b_mid.head(q);
+    const Eigen::MatrixXd c = residual / dof * b_plain.dot(plain.ldlt().solve(b_plain));
+    return 0.5 * (c + c.transpose());
+  }
   const double tbar = t / n;
   const Eigen::VectorXd vbar = v / n;
   const double stt = tt - n * tbar * tbar;
@@ -454,7 +497,7 @@ DwellValues DwellAccumulator::finish(int column) {
     // rho has ng^2 / sum(rho^2) times their degrees of freedom (docs/calibration.md).
     const Eigen::VectorXd sd = shape.diagonal().cwiseSqrt();
     const double rho2 = (shape.array() / (sd * sd.transpose()).array()).square().sum();
-    out.dof = (sums.n - (drift ? 2.0 : 1.0)) * static_cast<double>(ng * ng) / rho2;
+    out.dof = (sums.n - sums.parameters(drift)) * static_cast<double>(ng * ng) / rho2;
     const double level = (measured.diagonal().array() / shape.diagonal().array()).mean();
     out.covariance = level * shape;
     out.level = level;

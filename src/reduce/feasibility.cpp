@@ -24,12 +24,14 @@ double planned_test_samples(const TestSpec& test, double reference_rate_rad_s) {
   const double betas = static_cast<double>(test.beta_rad.size());
   const double gammas = static_cast<double>(test.gamma_rad.size());
   double seconds = 0.0;
-  for (double r : test.rates_rad_s) {
-    if (r != 0.0)
-      seconds += betas * (revolutions_s / std::abs(r) + test.settle_s);
-    else
-      seconds += betas * gammas * (revolutions_s / std::abs(reference) + test.settle_s);
-  }
+  for (double r : test.rates_rad_s)
+    for (double o : test.counter_rate_offsets_rad_s) {
+      // A spinning dwell lasts whole revolutions of gamma, which turns at r - o (docs/physics.md section 15).
+      if (r != 0.0 || o != 0.0)
+        seconds += betas * (revolutions_s / std::abs(r - o) + test.settle_s);
+      else
+        seconds += betas * gammas * (revolutions_s / std::abs(reference) + test.settle_s);
+    }
   return seconds * test.sample_rate_hz;
 }
 
@@ -42,15 +44,33 @@ void check_test_feasible(const TestSpec& test, const ReduceOptions& options, dou
           "[test] rates_rad_s holds {} rad/s: a non-zero rate must be at least {} rad/s in magnitude, slower "
           "the record reads as a stopped main axis (use 0 for a static set).",
           r, options.static_rate_tolerance_rad_s));
-    const double per_revolution = test.sample_rate_hz * 2.0 * kPi / std::abs(r);
-    if (per_revolution < needed)
-      throw Error(
-          fmt::format("[test] sample_rate_hz = {} Hz gives {:.3g} samples per revolution at {} rad/s ([test] "
-                      "rates_rad_s); the harmonic fit of order {} needs at least {}: a sample rate of at "
-                      "least {:.4g} Hz.",
-                      test.sample_rate_hz, per_revolution, r, options.harmonic_order, needed,
-                      needed * std::abs(r) / (2.0 * kPi)));
   }
+  for (double r : test.rates_rad_s)
+    for (double o : test.counter_rate_offsets_rad_s) {
+      if (r == 0.0 && o == 0.0) continue;
+      // docs/physics.md section 15: gamma turns at r - o; at r = 0 the platform turns at o alone.
+      if (r == 0.0 && std::abs(o) < options.static_rate_tolerance_rad_s)
+        throw Error(
+            fmt::format("[test] counter_rate_offsets_rad_s holds {} rad/s: at rate 0 a non-zero offset must "
+                        "be at least {} "
+                        "rad/s in magnitude, slower the record reads as a stopped platform.",
+                        o, options.static_rate_tolerance_rad_s));
+      if (std::abs(r - o) < options.static_rate_tolerance_rad_s)
+        throw Error(
+            fmt::format("[test] counter_rate_offsets_rad_s holds {} rad/s at rate {} rad/s: the arm angle "
+                        "gamma would turn "
+                        "at {} rad/s, too slowly for whole revolutions; use an offset at least {} rad/s away "
+                        "from the rate.",
+                        o, r, r - o, options.static_rate_tolerance_rad_s));
+      const double per_revolution = test.sample_rate_hz * 2.0 * kPi / std::abs(r - o);
+      if (per_revolution < needed)
+        throw Error(fmt::format(
+            "[test] sample_rate_hz = {} Hz gives {:.3g} samples per revolution of gamma at {} rad/s ([test] "
+            "rates_rad_s, counter_rate_offsets_rad_s {} rad/s); the harmonic fit of order {} needs at least "
+            "{}: a sample rate of at least {:.4g} Hz.",
+            test.sample_rate_hz, per_revolution, r, o, options.harmonic_order, needed,
+            needed * std::abs(r - o) / (2.0 * kPi)));
+    }
   const double samples = planned_test_samples(test, reference_rate_rad_s);
   if (!(samples <= kMaxTestSamples))
     throw Error(fmt::format(

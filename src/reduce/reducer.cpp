@@ -128,6 +128,13 @@ struct Run {
   DwellQuality quality;
 };
 
+/// The rate at which the platform's heading sweeps the Earth rate through a spinning dwell at a counter rate
+/// offset (docs/physics.md section 15); 0 without an offset, and at rate 0, where the heading turns with
+/// gamma.
+double heading_sweep_rad_s(double rate_rad_s, double offset_rad_s) {
+  return rate_rad_s != 0.0 ? offset_rad_s : 0.0;
+}
+
 }  // namespace
 
 PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, double main_rate_rad_s,
@@ -135,12 +142,39 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
   PlanMatch m;
   const double tol0 = options.static_rate_tolerance_rad_s;
   m.is_static = std::abs(main_rate_rad_s) < tol0 && std::abs(counter_rate_rad_s) < tol0;
+  // docs/physics.md section 15: the platform's heading (theta + psi_r) turns at the counter rate offset; a
+  // plain test has the single offset 0.
+  const double heading_rate = main_rate_rad_s + counter_rate_rad_s;
+  bool has_offset = false;
+  for (double o : plan.counter_rate_offsets_rad_s)
+    if (o != 0.0) has_offset = true;
+  const bool has_static =
+      std::find(plan.rates_rad_s.begin(), plan.rates_rad_s.end(), 0.0) != plan.rates_rad_s.end() &&
+      std::find(plan.counter_rate_offsets_rad_s.begin(), plan.counter_rate_offsets_rad_s.end(), 0.0) !=
+          plan.counter_rate_offsets_rad_s.end();
   if (m.is_static) {
-    if (std::find(plan.rates_rad_s.begin(), plan.rates_rad_s.end(), 0.0) == plan.rates_rad_s.end())
-      m.why_not = "the machine stands still and the plan has no static hold";
+    if (!has_static) m.why_not = "the machine stands still and the plan has no static hold";
   } else if (std::abs(main_rate_rad_s) < tol0) {
-    m.why_not = fmt::format("the main axis stands still while the counter platform turns at {:.6g} rad/s",
-                            counter_rate_rad_s);
+    // At main rate 0 the counter platform turns at the offset alone: a plain rate table.
+    double best = 0.0, best_rel = std::numeric_limits<double>::infinity();
+    const bool has_zero_rate =
+        std::find(plan.rates_rad_s.begin(), plan.rates_rad_s.end(), 0.0) != plan.rates_rad_s.end();
+    if (has_zero_rate)
+      for (double o : plan.counter_rate_offsets_rad_s) {
+        if (o == 0.0) continue;
+        const double rel = std::abs(heading_rate - o) / std::abs(o);
+        if (rel < best_rel) best_rel = rel, best = o;
+      }
+    if (best_rel == std::numeric_limits<double>::infinity())
+      m.why_not = fmt::format("the main axis stands still while the counter platform turns at {:.6g} rad/s",
+                              counter_rate_rad_s);
+    else if (best_rel > options.rate_tolerance)
+      m.why_not = fmt::format(
+          "the main axis stands still and the counter platform turns at {:.6g} rad/s, {:.2e} (relative) from "
+          "the planned counter rate offset {} rad/s (rate_tolerance {:.0e})",
+          counter_rate_rad_s, best_rel, best, options.rate_tolerance);
+    m.planned_rate_rad_s = 0.0;
+    m.planned_counter_rate_offset_rad_s = best;
   } else {
     double best = -1.0, best_rel = std::numeric_limits<double>::infinity();
     for (double r : plan.rates_rad_s) {
@@ -155,11 +189,26 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
           "the main axis turns at {:.6g} rad/s, {:.2e} (relative) from the planned {} rad/s "
           "(rate_tolerance {:.0e})",
           main_rate_rad_s, best_rel, best, options.rate_tolerance);
-    } else if (std::abs(counter_rate_rad_s + main_rate_rad_s) >
-               options.rate_tolerance * std::abs(main_rate_rad_s)) {
-      m.why_not =
-          fmt::format("the counter platform turns at {:.6g} rad/s, not at minus the main rate {:.6g} rad/s",
-                      counter_rate_rad_s, main_rate_rad_s);
+    } else {
+      // The planned offset nearest the heading's rate, within rate_tolerance of the larger of |rate| and
+      // |offset| (docs/rate_platform.md).
+      double best_o = 0.0, best_d = std::numeric_limits<double>::infinity();
+      for (double o : plan.counter_rate_offsets_rad_s) {
+        const double d = std::abs(heading_rate - o) / std::max(std::abs(best), std::abs(o));
+        if (d < best_d) best_d = d, best_o = o;
+      }
+      if (best_d > options.rate_tolerance) {
+        if (!has_offset)
+          m.why_not = fmt::format(
+              "the counter platform turns at {:.6g} rad/s, not at minus the main rate {:.6g} rad/s",
+              counter_rate_rad_s, main_rate_rad_s);
+        else
+          m.why_not = fmt::format(
+              "the counter platform turns at {:.6g} rad/s, {:.6g} rad/s relative to minus the main rate "
+              "{:.6g} rad/s, which matches no planned counter rate offset",
+              counter_rate_rad_s, heading_rate, main_rate_rad_s);
+      }
+      m.planned_counter_rate_offset_rad_s = best_o;
     }
     m.planned_rate_rad_s = best;
   }
@@ -253,6 +302,7 @@ struct Reducer::State {
     const double beta = median_of(betas);
     for (double b : betas)
       if (std::abs(wrap_deg(b - beta)) > options.beta_tolerance_deg) return;
+    if (offset_ramp(th.rate * kDegToRad, ps.rate * kDegToRad)) return;
     // Steady: the run begins at the earliest row before the window that still lies on its lines as closely as
     // the window's own rows do (twice their largest residual, and beta within their spread): the end of a
     // ramp or a move is not taken in.
@@ -273,6 +323,38 @@ struct Reducer::State {
     // follow() unwraps against the run's lines: the rows' readings as the record gave them.
     for (Row& q : rows_of_run) q.theta = wrap_deg(q.theta), q.psi = wrap_deg(q.psi);
     for (const Row& q : rows_of_run) take(q);
+  }
+
+  /// docs/rate_platform.md: in a plan with counter rate offsets, a window whose main axis is at a planned
+  /// rate (or stopped) while the platform's heading (theta + psi_r) turns at no planned offset is an offset
+  /// ramp or an index move, whose 20 deg/s^2 bends a window's line less than angle_tolerance_deg: no run
+  /// starts there, so that the dwell after it is found from the ramp's end (a run started inside the ramp is
+  /// matched on its last window, which still holds the ramp, and would be refused). A plain plan (the single
+  /// offset 0) is not affected: there such a window starts a run, refused with its reason. The heading is
+  /// held to rate_steadiness here, the tolerance the run's later windows must keep.
+  bool offset_ramp(double main_rate_rad_s, double counter_rate_rad_s) const {
+    bool has_offset = false;
+    for (double o : plan.counter_rate_offsets_rad_s)
+      if (o != 0.0) has_offset = true;
+    if (!has_offset) return false;
+    const double tol0 = options.static_rate_tolerance_rad_s;
+    const bool main_stopped = std::abs(main_rate_rad_s) < tol0;
+    if (main_stopped && std::abs(counter_rate_rad_s) < tol0) return false;  // a static hold
+    const double heading = main_rate_rad_s + counter_rate_rad_s;
+    for (double r : plan.rates_rad_s) {
+      const bool main_at_r =
+          r == 0.0 ? main_stopped : std::abs(main_rate_rad_s - r) <= options.rate_tolerance * std::abs(r);
+      if (!main_at_r) continue;
+      for (double o : plan.counter_rate_offsets_rad_s) {
+        if (r == 0.0 && o == 0.0) continue;
+        // Within rate_steadiness, the tolerance the run's windows are then held to (a window still holding
+        // the ramp's end would start a run whose next window ends it).
+        if (std::abs(heading - o) <= options.rate_steadiness * std::max(std::abs(r), std::abs(o)))
+          return false;
+      }
+      return true;
+    }
+    return false;
   }
 
   void take(const Row& raw) {
@@ -306,11 +388,13 @@ struct Reducer::State {
                             r.gamma_deg);
     r.matched = r.match.why_not.empty();
     if (!r.matched) return;
-    r.planned_duration = r.match.is_static
-                             ? hold_duration()
-                             : plan.revolutions * 2.0 * kPi / std::abs(r.match.planned_rate_rad_s);
+    // A spinning dwell: whole revolutions of gamma, which turns at rate - offset (docs/physics.md section
+    // 15).
+    const double rate = r.match.planned_rate_rad_s, offset = r.match.planned_counter_rate_offset_rad_s;
+    r.planned_duration =
+        r.match.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate - offset);
     r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad,
-                  r.match.is_static, 1, r.planned_duration, true);
+                  r.match.is_static, 1, r.planned_duration, true, heading_sweep_rad_s(rate, offset));
   }
 
   // ---- Following a steady run -----------------------------------------------------------------------
@@ -387,7 +471,11 @@ struct Reducer::State {
     r.block_psi.add(t - r.block_t0, u.psi - r.block_psi0);
     if (t - r.block_t0 >= options.window_s && r.block_theta.n >= 8) {
       const double rt = r.block_theta.sty() / r.block_theta.stt(), rp = r.block_psi.sty() / r.block_psi.stt();
-      const double scale = std::max(std::abs(r.rate_theta), options.static_rate_tolerance_rad_s * kRadToDeg);
+      // Relative to the main rate; with the main axis stopped, to the platform's (a rate table at main rate
+      // 0, docs/physics.md section 15; a static hold: the stopped tolerance).
+      const double tol0_deg = options.static_rate_tolerance_rad_s * kRadToDeg;
+      const double scale = std::abs(r.rate_theta) >= tol0_deg ? std::abs(r.rate_theta)
+                                                              : std::max(std::abs(r.rate_psi), tol0_deg);
       const double change = std::max(std::abs(rt - r.rate_theta), std::abs(rp - r.rate_psi)) / scale;
       if (!r.decided) {
         r.rate_theta = rt;
@@ -467,8 +555,10 @@ struct Reducer::State {
     r.prev_y = y_theta;
     r.prev_tt = tt;
     r.phase_theta.back().add(tt, y_theta);
-    r.phase_psi.back().add(tt, u.psi - r.psi_first + planned_turn);
-    r.phase_rel.back().add(tt, u.psi - r.psi_first + u.theta - r.theta_first);
+    // The heading (psi_r + theta) turns at the planned counter rate offset (docs/physics.md section 15).
+    const double offset_turn = r.match.planned_counter_rate_offset_rad_s * kRadToDeg * tt;
+    r.phase_psi.back().add(tt, u.psi - r.psi_first + planned_turn - offset_turn);
+    r.phase_rel.back().add(tt, u.psi - r.psi_first + u.theta - r.theta_first - offset_turn);
     r.beta_sum += u.beta;
     ++r.n;
     // The arm angle of the fit's basis from the line of the last window (smooth: a reading quantised to 0.1
@@ -534,6 +624,7 @@ struct Reducer::State {
     Dwell d;
     d.is_static = r.match.is_static;
     d.planned_rate_rad_s = r.match.planned_rate_rad_s;
+    d.planned_counter_rate_offset_rad_s = r.match.planned_counter_rate_offset_rad_s;
     d.measured_beta_rad = r.beta_sum / static_cast<double>(r.n) * kDegToRad;
     // The channels take the plan's beta (and a static hold's gamma): an encoder's mean reading at rest is
     // biased by up to half a count (docs/calibration.md).
@@ -572,12 +663,15 @@ struct Reducer::State {
       res_p += std::max(r.phase_psi[k].syy() - bp * r.phase_psi[k].sty(), 0.0);
     }
     const double planned_deg_s = r.match.planned_rate_rad_s * kRadToDeg;
+    // The counter platform turns at -rate + offset relative to the arm (docs/physics.md section 15).
+    const double planned_counter_deg_s =
+        -planned_deg_s + r.match.planned_counter_rate_offset_rad_s * kRadToDeg;
     const auto intercept = [&](const LineSums& s, double b) { return (s.y - b * s.t) / s.n; };
     const double nd = static_cast<double>(r.n);
     d.main = {(r.theta_first + intercept(r.phase_theta[0], bt)) * kDegToRad, (planned_deg_s + bt) * kDegToRad,
               std::sqrt(res_t / nd) * kDegToRad};
-    d.counter = {(r.psi_first + intercept(r.phase_psi[0], bp)) * kDegToRad, (-planned_deg_s + bp) * kDegToRad,
-                 std::sqrt(res_p / nd) * kDegToRad};
+    d.counter = {(r.psi_first + intercept(r.phase_psi[0], bp)) * kDegToRad,
+                 (planned_counter_deg_s + bp) * kDegToRad, std::sqrt(res_p / nd) * kDegToRad};
     double span = 0.0;
     std::size_t steps = 0;
     for (const StretchSums& st : r.stretches) {
@@ -589,7 +683,8 @@ struct Reducer::State {
       ts.main_at_first_rad =
           (r.theta_first + intercept(r.phase_theta[st.phase], bt) + (planned_deg_s + bt) * tt) * kDegToRad;
       ts.counter_at_first_rad =
-          (r.psi_first + intercept(r.phase_psi[st.phase], bp) + (-planned_deg_s + bp) * tt) * kDegToRad;
+          (r.psi_first + intercept(r.phase_psi[st.phase], bp) + (planned_counter_deg_s + bp) * tt) *
+          kDegToRad;
       d.stretches.push_back(ts);
       span += st.last - st.first;
       steps += st.count - 1;
@@ -599,7 +694,10 @@ struct Reducer::State {
     const std::string what =
         d.is_static ? fmt::format("static hold at beta {:.4f} deg, gamma {:.4f} deg", beta_deg,
                                   d.gammas_rad[0] * kRadToDeg)
-                    : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
+        : d.planned_counter_rate_offset_rad_s != 0.0
+            ? fmt::format("dwell at {} rad/s, counter rate offset {} rad/s, beta {:.4f} deg",
+                          d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, beta_deg)
+            : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
     d.gyro = r.acc->finish(0);
     // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
     // at which clean noise reaches the rule's threshold).
@@ -630,7 +728,7 @@ struct Reducer::State {
                       "beyond its sample-to-sample scatter.",
                       at(d.first_time_s), what, wander_deg));
     }
-    if (!d.is_static) {
+    if (!d.is_static && d.planned_rate_rad_s != 0.0) {
       const double rel = std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) / std::abs(d.planned_rate_rad_s);
       if (rel > 1e-4) {
         ++offset_dwells;
@@ -645,10 +743,15 @@ struct Reducer::State {
     const RejectedRun* best = nullptr;
     int best_rank = 0;
     for (const RejectedRun& x : rejected) {
-      const bool is_static = p.rate_rad_s == 0.0;
+      const bool is_static = p.rate_rad_s == 0.0 && p.counter_rate_offset_rad_s == 0.0;
       if (x.is_static != is_static) continue;
       const double db = std::abs(wrap_deg(x.beta_deg - p.beta_rad * kRadToDeg));
-      const double dr = is_static ? 0.0 : std::abs(x.main_rate_rad_s - p.rate_rad_s) / std::abs(p.rate_rad_s);
+      // A rate table at main rate 0 (docs/physics.md section 15): the main axis' rate against the stopped
+      // tolerance.
+      const double dr = is_static ? 0.0
+                        : p.rate_rad_s == 0.0
+                            ? (std::abs(x.main_rate_rad_s) < options.static_rate_tolerance_rad_s ? 0.0 : 1.0)
+                            : std::abs(x.main_rate_rad_s - p.rate_rad_s) / std::abs(p.rate_rad_s);
       const double dg = is_static ? std::abs(wrap_deg(x.gamma_deg - p.gamma_rad * kRadToDeg)) : 0.0;
       if (db > 5.0 || dr > 0.05 || dg > 5.0) continue;
       const int rank = (db <= options.beta_tolerance_deg ? 2 : 0) + (dr <= options.rate_tolerance ? 1 : 0);
@@ -707,10 +810,12 @@ Reduction Reducer::finish() {
                     "are used.",
                     st.source, st.offset_dwells, st.offset_dwells > 1 ? "s" : "", st.worst_rate_offset));
   // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several.
-  std::map<std::tuple<double, double, double>, int> chosen;
+  // The key of a dwell: rate, counter rate offset (docs/physics.md section 15), beta and a hold's gamma.
+  std::map<std::tuple<double, double, double, double>, int> chosen;
   for (std::size_t i = 0; i < st.dwells.size(); ++i) {
     const Dwell& d = st.dwells[i];
-    const auto key = std::make_tuple(d.planned_rate_rad_s, d.beta_rad, d.is_static ? d.gammas_rad[0] : 0.0);
+    const auto key = std::make_tuple(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, d.beta_rad,
+                                     d.is_static ? d.gammas_rad[0] : 0.0);
     auto it = chosen.find(key);
     if (it == chosen.end()) {
       chosen[key] = static_cast<int>(i);
@@ -739,12 +844,17 @@ Reduction Reducer::finish() {
             [](const RejectedRun& a, const RejectedRun& b) { return a.start_s < b.start_s; });
   std::vector<std::string> missing;
   for (const Position& p : test_positions(st.plan)) {
-    const auto key = std::make_tuple(p.rate_rad_s, p.beta_rad, p.rate_rad_s == 0.0 ? p.gamma_rad : 0.0);
+    const bool is_static = p.rate_rad_s == 0.0 && p.counter_rate_offset_rad_s == 0.0;
+    const auto key =
+        std::make_tuple(p.rate_rad_s, p.counter_rate_offset_rad_s, p.beta_rad, is_static ? p.gamma_rad : 0.0);
     const auto it = chosen.find(key);
     if (it == chosen.end()) {
-      missing.push_back(fmt::format("position {} (rate {} rad/s, beta {} deg, gamma {} deg): {}", p.index,
-                                    p.rate_rad_s, p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg,
-                                    st.why_missing(p)));
+      missing.push_back(
+          fmt::format("position {} (rate {} rad/s, {}beta {} deg, gamma {} deg): {}", p.index, p.rate_rad_s,
+                      p.counter_rate_offset_rad_s != 0.0
+                          ? fmt::format("counter rate offset {} rad/s, ", p.counter_rate_offset_rad_s)
+                          : std::string(),
+                      p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg, st.why_missing(p)));
       continue;
     }
     const int di = renumber[it->second];
@@ -763,7 +873,13 @@ Reduction Reducer::finish() {
   int zero = 0;
   for (const Dwell& d : out.dwells) {
     if (d.gyro.dof > 0.0) continue;
-    const int needed = d.is_static ? 2 : (st.options.linear_drift ? 3 : 2);
+    // The scatter is about a mean (and a drift), and at a counter rate offset also the heading's sweep.
+    const int needed =
+        d.is_static
+            ? 2
+            : (st.options.linear_drift ? 3 : 2) +
+                  (heading_sweep_rad_s(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s) != 0.0 ? 2
+                                                                                                         : 0);
     throw Error(fmt::format(
         "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
         "error from the scatter between them; it needs at least {}{}.",
@@ -795,6 +911,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.rate_rad_s = p.rate_rad_s;
   rp.beta_rad = p.beta_rad;
   rp.gamma_rad = p.gamma_rad;
+  rp.counter_rate_offset_rad_s = p.counter_rate_offset_rad_s;
   rp.mean_deg_h = d.gyro.value[k];
   rp.std_err_deg_h = d.gyro.std_err[k];
   rp.samples = d.gyro.samples[k];

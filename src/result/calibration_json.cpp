@@ -32,6 +32,16 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
         {"unit", kCoefficientUnits[k]},
         {"identifiable", c.identifiable}};
   }
+  // docs/physics.md section 15: with drift+rate the rate errors are coefficients too.
+  if (r.gyro_model == GyroModel::kDriftRate)
+    for (std::size_t k = 0; k < kNumRateTerms; ++k) {
+      const CoefficientEstimate& c = r.rate_terms[k];
+      coefficients[std::string(kRateTermNames[k])] = {
+          {"value", c.identifiable ? number_or_null(c.value) : nlohmann::json(nullptr)},
+          {"std", c.identifiable ? number_or_null(c.std) : nlohmann::json(nullptr)},
+          {"unit", kRateTermUnits[k]},
+          {"identifiable", c.identifiable}};
+    }
   j["coefficients"] = coefficients;
   j["combinations"] = nlohmann::json::array();
   for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
@@ -48,11 +58,13 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
                         {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
                         {"samples", p.samples},
                         {"outliers", p.outliers}};
+    if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
     if (i < r.residuals_deg_h.size()) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
     j["positions"].push_back(e);
   }
   j["method"] = to_string(r.method);
   j["compensation"] = to_string(r.compensation);
+  j["gyro_model"] = r.gyro_model == GyroModel::kDrift ? "drift" : "drift+rate";
   j["g_level"] = r.g_level;
   j["warnings"] = r.warnings;
   j["rank"] = r.rank;
@@ -132,18 +144,24 @@ nlohmann::json plan_to_json(const TestSpec& t) {
     return a;
   };
   nlohmann::json positions = nlohmann::json::array();
-  for (const Position& p : test_positions(t))
-    positions.push_back({{"index", p.index},
-                         {"beta_deg", p.beta_rad * kRadToDeg},
-                         {"gamma_deg", p.gamma_rad * kRadToDeg},
-                         {"rate_rad_s", p.rate_rad_s}});
-  return {{"sample_rate_hz", t.sample_rate_hz},
-          {"revolutions", t.revolutions},
-          {"settle_s", t.settle_s},
-          {"beta_deg", deg(t.beta_rad)},
-          {"gamma_deg", deg(t.gamma_rad)},
-          {"rates_rad_s", t.rates_rad_s},
-          {"positions", positions}};
+  for (const Position& p : test_positions(t)) {
+    nlohmann::json e = {{"index", p.index},
+                        {"beta_deg", p.beta_rad * kRadToDeg},
+                        {"gamma_deg", p.gamma_rad * kRadToDeg},
+                        {"rate_rad_s", p.rate_rad_s}};
+    if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
+    positions.push_back(e);
+  }
+  nlohmann::json j = {{"sample_rate_hz", t.sample_rate_hz},
+                      {"revolutions", t.revolutions},
+                      {"settle_s", t.settle_s},
+                      {"beta_deg", deg(t.beta_rad)},
+                      {"gamma_deg", deg(t.gamma_rad)},
+                      {"rates_rad_s", t.rates_rad_s},
+                      {"positions", positions}};
+  if (t.counter_rate_offsets_rad_s != std::vector<double>{0.0})
+    j["counter_rate_offsets_rad_s"] = t.counter_rate_offsets_rad_s;
+  return j;
 }
 
 }  // namespace gyrocal

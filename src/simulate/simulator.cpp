@@ -52,8 +52,10 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
     sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
     sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
     sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
-    sample.gyro_deg_h =
-        noise.next(gyro_output_deg_h(scenario.gyro, inputs.rate_rad_s.x(), inputs.specific_force_g));
+    // docs/physics.md sections 6 and 15: the sensed rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the
+    // drift; with no rate errors the sensed rate is omega_I bit for bit.
+    sample.gyro_deg_h = noise.next(sensed_rate_deg_h(scenario.gyro_rate, inputs.rate_rad_s) +
+                                   drift_deg_h(scenario.gyro, inputs.specific_force_g));
     sink(sample);
     if (options.progress && (k + 1) % kProgressEverySamples == 0) {
       options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
@@ -96,6 +98,17 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
   };
   for (std::size_t i = 0; i < kNumCoefficients; ++i) {
     m.emplace_back(fmt::format("truth_{}", kCoefficientNames[i]), fmt::format("{}", scenario.gyro.values[i]));
+  }
+  // The rate-platform method (docs/physics.md section 15), written only where it is used, so that a plain
+  // test's record is what it always was.
+  if (test.counter_rate_offsets_rad_s != std::vector<double>{0.0})
+    m.emplace_back("counter_rate_offsets_rad_s", list(test.counter_rate_offsets_rad_s, 1.0));
+  if (!scenario.gyro_rate.is_zero()) {
+    const GyroRateErrors& e = scenario.gyro_rate;
+    const double values[kNumRateTerms] = {e.scale_factor_error_ppm, e.input_axis_misalignment_O_arcsec,
+                                          e.input_axis_misalignment_S_arcsec};
+    for (std::size_t i = 0; i < kNumRateTerms; ++i)
+      m.emplace_back(fmt::format("truth_{}", kRateTermNames[i]), fmt::format("{}", values[i]));
   }
   return m;
 }

@@ -19,9 +19,10 @@ Reduction planned_reduction(const Scenario& scenario);
 double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_hz);
 
 /// Set each position's mean_deg_h to its noise-free reduced output for `truth`:
-/// reduce(omega_I exact) + sum_j truth_j reduce(x_j exact).
+/// reduce(omega_I exact) + sum_j truth_j reduce(x_j exact), and with rate errors (docs/physics.md section 15)
+/// e reduce(omega_I) + (1 + e)(dO reduce(omega_O) + dS reduce(omega_S)).
 void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
-                            const DriftCoefficients& truth);
+                            const DriftCoefficients& truth, const GyroRateErrors& rate_errors = {});
 
 /// gamma x gamma: the covariance of a planned dwell's reduced values per unit variance of white noise on each
 /// sample (DwellAccumulator::white_noise_covariance of its samples). Harmonic fit: in closed form from the

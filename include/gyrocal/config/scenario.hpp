@@ -17,8 +17,11 @@ namespace gyrocal {
 struct Scenario {
   Site site;
   CentrifugeGeometry centrifuge;
-  CentrifugeErrors errors;       ///< [centrifuge.errors]
-  DriftCoefficients gyro;        ///< [gyro]: the truth, for simulation
+  CentrifugeErrors errors;   ///< [centrifuge.errors]
+  DriftCoefficients gyro;    ///< [gyro]: the truth, for simulation
+  GyroRateErrors gyro_rate;  ///< [gyro] scale factor and input-axis misalignment: the truth, for simulation
+  /// [calibration] gyro_model: the gyro model identification fits unless the command line says otherwise.
+  GyroModel gyro_model = GyroModel::kDrift;
   GyroNoise noise;               ///< [gyro.noise]
   TestSpec test;                 ///< [test]
   CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)

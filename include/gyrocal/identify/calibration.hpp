@@ -21,8 +21,10 @@ enum class Method { kClosedForm, kLeastSquares };
 struct CalibrationOptions {
   Method method = Method::kLeastSquares;            ///< default: least squares, any plan
   Compensation compensation = Compensation::kFull;  ///< default: every configured machine error
-  ReduceOptions reduce;                             ///< how dwells are reduced
-  LeastSquaresOptions least_squares;                ///< the solver's options
+  /// default: the ten drift coefficients; drift+rate adds the rate errors (docs/physics.md section 15).
+  GyroModel gyro_model = GyroModel::kDrift;
+  ReduceOptions reduce;               ///< how dwells are reduced
+  LeastSquaresOptions least_squares;  ///< the solver's options
   /// Reduced positions whose standard error is below this (a noise-free record) are weighted with it,
   /// deg/h. Default 1e-9.
   double min_std_err_deg_h = 1e-9;
@@ -125,8 +127,11 @@ struct DataQuality {
 struct CalibrationResult {
   Method method = Method::kLeastSquares;
   Compensation compensation = Compensation::kFull;
+  GyroModel gyro_model = GyroModel::kDrift;
   double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
   std::array<CoefficientEstimate, kNumCoefficients> coefficients;
+  /// With drift+rate: e (ppm), dO, dS (arcsec) in kRateTermNames order (docs/physics.md section 15).
+  std::array<CoefficientEstimate, kNumRateTerms> rate_terms;
   std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
   std::vector<NamedEstimate> alternatives;  ///< closed form's second expressions (dI_1g, ...)
   std::vector<ReducedPosition> positions;   ///< the reduced positions
@@ -170,8 +175,9 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
                                    const TestSpec& plan, const CalibrationOptions& options,
                                    const std::optional<RecordLayout>& layout = std::nullopt);
 
-/// The 16 positions of docs/physics.md section 7 in the plan, at its first spinning rate: for k = 1..16 the
-/// index into reduction.positions, or an empty vector when the plan does not hold them.
+/// The 16 positions of docs/physics.md section 7 in the plan, at its first spinning rate and counter rate
+/// offset 0: for k = 1..16 the index into reduction.positions, or an empty vector when the plan does not
+/// hold them.
 std::vector<int> sixteen_positions(const std::vector<ReducedPosition>& positions);
 
 }  // namespace gyrocal

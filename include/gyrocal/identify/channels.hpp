@@ -23,6 +23,10 @@ struct PositionChannels {
   double omega_exact_deg_h = 0.0;    ///< omega_I of the exact model, deg/h
   double omega_nominal_deg_h = 0.0;  ///< omega_I of section 5 for a perfect machine, deg/h
   double omega_seed_deg_h = 0.0;     ///< omega_I of section 5 with the seed's k1, k2, dw, deg/h
+  /// omega_O and omega_S of the exact model, deg/h: what the input axis' misalignments toward O and S sense
+  /// (docs/physics.md section 15).
+  double omega_O_exact_deg_h = 0.0;
+  double omega_S_exact_deg_h = 0.0;
   std::array<double, kNumCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
   std::array<double, kNumCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
 

@@ -44,14 +44,17 @@ struct IdentifiabilityOptions {
 /// regressors: m x 10, the unwhitened regressors of each position (g units); whitened_design and
 /// whitened_observations: the same rows whitened by the positions' covariance. ar: the radial level of
 /// the first spinning rate (g), for docs/physics.md section 8's named combinations. positions and model: the
-/// plan actually run, for the advice. extra_names: the estimated machine errors (self-calibration), whose
-/// columns follow the ten coefficients' in whitened_design (the unknowns: coefficients, then errors); the
-/// solution then has 10 + extra_names.size() parameters.
+/// plan actually run, for the advice.
+/// names: one per column (identify/unknowns.hpp): the ten coefficients first, then any further unknowns (the
+/// rate errors of docs/physics.md section 15), which count as excited wherever their regressor is not zero;
+/// empty = the ten coefficients.
+/// Columns beyond `regressors`' (the estimated machine errors of a self-calibration, which follow the
+/// coefficients and rate terms) count as excited: their excitation is judged by the self-calibration.
 CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::MatrixXd& whitened_design,
                                 const Eigen::VectorXd& whitened_observations, double ar,
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
                                 const IdentifiabilityOptions& options,
-                                const std::vector<std::string>& extra_names = {});
+                                const std::vector<std::string>& names = {});
 
 /// Rows brought to reduced row echelon form with pivots taken in `order` (column indices); each pivot is 1.
 /// A column whose largest remaining entry is at most `tolerance` times the largest entry of `rows` gives no

@@ -139,16 +139,22 @@ class CentrifugeModel {
 GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
-/// theta = theta0 + omega*t, psi_r = -theta + psi0 + delta_omega*t (docs/physics.md section 3).
+/// theta = theta0 + omega*t, psi_r = -theta + psi0 + (delta_omega + offset)*t (docs/physics.md sections 3
+/// and 15). offset: the counter platform's commanded rate offset (the rate-platform method, rad/s): it turns
+/// at -omega + offset relative to the arm, so the platform's heading turns at offset (plus delta omega);
+/// omega = 0 with an offset is a plain rate table.
 JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,
-                                double time_s);
+                                double time_s, double counter_rate_offset_rad_s = 0.0);
 
 /// Joint state with the main axis stopped at theta0 and the counter-rotating platform indexed so that
 /// gamma = gamma_rad (psi_r = -gamma), position beta (rad). All rates zero.
 JointState static_joint_state(const CentrifugeModel& model, double beta_rad, double gamma_rad);
 
-/// The time (s) at which gamma = gamma_rad during revolution `revolution` (0-based) of the main axis of a
-/// spinning dwell at rate omega != 0 started at t = 0: the first such t >= revolution * 2*pi/|omega|.
-double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution);
+/// The time (s) at which gamma = gamma_rad during revolution `revolution` (0-based) of a spinning dwell at
+/// rate omega and counter rate offset (spinning_joint_state) started at t = 0: the first such t >=
+/// revolution * 2*pi/|omega - offset|, a revolution being one of gamma (with no offset: of the main axis).
+/// gamma must turn: omega - delta_omega - offset != 0.
+double time_at_gamma(const CentrifugeModel& model, double rate_rad_s, double gamma_rad, int revolution,
+                     double counter_rate_offset_rad_s = 0.0);
 
 }  // namespace gyrocal

@@ -38,6 +38,34 @@ double drift_deg_h(const DriftCoefficients& coefficients, const Eigen::Vector3d&
 double gyro_output_deg_h(const DriftCoefficients& coefficients, double omega_I_rad_s,
                          const Eigen::Vector3d& specific_force_g);
 
+/// The gyro's rate errors (docs/physics.md section 15): the sensed rate is (1 + e) (omega_I + dO omega_O +
+/// dS omega_S), e the scale-factor error and dO, dS the input axis tilted toward O and toward S. All zero =
+/// the sensed rate is omega_I, as in eq. 6.
+struct GyroRateErrors {
+  double scale_factor_error_ppm = 0.0;            ///< e, parts per million
+  double input_axis_misalignment_O_arcsec = 0.0;  ///< dO, arcsec: the input axis tilted toward O
+  double input_axis_misalignment_S_arcsec = 0.0;  ///< dS, arcsec: the input axis tilted toward S
+
+  bool is_zero() const {
+    return scale_factor_error_ppm == 0.0 && input_axis_misalignment_O_arcsec == 0.0 &&
+           input_axis_misalignment_S_arcsec == 0.0;
+  }
+};
+
+/// Which gyro model identification fits (docs/contract.md, --gyro-model): "drift" the ten coefficients,
+/// "drift+rate" also the three rate errors of GyroRateErrors.
+enum class GyroModel { kDrift, kDriftRate };
+
+/// The rate errors as identified, in this order after the ten drift coefficients (results, JSON).
+inline constexpr std::size_t kNumRateTerms = 3;
+inline constexpr std::array<std::string_view, kNumRateTerms> kRateTermNames = {
+    "scale_factor_error_ppm", "input_axis_misalignment_O_arcsec", "input_axis_misalignment_S_arcsec"};
+inline constexpr std::array<std::string_view, kNumRateTerms> kRateTermUnits = {"ppm", "arcsec", "arcsec"};
+
+/// The sensed rate (1 + e) (omega_I + dO omega_O + dS omega_S) in deg/h, from the inertial rate in gyro
+/// axes (I, O, S), rad/s (docs/physics.md section 15). With all errors zero it is omega_I, bit for bit.
+double sensed_rate_deg_h(const GyroRateErrors& errors, const Eigen::Vector3d& rate_rad_s);
+
 /// Noise of the gyro's output (configuration section [gyro.noise]).
 struct GyroNoise {
   double angle_random_walk_deg_rt_h = 0.0;   ///< white rate noise, deg/sqrt(h)

@@ -33,6 +33,9 @@ NominalInputs nominal_inputs(const Site& site, double radius_m, double rate_rad_
 
 /// Convenience: nominal inputs of `model` at joint state `joints` (beta, gamma and rate from the joints;
 /// R0, psi0 from the geometry), with the seed's terms from the configured errors when with_seed_terms.
-NominalInputs nominal_inputs(const CentrifugeModel& model, const JointState& joints, bool with_seed_terms);
+/// counter_rate_offset_rad_s: the commanded offset of a rate-platform dwell (docs/physics.md section 15),
+/// which turns the platform about Up as delta omega does: it adds to Omega_U.
+NominalInputs nominal_inputs(const CentrifugeModel& model, const JointState& joints, bool with_seed_terms,
+                             double counter_rate_offset_rad_s = 0.0);
 
 }  // namespace gyrocal

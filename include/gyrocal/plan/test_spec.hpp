@@ -14,7 +14,10 @@ struct TestSpec {
   std::vector<double> beta_rad = {0.0, kPi, kPi / 2, 3 * kPi / 2};   ///< position-platform angles, rad
   std::vector<double> gamma_rad = {0.0, kPi, kPi / 2, 3 * kPi / 2};  ///< arm angles read out, rad
   std::vector<double> rates_rad_s = {9.9};  ///< main rates; 0 = stopped, platform indexed to each gamma
-  std::uint64_t seed = 1;                   ///< random seed of the simulation
+  /// The rate-platform method (docs/physics.md section 15): at each rate, one set of positions per offset,
+  /// the counter platform turning at -rate + offset relative to the arm, rad/s. {0} = the plain test.
+  std::vector<double> counter_rate_offsets_rad_s = {0.0};
+  std::uint64_t seed = 1;  ///< random seed of the simulation
 };
 
 }  // namespace gyrocal

@@ -2,9 +2,11 @@
 // The test timeline: how the three joints move over the whole test (configuration section [test]),
 // as an ordered list of segments covering [0, duration) with no jump in any angle or in the main rate.
 //
-// For each rate of test.rates_rad_s, for each beta of test.beta_rad:
-//   spinning (rate != 0): [transition] settle, dwell of `revolutions` whole main-axis revolutions
-//                         (duration revolutions * 2 pi / |rate|);
+// For each rate of test.rates_rad_s, for each counter rate offset of test.counter_rate_offsets_rad_s
+// (docs/physics.md section 15), for each beta of test.beta_rad:
+//   spinning (rate != 0 or offset != 0): [transition] settle, dwell of `revolutions` whole revolutions of
+//                         gamma, which turns at rate - offset (duration revolutions * 2 pi / |rate - offset|;
+//                         with offset 0 whole main-axis revolutions); at rate 0 a plain rate table;
 //   stopped (rate == 0):  for each gamma of test.gamma_rad: [transition] settle, hold (duration
 //                         revolutions * 2 pi / |reference rate|), the counter platform at psi_r = -gamma.
 // The test starts at t = 0 at the first rate, beta and (stopped) gamma with no transition, so that in the
@@ -14,9 +16,12 @@
 //   1. position move: beta turns to the new value (by the configured difference, not modulo 2 pi);
 //   2. counter engage (from rest only): the counter platform moves back onto its servo law;
 //   3. main ramp: the main axis changes rate at a constant acceleration, theta and d theta/dt continuous;
-//   4. counter index (stopped only): the counter platform turns the shortest way to psi_r = -gamma.
+//   4. offset ramp: the counter platform's rate offset changes at the platforms' acceleration, its angle and
+//      rate continuous;
+//   5. counter index (stopped only): the counter platform turns the shortest way to psi_r = -gamma.
 // While the main axis turns or is servoed, the counter platform follows psi_r = -theta(t) + psi0 +
-// delta_omega t + 2 pi m (m an integer, fixed at each engagement; t global). Platform moves follow a
+// delta_omega t + phi(t) + 2 pi m (m an integer, fixed at each engagement; t global), phi the integral of
+// the commanded offset (Segment::counter_offset; zero in a plain test). Platform moves follow a
 // trapezoidal rate profile (constant acceleration, cruise, constant deceleration; start and end at rest).
 // With the main axis stopped the counter platform holds its index exactly (the servo's delta_omega does not
 // act), so its rate steps by delta_omega where the servo lets go or takes over; theta, its rate, beta and
@@ -46,6 +51,7 @@ enum class SegmentKind {
   kPositionMove,  ///< the position platform turns to a new beta
   kCounterMove,   ///< the counter platform indexes (stopped) or moves back onto its servo law
   kMainRamp,      ///< the main axis changes rate
+  kOffsetRamp,    ///< the counter platform's rate offset changes (docs/physics.md section 15)
 };
 
 /// A platform's angle over a segment: a move from start_angle_rad to end_angle_rad with a trapezoidal
@@ -83,6 +89,9 @@ struct Segment {
   /// true: psi_r = -theta(t) + psi0 + delta_omega t + counter_servo_offset_rad; false: `counter` moves it.
   bool counter_servoed = true;
   double counter_servo_offset_rad = 0.0;  ///< 2 pi m
+  /// phi(t), the servo law's integral of the commanded rate offset (docs/physics.md section 15), rad, with
+  /// the same form as the main axis' motion: constant rate in a dwell, constant acceleration in a ramp.
+  MainMotion counter_offset;
   PlatformMotion counter;
 };
 
@@ -96,7 +105,8 @@ struct MeasurementInterval {
   double rate_rad_s = 0.0;  ///< configured main rate, rad/s (0 for a hold)
   double beta_rad = 0.0;    ///< configured position-platform angle, rad
   double gamma_rad = 0.0;   ///< hold: the configured gamma, rad (psi_r = -gamma modulo 2 pi); dwell: 0
-  double start_s = 0.0;     ///< interval [start_s, end_s), s since the start of the test
+  double counter_rate_offset_rad_s = 0.0;  ///< the dwell's commanded counter rate offset, rad/s
+  double start_s = 0.0;                    ///< interval [start_s, end_s), s since the start of the test
   double end_s = 0.0;
 };
 
@@ -121,6 +131,7 @@ Timeline make_timeline(const TestSpec& test, const CentrifugeModel& model, const
 
 /// The joints at time t (s since the start of the test; clamped to [0, duration]): angles (rad), rates
 /// (rad/s) and accelerations (rad/s^2), exact for the segment's profiles. Angles are unwrapped.
+/// A non-zero offset needs |rate - offset| of a dwell not 0 (gamma must turn); make_timeline refuses it.
 JointState joint_state_at(const Timeline& timeline, double time_s);
 
 /// Number of samples k >= 0 with k / sample_rate_hz < duration_s.

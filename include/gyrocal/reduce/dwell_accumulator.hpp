@@ -109,8 +109,16 @@ class DwellAccumulator {
   /// columns: how many value columns each sample carries (1 for the gyro output, more for model channels).
   /// planned_duration_s: the planned length of the measured part (> 0), to scale time and size batches.
   /// with_std_err: also compute the standard errors of column 0 (scatter between revolutions or batches).
+  /// sweep_rate_rad_s: a spinning dwell at a counter rate offset (docs/physics.md section 15) turns the
+  /// platform's heading at this rate, and the Earth rate's horizontal part sweeps through the output as
+  /// cos and sin of sweep_rate * (t - t_first): not a harmonic of gamma, and tens of thousands of times the
+  /// noise. The outlier rule and the scatter between revolutions (the standard errors' level) fit these two
+  /// terms too, so that they measure the noise, not the sweep. The values stay the plain fit's: fitted over
+  /// the fraction of a sweep a dwell holds, the two terms would take the constant's place and multiply its
+  /// variance; the same operator reduces the model's channels, so the sweep is carried, not lost. 0
+  /// (default): none.
   DwellAccumulator(const ReduceOptions& options, std::vector<double> gammas_rad, bool is_static, int columns,
-                   double planned_duration_s, bool with_std_err);
+                   double planned_duration_s, bool with_std_err, double sweep_rate_rad_s = 0.0);
 
   /// One sample at time t (s) and arm angle gamma (rad, unwrapped: it must progress monotonically while
   /// spinning), with `columns` values. With outlier rejection (with_std_err, one column and
@@ -161,6 +169,7 @@ class DwellAccumulator {
   bool static_;
   int columns_;
   double duration_s_;
+  double sweep_scaled_ = 0.0;  // the sweep's phase per unit of scaled time (sweep rate * planned duration)
   bool with_std_err_;
 
   std::size_t samples_ = 0;
@@ -200,6 +209,9 @@ class DwellAccumulator {
   // Per-revolution (or batch) values of column 0 at every gamma, as sums for straight-line fits in time
   // and their cross products.
   struct RevolutionSums {
+    /// The sweep's phase per unit of scaled time (0: none): then the fit in time is of 1, t, cos, sin of it.
+    double sweep = 0.0;
+    Eigen::MatrixXd bb, bv;  // with a sweep: sums of b b' and b (v - v0)', b = (1, t, cos, sin)
     double n = 0, t = 0, tt = 0;
     Eigen::VectorXd v0;     // the first values: sums are of deviations from them (no cancellation)
     Eigen::VectorXd v, tv;  // sums of (v - v0) and t (v - v0)
@@ -208,6 +220,8 @@ class DwellAccumulator {
     /// Covariance of the lines' predictions at t_mid (of the means without drift); NaN without enough
     /// revolutions.
     Eigen::MatrixXd covariance_at(double t_mid, bool drift) const;
+    /// The parameters of the fit in time: the mean, the drift, the sweep's two.
+    double parameters(bool drift) const { return 1.0 + (drift ? 1.0 : 0.0) + (sweep != 0.0 ? 2.0 : 0.0); }
   };
   RevolutionSums trend_;
   // Static hold: sums per column, and batch means of column 0.

@@ -49,6 +49,10 @@ struct DwellQuality {
 struct Dwell {
   bool is_static = false;
   double planned_rate_rad_s = 0.0;  ///< the plan's rate this dwell was matched to
+  /// The plan's counter rate offset this dwell was matched to (docs/physics.md section 15), rad/s: the
+  /// counter platform turned at -rate + offset, gamma at rate - offset, and the revolutions are counted on
+  /// gamma.
+  double planned_counter_rate_offset_rad_s = 0.0;
   double beta_rad = 0.0;            ///< the plan's beta this dwell was matched to
   double measured_beta_rad = 0.0;   ///< mean position encoder reading
   std::vector<double> gammas_rad;   ///< the plan's gammas reduced here (one for a static hold)
@@ -89,7 +93,8 @@ struct ReducedPosition {
   double rate_rad_s = 0.0;  ///< planned rate
   double beta_rad = 0.0;    ///< planned beta
   double gamma_rad = 0.0;   ///< planned gamma
-  double mean_deg_h = 0.0;  ///< reduced gyro output
+  double counter_rate_offset_rad_s = 0.0;  ///< planned counter rate offset (docs/physics.md section 15)
+  double mean_deg_h = 0.0;                 ///< reduced gyro output
   double std_err_deg_h = 0.0;
   std::size_t samples = 0;
   /// Outliers rejected in the dwell this position is reduced from (one fit reduces all its gammas).
@@ -126,6 +131,9 @@ struct PlannedTest {
 struct PlanMatch {
   bool is_static = false;
   double planned_rate_rad_s = 0.0;
+  /// The planned counter rate offset (docs/physics.md section 15): the counter platform turns at -rate +
+  /// offset relative to the arm (at rate 0 at the offset alone: a plain rate table); 0 in a plain test.
+  double planned_counter_rate_offset_rad_s = 0.0;
   double beta_rad = 0.0;
   double gamma_rad = 0.0;  ///< static holds
   std::string why_not;
