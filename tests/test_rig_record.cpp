@@ -66,17 +66,11 @@ TEST(RigRecord, EveryImperfectionAtOnceInTheRigsLayoutCalibratesToTheTruthThroug
   s.test.sample_rate_hz = 50.0;
   s.test.revolutions = 8;
   s.test.rates_rad_s = {9.9, 7.0};
-  testing::RigImperfections all;
-  all.jitter_s = 1e-4;
-  all.stamp_resolution_s = 1e-3;  // whole milliseconds, as the layout writes them
-  all.angle_quantum_deg = 0.1;    // one count of the main and counter encoders
-  all.position_count_deg = 0.002;
-  all.rate_offset = 1e-3;
-  all.ripple = 2e-4;
-  all.gap_fraction = 0.1;
-  all.clock_jump_s = 1000.0;
-  all.spikes = 6;
-  all.beta_glitch_deg = 30.0;
+  // Stamps rounded to whole ms, as the layout writes them; angles a whole number of counts.
+  const testing::RigImperfections all = testing::every_imperfection();
+  ASSERT_EQ(all.stamp_resolution_s, 1e-3);
+  ASSERT_EQ(all.angle_quantum_deg, 360.0 / kMainCounts);
+  ASSERT_EQ(all.position_count_deg, 360.0 / kPositionCounts);
   std::vector<testing::RigRow> rows;
   testing::rig_rows(s, all, testing::RigMotion{}, 7, [&](const testing::RigRow& r) { rows.push_back(r); });
 
