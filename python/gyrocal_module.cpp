@@ -45,7 +45,8 @@ py::object json_to_python(const nlohmann::json& j) {
 }
 
 CalibrationOptions calibration_options(const std::string& method, const std::string& compensation,
-                                       const std::string& reduction, const std::vector<std::string>& estimate) {
+                                       const std::string& reduction,
+                                       const std::vector<std::string>& estimate) {
   CalibrationOptions options;
   options.estimate = parse_machine_error_names(estimate, "estimate");
   options.method = parse_method(method);

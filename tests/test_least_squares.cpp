@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/least_squares.hpp"
+#include "gyrocal/solve/least_squares.hpp"
 
 namespace gyrocal {
 namespace {

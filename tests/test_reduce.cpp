@@ -331,17 +331,7 @@ std::map<std::string, testing::RigImperfections> rig_cases() {
   c["clock jump"].clock_jump_s = 1000.0;
   c["spikes"].spikes = 6;
   c["beta glitch"].beta_glitch_deg = 30.0;
-  testing::RigImperfections all;
-  all.jitter_s = 1e-4;
-  all.stamp_resolution_s = 1e-3;
-  all.angle_quantum_deg = 0.1;
-  all.position_count_deg = 0.002;
-  all.rate_offset = 1e-3;
-  all.ripple = 2e-4;
-  all.gap_fraction = 0.1;
-  all.clock_jump_s = 1000.0;
-  all.spikes = 6;
-  all.beta_glitch_deg = 30.0;
+  const testing::RigImperfections all = testing::every_imperfection();
   c["all together"] = all;
   return c;
 }

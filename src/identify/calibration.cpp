@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
@@ -12,6 +11,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/closed_form.hpp"
 #include "gyrocal/identify/identifiability.hpp"
+#include "gyrocal/identify/named_combinations.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -173,13 +173,15 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   }
   for (const LinearForm& f : cf.alternatives)
     r.alternatives.push_back({f.name, f.unit, f.value(w), std_of(f), {}});
-  const double ar2 = r.g_level * r.g_level;
-  const std::map<std::string, std::vector<double>> combination_coefficients = {
-      {"dII-dSS", {0, 0, 0, 0, 1, 0, -1, 0, 0, 0}},
-      {"dOO-dSS", {0, 0, 0, 0, 0, 1, -1, 0, 0, 0}},
-      {"dF+(1+Ar^2)dSS", {1, 0, 0, 0, 0, 0, 1 + ar2, 0, 0, 0}}};
-  for (const LinearForm& f : cf.combinations)
-    r.combinations.push_back({f.name, f.unit, f.value(w), std_of(f), combination_coefficients.at(f.name)});
+  const std::array<NamedCombination, 3> named = named_combinations(r.g_level);
+  for (const LinearForm& f : cf.combinations) {
+    const auto it =
+        std::find_if(named.begin(), named.end(), [&](const NamedCombination& c) { return c.name == f.name; });
+    if (it == named.end())
+      throw Error("closed forms: " + f.name + " is not a combination of docs/physics.md section 8.");
+    r.combinations.push_back(
+        {f.name, f.unit, f.value(w), std_of(f), std::vector<double>(it->weights.begin(), it->weights.end())});
+  }
   r.unidentifiable.push_back(
       fmt::format("dF, dII, dOO, dSS: adding c to dII, dOO, dSS and -(1+Ar^2) c to dF "
                   "changes no output at one speed (docs/physics.md section 8)"));
@@ -226,7 +228,9 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
       }
   }
   for (const LinearForm& f : cf.combinations) {
-    const std::vector<double>& c = combination_coefficients.at(f.name);
+    const auto it = std::find_if(r.combinations.begin(), r.combinations.end(),
+                                 [&](const NamedEstimate& e) { return e.name == f.name; });
+    const std::vector<double>& c = it->coefficients;  // set above, for every closed-form combination
     compare(f, evaluate_combination(sol, Eigen::Map<const Eigen::VectorXd>(c.data(), x.cols()), ls));
   }
   r.uncertainty_amplification = amplification;

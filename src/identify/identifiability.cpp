@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/named_combinations.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -353,15 +354,16 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   };
 
   // docs/physics.md section 8's names, only where the estimable combination IS the named one.
-  const auto e = [n](Coefficient k) { return VectorXd::Unit(n, static_cast<Index>(k)); };
   struct Named {
     std::string name, unit;
     VectorXd c;
   };
-  const std::vector<Named> named = {
-      {"dII-dSS", "deg/h/g^2", e(Coefficient::dII) - e(Coefficient::dSS)},
-      {"dOO-dSS", "deg/h/g^2", e(Coefficient::dOO) - e(Coefficient::dSS)},
-      {"dF+(1+Ar^2)dSS", "deg/h", e(Coefficient::dF) + (1 + ar * ar) * e(Coefficient::dSS)}};
+  std::vector<Named> named;
+  for (const NamedCombination& nc : named_combinations(ar)) {
+    VectorXd c = VectorXd::Zero(n);
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) c[static_cast<Index>(k)] = nc.weights[k];
+    named.push_back({std::string(nc.name), std::string(nc.unit), c});
+  }
   for (const Named& nc : named) {
     bool touches_unexcited = false, touches_unidentified = false;
     for (Index j = 0; j < n; ++j) {

@@ -220,6 +220,12 @@ Cell text_cell(std::string_view text) {
   return {esc(text), false, "", ""};
 }
 
+Cell value_cell(const json* v) {
+  if (v == nullptr) return text_cell(kDash);
+  if (v->is_number()) return num_cell(value_text(*v));
+  return text_cell(value_text(*v));
+}
+
 Cell num_cell(std::string text, std::string cls, std::string title) {
   return {esc(text), true, std::move(cls), std::move(title)};
 }
@@ -265,13 +271,7 @@ std::string generic_table(const json& entries, const std::vector<std::string>& f
   for (const auto& e : entries) {
     std::vector<Cell> row;
     for (const auto& column : columns) {
-      const json* v = find(e, column);
-      if (v == nullptr)
-        row.push_back(text_cell(kDash));
-      else if (v->is_number())
-        row.push_back(num_cell(value_text(*v)));
-      else
-        row.push_back(text_cell(value_text(*v)));
+      row.push_back(value_cell(find(e, column)));
     }
     rows.push_back(std::move(row));
   }

@@ -85,6 +85,8 @@ struct Cell {
 
 Cell text_cell(std::string_view text);
 Cell num_cell(std::string text, std::string cls = "", std::string title = "");
+/// A cell for a field of unknown type: a dash when absent (nullptr), a number cell for a number, text else.
+Cell value_cell(const json* v);
 
 /// An HTML table (header cells are escaped here; long names may break after an underscore).
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<Cell>>& rows,

@@ -169,13 +169,7 @@ void coefficients(const json& result, Page& page, std::string& out) {
     row.push_back(text_cell(identifiable));
     if (ident_j && ident_j->is_boolean() && !ident_j->get<bool>()) row.back().cls = "muted";
     for (const auto& field : extra_fields) {
-      const json* v = find(e, field);
-      if (v == nullptr)
-        row.push_back(text_cell(kDash));
-      else if (v->is_number())
-        row.push_back(num_cell(value_text(*v)));
-      else
-        row.push_back(text_cell(value_text(*v)));
+      row.push_back(value_cell(find(e, field)));
     }
     rows.push_back(std::move(row));
 

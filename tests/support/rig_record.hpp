@@ -81,6 +81,22 @@ struct Phase {
 
 }  // namespace rig_detail
 
+/// Every imperfection of docs/physics.md section 14 at once, at the level the reduction must take.
+inline RigImperfections every_imperfection() {
+  RigImperfections all;
+  all.jitter_s = 1e-4;
+  all.stamp_resolution_s = 1e-3;
+  all.angle_quantum_deg = 0.1;
+  all.position_count_deg = 0.002;
+  all.rate_offset = 1e-3;
+  all.ripple = 2e-4;
+  all.gap_fraction = 0.1;
+  all.clock_jump_s = 1000.0;
+  all.spikes = 6;
+  all.beta_glitch_deg = 30.0;
+  return all;
+}
+
 /// Calls emit(row) for each row of a rig's record of `s`'s plan (spinning rates only), in time order.
 inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion,
                      std::uint64_t seed, const std::function<void(const RigRow&)>& emit) {

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/least_squares.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/solve/least_squares.hpp"
 
 namespace gyrocal {
 

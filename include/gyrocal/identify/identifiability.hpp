@@ -10,9 +10,9 @@
 #include <Eigen/Core>
 
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/least_squares.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/solve/least_squares.hpp"
 
 namespace gyrocal {
 

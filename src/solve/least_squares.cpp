@@ -1,6 +1,6 @@
 // Weighted linear least squares (docs/physics.md section 9; method and measured accuracy in
 // docs/least_squares.md).
-#include "gyrocal/identify/least_squares.hpp"
+#include "gyrocal/solve/least_squares.hpp"
 
 #include <algorithm>
 #include <cmath>
