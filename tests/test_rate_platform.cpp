@@ -172,9 +172,12 @@ TEST(RatePlatformTimeline, TheReducersDwellsAreThePlansPositions) {
   const Pipeline p = run(s);
   const std::vector<Position> plan = test_positions(s.test);
   ASSERT_EQ(p.reduction.positions.size(), plan.size());
-  // The reducer sees a dwell begin once the rates are within ReduceOptions::rate_tolerance of the plan's: up
-  // to 1e-3 * 9.9 rad/s / (20 deg/s^2) = 28 ms before a ramp of the offset ends; and it works on the samples.
-  const double tolerance_s = 0.03 + 2.0 / s.test.sample_rate_hz;
+  // The reducer knows nothing of the plan's timing: it measures once the encoders have been steady for the
+  // settle time, and for the planned duration. Its measured part must lie in the machine's steady state
+  // before the plan's measurement interval ends (the settle interval before it is steady too: a run may
+  // start in the last tenths of a second of a ramp, which the settle time then drops), and be the
+  // planned length (to two samples: the reducer works on the samples).
+  const double tolerance_s = 2.0 / s.test.sample_rate_hz;
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const ReducedPosition& r = p.reduction.positions[i];
     EXPECT_EQ(r.index, plan[i].index);
@@ -188,8 +191,8 @@ TEST(RatePlatformTimeline, TheReducersDwellsAreThePlansPositions) {
           mi.counter_rate_offset_rad_s == plan[i].counter_rate_offset_rad_s &&
           mi.beta_rad == plan[i].beta_rad &&
           (mi.kind == SegmentKind::kDwell || mi.gamma_rad == plan[i].gamma_rad))
-        inside |= std::abs(d.first_time_s - mi.start_s) <= tolerance_s &&
-                  std::abs(d.last_time_s - mi.end_s) <= tolerance_s;
+        inside |= d.first_time_s >= mi.start_s - s.test.settle_s && d.last_time_s <= mi.end_s + tolerance_s &&
+                  d.last_time_s - d.first_time_s >= mi.end_s - mi.start_s - tolerance_s;
     EXPECT_TRUE(inside) << "position " << plan[i].index << " dwell " << d.first_time_s << ".."
                         << d.last_time_s << " rate " << d.planned_rate_rad_s << " offset "
                         << d.planned_counter_rate_offset_rad_s << " beta " << d.beta_rad;

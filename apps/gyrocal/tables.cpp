@@ -82,13 +82,14 @@ std::string result_table(const CalibrationResult& r) {
     out +=
         fmt::format("\ndata quality: {} rows read, {} used, {} outliers, {} gaps, {} encoder glitch rows\n",
                     q.rows_read, q.rows_used, q.outliers, q.gaps, q.encoder_glitch_rows);
-    out +=
-        fmt::format("{:>9} {:>9} {:>9} {:>11} {:>7} {:>7} {:>8} {:>7} {:>8} {:>5}  {}\n", "rate", "beta",
-                    "start_s", "rows used", "settle", "beyond", "glitches", "outliers", "gaps", "", "ended");
+    out += fmt::format("{:>9} {:>9} {:>9} {:>11} {:>7} {:>7} {:>8} {:>7} {:>8} {:>5}  {}\n", "rate", "beta",
+                       "start_s", "rows used", "settle", "beyond", "glitches", "leaving", "outliers", "gaps",
+                       "ended");
     for (const DataQuality::Dwell& d : q.dwells)
-      out += fmt::format("{:>9.4g} {:>9.3f} {:>9.3f} {:>5}/{:<5} {:>7} {:>7} {:>8} {:>8} {:>5}  {}\n",
+      out += fmt::format("{:>9.4g} {:>9.3f} {:>9.3f} {:>5}/{:<5} {:>7} {:>7} {:>8} {:>7} {:>8} {:>5}  {}\n",
                          d.rate_rad_s, d.beta_deg, d.start_s, d.rows_used, d.rows, d.settle_rows,
-                         d.beyond_planned_rows, d.encoder_glitch_rows, d.outliers, d.gaps, d.ended);
+                         d.beyond_planned_rows, d.encoder_glitch_rows, d.before_leaving_rows, d.outliers,
+                         d.gaps, d.ended);
     for (const DataQuality::Rejected& x : q.rejected)
       out += fmt::format("- no dwell from the steady run at t = {:.3f} to {:.3f} s: {}\n", x.start_s, x.end_s,
                          x.reason);

@@ -896,6 +896,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
     q.settle_rows = d.quality.settle_rows;
     q.beyond_planned_rows = d.quality.beyond_planned_rows;
     q.encoder_glitch_rows = d.quality.encoder_glitch_rows;
+    q.before_leaving_rows = d.quality.before_leaving_rows;
     q.outliers = d.gyro.outliers;
     q.gaps = d.gaps;
     q.ended = d.quality.ended;

@@ -47,6 +47,7 @@ bool ReduceOptions::IsValid(std::string* error) const {
   if (!(gap_intervals > 1.0)) return fail("gap_intervals must be above 1");
   if (encoder_glitch_rows < 0 || encoder_glitch_rows > 1000)
     return fail("encoder_glitch_rows must be between 0 and 1000");
+  if (!(leave_guard_s >= 0.0 && leave_guard_s <= 60.0)) return fail("leave_guard_s must be in [0, 60] s");
   if (max_stretches_per_dwell < 1) return fail("max_stretches_per_dwell must be at least 1");
   if (!(wander_warning_deg > 0.0)) return fail("wander_warning_deg must be positive");
   if (model_samples_per_revolution < 0 ||

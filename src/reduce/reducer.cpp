@@ -81,12 +81,32 @@ double median_of(std::vector<double> v) {
 constexpr std::size_t kRejectedKept = 256;
 /// The window of rows searched for a steady state never holds more than this many rows.
 constexpr std::size_t kMaxWindowRows = std::size_t{1} << 16;
+/// The rows waiting ReduceOptions::leave_guard_s before they are measured never exceed this many (15 MB; at
+/// 1 MHz the guard is then 0.26 s).
+constexpr std::size_t kMaxGuardRows = std::size_t{1} << 18;
 
 /// A stretch being measured, and the phase (encoder line intercepts) it shares with others until a gap.
 struct StretchSums {
   double first = 0.0, last = 0.0;
   std::size_t count = 0;
   std::size_t phase = 0;
+};
+
+/// How far a row lies from its run's steady state, deg: beta from the run's, the main and counter encoders
+/// from their prediction (the last row's reading advanced at the last window's rate), and a static hold's
+/// angles from the hold's.
+struct Deviations {
+  double beta = 0.0, angle = 0.0, hold = 0.0;
+  void widen(const Deviations& o) {
+    beta = std::max(beta, o.beta);
+    angle = std::max(angle, o.angle);
+    hold = std::max(hold, o.hold);
+  }
+  /// Within twice `steady`'s (and 1e-9 deg): a row as close to the steady state as the measured rows were.
+  bool within(const Deviations& steady) const {
+    return beta <= 2.0 * steady.beta + 1e-9 && angle <= 2.0 * steady.angle + 1e-9 &&
+           hold <= 2.0 * steady.hold + 1e-9;
+  }
 };
 
 /// The run in progress: consecutive rows at one steady state of the machine.
@@ -114,9 +134,22 @@ struct Run {
   std::vector<Row> held;  // rows off the line, waiting to be judged glitches or the run's end
   std::string held_reason;
   bool dropped = false;  // rows were dropped since the last accepted one
+  // Rows of the measured part waiting ReduceOptions::leave_guard_s before they are measured: dropped if the
+  // machine is seen leaving its steady state before then.
+  struct Waiting {
+    Row u;  // on the run's clock, unwrapped
+    bool gap = false, dropped = false;
+    double t_record = 0.0;
+    Deviations dev;
+  };
+  std::deque<Waiting> guard;
+  Deviations steady_dev;  // the largest of the measured rows
+  // A static hold's encoder readings (deg, unwrapped, from the lines at the end of its settle time): its
+  // angles stay within beta_tolerance_deg of them.
+  double hold_theta = 0.0, hold_psi = 0.0;
   // The measured part.
   std::optional<DwellAccumulator> acc;
-  bool measuring = false;
+  bool measuring = false;  // the first row of the measured part has been measured
   double t_first = 0.0, theta_first = 0.0, psi_first = 0.0;
   std::vector<LineSums> phase_theta, phase_psi, phase_rel;  // rel: psi_r + theta
   // Successive differences of the main encoder's deviations inside stretches: the white part of its scatter
@@ -380,10 +413,11 @@ struct Reducer::State {
     run = std::move(r);
   }
 
-  /// Matches the run to the plan when its settle time is over, on the rates of its last window (the ramp
-  /// that led to it has ended by then).
-  void decide(Run& r) {
+  /// Matches the run to the plan, on the rates of its last window (check_rate), at time t (run's clock).
+  void decide(Run& r, double t) {
     r.decided = true;
+    r.hold_theta = r.theta_line(t);
+    r.hold_psi = r.psi_line(t);
     r.match = match_to_plan(plan, options, r.rate_theta * kDegToRad, r.rate_psi * kDegToRad, r.beta_deg,
                             r.gamma_deg);
     r.matched = r.match.why_not.empty();
@@ -408,7 +442,10 @@ struct Reducer::State {
     r.prev_row_t = raw.t;
     const double dt = raw.t - r.last_t_record;
     double offset = r.clock_offset;
-    if (gap && r.measuring) offset += dt - dt_planned;
+    // The measured part begins with the settle time's end (its rows wait in the guard until the run is
+    // matched to the plan).
+    const bool in_measured_part = r.decided ? r.matched : raw.t >= r.start_s + plan.settle_s;
+    if (gap && in_measured_part) offset += dt - dt_planned;
     const double t = raw.t - offset;
     // Each reading is predicted from the last accepted one at the rate of the last window; after a gap the
     // encoders' phase is unknown (a clock jump looks like a gap), so only beta is judged there and the angles
@@ -421,6 +458,11 @@ struct Reducer::State {
     u.theta = th_pred + wrap_deg(raw.theta - th_pred);
     u.psi = ps_pred + wrap_deg(raw.psi - ps_pred);
     const double db = wrap_deg(raw.beta - r.beta_deg);
+    Deviations dev;
+    dev.beta = std::abs(db);
+    if (!gap) dev.angle = std::max(std::abs(u.theta - th_pred), std::abs(u.psi - ps_pred));
+    if (r.decided && r.matched && r.match.is_static)
+      dev.hold = std::max(std::abs(wrap_deg(u.theta - r.hold_theta)), std::abs(wrap_deg(u.psi - r.hold_psi)));
     std::string off;
     if (std::abs(db) > options.beta_tolerance_deg)
       off = fmt::format("beta moves by {:.3g} deg at t = {:.3f} s", db, raw.t);
@@ -431,10 +473,19 @@ struct Reducer::State {
       off = fmt::format(
           "the counter platform leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)", raw.t,
           u.psi - ps_pred);
+    else if (dev.hold > options.beta_tolerance_deg) {
+      // A static hold: a move that starts slowly stays within angle_tolerance_deg of each last reading;
+      // the hold's angles are held, like beta, within beta_tolerance_deg (docs/calibration.md).
+      const double dth = wrap_deg(u.theta - r.hold_theta), dps = wrap_deg(u.psi - r.hold_psi);
+      off = std::abs(dth) > options.beta_tolerance_deg
+                ? fmt::format("the main axis moves by {:.3g} deg at t = {:.3f} s", dth, raw.t)
+                : fmt::format("the counter platform moves by {:.3g} deg at t = {:.3f} s", dps, raw.t);
+    }
     if (!off.empty()) {
       if (r.held.empty()) r.held_reason = off;
       r.held.push_back(raw);
-      if (r.held.size() > static_cast<std::size_t>(options.encoder_glitch_rows)) end_run(r.held_reason);
+      if (r.held.size() > static_cast<std::size_t>(options.encoder_glitch_rows))
+        end_run(r.held_reason, Ending::kLeft);
       return;
     }
     if (gap) {
@@ -446,7 +497,7 @@ struct Reducer::State {
     r.t_prev = t;
     if (!r.held.empty()) {
       // Dropped: as encoder glitches inside the measured part; in the settle time they are settle rows.
-      (r.measuring ? r.quality.encoder_glitch_rows : r.quality.settle_rows) += r.held.size();
+      (in_measured_part ? r.quality.encoder_glitch_rows : r.quality.settle_rows) += r.held.size();
       r.held.clear();
       r.dropped = true;
     }
@@ -454,14 +505,34 @@ struct Reducer::State {
     r.last_t_record = raw.t;
     r.end_s = raw.t;
     ++r.quality.rows;
+    // The rate is judged, and the run matched to the plan, before the row is measured (check_rate).
+    if (!check_rate(r, u, t, raw.t)) return;
     if (!r.decided && raw.t < r.start_s + plan.settle_s) {
       ++r.quality.settle_rows;
-    } else {
-      if (!r.decided) decide(r);
-      if (r.matched) measure(u, gap, raw.t);
+      return;
+    }
+    if (!r.decided && raw.t >= r.start_s + plan.settle_s + 2.0 * options.window_s) decide(r, t);
+    if (r.decided && !r.matched) return;
+    r.guard.push_back({u, gap, r.dropped, raw.t, dev});
+    r.dropped = false;
+    while (!r.guard.empty() && (r.decided ? r.guard.front().t_record < raw.t - options.leave_guard_s ||
+                                                r.guard.size() > kMaxGuardRows
+                                          : r.guard.size() > kMaxGuardRows)) {
+      const Run::Waiting w = r.guard.front();
+      r.guard.pop_front();
+      if (!r.decided) {
+        ++r.quality.settle_rows;
+        continue;
+      }
+      r.steady_dev.widen(w.dev);
+      measure(w.u, w.gap, w.dropped, w.t_record);
       if (!run) return;
     }
-    // The rate, window by window, against the run's.
+  }
+
+  /// The rate, window by window, against the run's (and the lines the next rows are predicted from). False
+  /// when the run ended here.
+  bool check_rate(Run& r, const Row& u, double t, double t_record) {
     if (r.block_theta.n == 0) {
       r.block_t0 = t;
       r.block_theta0 = u.theta;
@@ -477,15 +548,21 @@ struct Reducer::State {
       const double scale = std::abs(r.rate_theta) >= tol0_deg ? std::abs(r.rate_theta)
                                                               : std::max(std::abs(r.rate_psi), tol0_deg);
       const double change = std::max(std::abs(rt - r.rate_theta), std::abs(rp - r.rate_psi)) / scale;
+      // The run is matched to the plan at the first window closing after its settle time that agrees with
+      // the window before it: a run may start in the last tenths of a second of a ramp, whose end then
+      // bends its first window (matched on it, the run would be refused or end at the next window, and the
+      // next run's settle time would start late). Until then the run follows each window's rate.
+      bool decide_now = false;
       if (!r.decided) {
+        decide_now = change <= options.rate_steadiness && t_record >= r.start_s + plan.settle_s;
         r.rate_theta = rt;
         r.rate_psi = rp;
       } else if (change > options.rate_steadiness) {
-        end_run(fmt::format(
-            "the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window ending at "
-            "t = {:.3f} s",
-            change, options.rate_steadiness, raw.t));
-        return;
+        end_run(fmt::format("the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window "
+                            "ending at t = {:.3f} s",
+                            change, options.rate_steadiness, t_record),
+                Ending::kLeft);
+        return false;
       }
       const auto line = [&](const LineSums& s, double rate, double y0) {
         Line l;
@@ -499,11 +576,14 @@ struct Reducer::State {
       r.psi_line_valid = true;
       if (!r.decided) r.gamma_deg = wrap_deg(-r.psi_line(t));
       r.block_theta = r.block_psi = LineSums{};
+      if (decide_now) decide(r, t);
     }
+    return true;
   }
 
-  void measure(const Row& u, bool gap, double t_record) {
-    (void)t_record;
+  /// Takes a row of the measured part (on the run's clock) into the dwell; gap and dropped: the row follows
+  /// a gap, or rows dropped as glitches.
+  void measure(const Row& u, bool gap, bool dropped, double t_record) {
     Run& r = *run;
     // The plan says how long a dwell is: its measured part is [t_first, t_first + planned duration) on the
     // dwell's clock.
@@ -520,12 +600,13 @@ struct Reducer::State {
       r.phase_psi.emplace_back();
       r.phase_rel.emplace_back();
       r.stretches.push_back({u.t, u.t, 0, 0});
-    } else if (gap || r.dropped) {
+    } else if (gap || dropped) {
       if (r.stretches.size() >= static_cast<std::size_t>(options.max_stretches_per_dwell)) {
         end_run(fmt::format(
-            "gaps and dropped rows break it into more than {} stretches (max_stretches_per_dwell) "
-            "by t = {:.3f} s",
-            options.max_stretches_per_dwell, t_record));
+                    "gaps and dropped rows break it into more than {} stretches (max_stretches_per_dwell) "
+                    "by t = {:.3f} s",
+                    options.max_stretches_per_dwell, t_record),
+                Ending::kStretches);
         return;
       }
       if (gap) {
@@ -537,7 +618,6 @@ struct Reducer::State {
       }
       r.stretches.push_back({u.t, u.t, 0, r.phase_theta.size() - 1});
     }
-    r.dropped = false;
     StretchSums& st = r.stretches.back();
     if (st.count == 0) st.first = u.t;
     st.last = u.t;
@@ -587,10 +667,40 @@ struct Reducer::State {
     }
   }
 
+  /// How a run ends: the machine left its steady state (the rows waiting in the guard are dropped), the
+  /// record ended (they are measured), or its gaps broke it into too many stretches (the rest is not used).
+  enum class Ending { kLeft, kRecordEnds, kStretches };
+
   /// Ends the run in progress: a dwell if it matched the plan and is long enough, otherwise a rejected run
   /// with its reason. The rows it held go back to look().
-  void end_run(std::string reason) {
+  void end_run(std::string reason, Ending how) {
     if (!run) return;
+    if (how == Ending::kRecordEnds) {
+      while (run && !run->guard.empty()) {
+        const Run::Waiting w = run->guard.front();
+        run->guard.pop_front();
+        measure(w.u, w.gap, w.dropped, w.t_record);
+      }
+      if (!run) return;
+    }
+    // The machine left: the rows waiting in the guard are measured up to the first that lies further from
+    // the steady state than twice the measured rows did (the move's onset, found as the run's start is);
+    // from there on they are dropped.
+    bool onset = how != Ending::kLeft || !run->measuring;
+    while (run && !run->guard.empty()) {
+      const Run::Waiting w = run->guard.front();
+      onset = onset || !w.dev.within(run->steady_dev);
+      if (onset) break;
+      run->guard.pop_front();
+      measure(w.u, w.gap, w.dropped, w.t_record);
+    }
+    if (!run) return;
+    for (const Run::Waiting& w : run->guard) {
+      // Beyond the planned duration they would not have been measured anyway.
+      const bool beyond = run->measuring && w.u.t >= run->t_first + run->planned_duration - 1e-9;
+      ++(beyond ? run->quality.beyond_planned_rows : run->quality.before_leaving_rows);
+    }
+    run->guard.clear();
     Run r = std::move(*run);
     run.reset();
     r.quality.ended = std::move(reason);
@@ -604,8 +714,13 @@ struct Reducer::State {
 
   void finish_run(Run& r) {
     if (!r.decided) {
-      reject(r, fmt::format("it lasted {:.3f} s, less than its settle time of {} s: {}", r.end_s - r.start_s,
-                            plan.settle_s, r.quality.ended));
+      if (r.end_s - r.start_s < plan.settle_s)
+        reject(r, fmt::format("it lasted {:.3f} s, less than its settle time of {} s: {}",
+                              r.end_s - r.start_s, plan.settle_s, r.quality.ended));
+      else
+        reject(r, fmt::format("its rate did not hold within rate_steadiness ({:.0e}) from one {} s window to "
+                              "the next after its settle time of {} s: {}",
+                              options.rate_steadiness, options.window_s, plan.settle_s, r.quality.ended));
       return;
     }
     if (!r.matched) {
@@ -799,7 +914,7 @@ void Reducer::push(const RecordSample& s) {
 
 Reduction Reducer::finish() {
   State& st = *state_;
-  while (st.run) st.end_run("the record ends");
+  while (st.run) st.end_run("the record ends", State::Ending::kRecordEnds);
   Reduction out;
   out.samples_read = st.rows;
   out.warnings = st.warnings;

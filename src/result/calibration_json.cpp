@@ -95,6 +95,7 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
                              {{"settle", d.settle_rows},
                               {"beyond_planned", d.beyond_planned_rows},
                               {"encoder_glitches", d.encoder_glitch_rows},
+                              {"before_leaving", d.before_leaving_rows},
                               {"outliers", d.outliers}}},
                             {"gaps", d.gaps},
                             {"ended", d.ended}};

@@ -112,7 +112,7 @@ struct DataQuality {
     double gamma_deg = 0.0;             ///< static holds
     double start_s = 0.0, end_s = 0.0;  ///< the steady run, record time
     std::size_t rows = 0, rows_used = 0, settle_rows = 0, beyond_planned_rows = 0, encoder_glitch_rows = 0,
-                outliers = 0, gaps = 0;
+                before_leaving_rows = 0, outliers = 0, gaps = 0;
     std::string ended;  ///< why its steady run ended
   };
   std::vector<Dwell> dwells;

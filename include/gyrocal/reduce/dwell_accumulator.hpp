@@ -55,6 +55,12 @@ struct ReduceOptions {
   /// At most this many consecutive rows whose encoders leave the dwell's line (or beta its value) and come
   /// back are dropped as encoder glitches; more end the dwell.
   int encoder_glitch_rows = 3;
+  /// The machine is seen leaving a dwell only once an encoder has left its tolerance: a platform starting a
+  /// move at 20 deg/s^2 leaves beta_tolerance_deg after 0.14 s, and encoder_glitch_rows more rows pass
+  /// before the run ends. The samples of this last interval before the end of a run that left its steady
+  /// state are dropped (counted as "before_leaving"), since the model's channels assume the steady state,
+  /// s. A run that ends at its planned duration or with the record loses nothing.
+  double leave_guard_s = 0.25;
   /// A dwell broken into more stretches than this (by gaps and glitches) is refused: the channels keep one
   /// entry per stretch, so this bounds their memory.
   int max_stretches_per_dwell = 4096;

@@ -42,7 +42,9 @@ struct DwellQuality {
   std::size_t settle_rows = 0;                ///< dropped: in the settle interval
   std::size_t beyond_planned_rows = 0;        ///< dropped: after the planned duration
   std::size_t encoder_glitch_rows = 0;        ///< dropped: encoders left the line for a few rows
-  std::string ended;                          ///< why the run ended
+  /// dropped: the last ReduceOptions::leave_guard_s before the machine left the steady state
+  std::size_t before_leaving_rows = 0;
+  std::string ended;  ///< why the run ended
 };
 
 /// One measured dwell: a spinning dwell (rate, beta) or a static hold (beta, gamma).
