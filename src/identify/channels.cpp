@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "gyrocal/core/parallel.hpp"
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
@@ -31,7 +32,9 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
   constexpr int kOmegaO = kFirstRegressor + 2 * static_cast<int>(kNumCoefficients);
   constexpr int kColumns = kOmegaO + 2;
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
-  for (std::size_t di = 0; di < reduction.dwells.size(); ++di) {
+  // Dwells are independent: one per thread, each writing its own slot (the same numbers for any number of
+  // threads).
+  parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
     const Dwell& d = reduction.dwells[di];
     // The reducer's operator, the heading's sweep at a counter rate offset included (docs/physics.md 15).
     const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
@@ -109,7 +112,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       }
     }
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
-  }
+  });
   std::vector<PositionChannels> out;
   for (const ReducedPosition& p : reduction.positions) {
     const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];
