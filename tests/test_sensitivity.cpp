@@ -271,8 +271,9 @@ TEST(SensitivityRateTerms, ShiftOfScaleFactorAndMisalignmentIsTheSimulatedFinite
       // of the shift: 1 % for an error the model absorbs exactly (a mount misalignment is an input-axis
       // misalignment), 6 % for one it does not fit without compensation. Such an error's trace at an offset
       // rides on the Earth rate's sweep through the dwell (not a harmonic of gamma), whose average depends on
-      // where the dwell begins; a record's dwells at an offset begin up to 0.1 s from the planned interval
-      // (docs/rate_platform.md), and the study's shifts are the planned intervals' (3.5-4 % apart here).
+      // where the dwell begins; a record's dwell begins where the reducer finds the machine steady, which may
+      // be before the planned interval (docs/rate_platform.md), and the study's shifts are the planned
+      // intervals' (3.5-4 % apart here).
       EXPECT_NEAR(predicted, finite_difference, c.tolerance * std::abs(finite_difference) + 2e-3)
           << c.error << " " << name;
       if (k == c.moves) {
