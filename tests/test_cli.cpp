@@ -225,5 +225,87 @@ TEST_F(Cli, PlanPredictsIdentifiabilityAndUncertainty) {
   EXPECT_EQ(nlohmann::json::parse(two.out)["rank"], 10);
 }
 
+TEST_F(Cli, SensitivityAndMonteCarloTakeTheGyroModelAndWriteTheRateErrors) {
+  // docs/contract.md: --gyro-model drift|drift+rate, default [calibration] gyro_model. With drift+rate the
+  // JSON holds the scale-factor error and the input axis' misalignments beside the drift coefficients.
+  Scenario s = default_scenario();
+  s.gyro_rate = {150.0, -25.0, 40.0};
+  s.test.counter_rate_offsets_rad_s = {0.0, 0.25, -0.25};
+  s.test.revolutions = 8;
+  s.test.sample_rate_hz = 50;
+  s.test.settle_s = 1;
+  s.uncertainty.counter_perpendicularity_x_rad = 0.1 * kArcsecToRad;
+  write("rp.toml", scenario_to_toml(s));
+  const std::string config = " --config " + path("rp.toml").string();
+  const char* const rate_errors[] = {"scale_factor_error_ppm", "input_axis_misalignment_O_arcsec",
+                                     "input_axis_misalignment_S_arcsec"};
+
+  const Outcome sens = run("sensitivity --gyro-model drift+rate --json -" + config);
+  ASSERT_EQ(sens.status, 0) << sens.err;
+  const nlohmann::json js = nlohmann::json::parse(sens.out);
+  EXPECT_EQ(js["gyro_model"], "drift+rate");
+  EXPECT_EQ(js["units"]["scale_factor_error_ppm"], "ppm");
+  for (const char* name : rate_errors) {
+    // Each rate error has a shift per row and compensation, or is named unidentifiable with its reason.
+    const bool named = js["not_identifiable"].contains(name);
+    EXPECT_EQ(js["rows"][0]["least_squares"]["full"].contains(name), !named) << name;
+    EXPECT_EQ(js["least_squares_noise_std"].contains(name), !named) << name;
+  }
+  EXPECT_TRUE(js["rows"][0]["least_squares"]["none"].contains("scale_factor_error_ppm"));
+  EXPECT_TRUE(js["rows"][0]["least_squares"]["full"].contains("input_axis_misalignment_S_arcsec"));
+
+  const Outcome mc = run("montecarlo --trials 200 --gyro-model drift+rate --json -" + config);
+  ASSERT_EQ(mc.status, 0) << mc.err;
+  const nlohmann::json jm = nlohmann::json::parse(mc.out);
+  EXPECT_EQ(jm["gyro_model"], "drift+rate");
+  for (const char* name : rate_errors) {
+    const bool named = jm["not_identifiable"].contains(name);
+    EXPECT_EQ(jm["coefficients"].contains(name), !named) << name;
+    EXPECT_EQ(jm["budget"].contains(name), !named) << name;
+  }
+  const nlohmann::json& e = jm["coefficients"]["scale_factor_error_ppm"];
+  EXPECT_EQ(e["unit"], "ppm");
+  EXPECT_EQ(e["truth"], 150.0);
+  for (const char* key : {"mean", "std", "predicted_std", "stated_std", "z_std", "histogram"})
+    EXPECT_TRUE(e.contains(key)) << key;
+  EXPECT_TRUE(jm["budget"]["scale_factor_error_ppm"].contains("counter_perpendicularity_x"));
+
+  // The text output names them too.
+  const Outcome text = run("montecarlo --trials 200 --gyro-model drift+rate" + config);
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("input_axis_misalignment_S_arcsec"), std::string::npos) << text.out;
+  const Outcome sens_text = run("sensitivity --gyro-model drift+rate" + config);
+  ASSERT_EQ(sens_text.status, 0) << sens_text.err;
+  EXPECT_NE(sens_text.out.find("scale_factor_error_ppm (ppm"), std::string::npos) << sens_text.out;
+
+  // [calibration] gyro_model is the default; the command line wins.
+  s.gyro_model = GyroModel::kDriftRate;
+  write("rp_rate.toml", scenario_to_toml(s));
+  ASSERT_NE(slurp(path("rp_rate.toml")).find("gyro_model = \"drift+rate\""), std::string::npos);
+  const std::string rate_config = " --config " + path("rp_rate.toml").string();
+  const Outcome by_config = run("montecarlo --trials 200 --json -" + rate_config);
+  ASSERT_EQ(by_config.status, 0) << by_config.err;
+  EXPECT_TRUE(nlohmann::json::parse(by_config.out)["coefficients"].contains("scale_factor_error_ppm"));
+  const Outcome overridden = run("sensitivity --gyro-model drift --json -" + rate_config);
+  ASSERT_EQ(overridden.status, 0) << overridden.err;
+  const nlohmann::json jo = nlohmann::json::parse(overridden.out);
+  EXPECT_EQ(jo["gyro_model"], "drift");
+  EXPECT_FALSE(jo["rows"][0]["least_squares"]["full"].contains("scale_factor_error_ppm"));
+
+  // A bad value is refused naming the option, and nothing is written.
+  for (const std::string sub : {"sensitivity", "montecarlo --trials 100"}) {
+    const Outcome bad = run(sub + " --gyro-model foo --json " + path("out.json").string() + config);
+    EXPECT_NE(bad.status, 0) << sub;
+    EXPECT_NE(bad.err.find("--gyro-model"), std::string::npos) << sub << ": " << bad.err;
+    EXPECT_NE(bad.err.find("{drift,drift+rate}"), std::string::npos) << sub << ": " << bad.err;
+    EXPECT_FALSE(fs::exists(path("out.json"))) << sub;
+  }
+  // The closed forms identify the drift coefficients only: montecarlo says so.
+  const Outcome closed = run("montecarlo --trials 100 --method closed-form --gyro-model drift+rate" + config);
+  EXPECT_NE(closed.status, 0);
+  EXPECT_NE(closed.err.find("closed forms identify the ten drift coefficients only"), std::string::npos)
+      << closed.err;
+}
+
 }  // namespace
 }  // namespace gyrocal

@@ -1,7 +1,10 @@
 // Monte Carlo uncertainty budget: reproducible whatever the threads, budgets that add up to the variance the
 // trials show, and a fast linearised mode that agrees with the whole time-series pipeline.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -129,6 +132,90 @@ TEST(MonteCarlo, JsonHasTheReportsKeys) {
   EXPECT_EQ(di["histogram"]["edges"].size(), di["histogram"]["counts"].size() + 1);
   EXPECT_TRUE(j["budget"]["dI"].contains("noise"));
   EXPECT_TRUE(j["budget"]["dI"].contains("counter_perpendicularity_y"));
+}
+
+// ---- The rate errors of the gyro model drift+rate (docs/physics.md section 15) ----------------------------
+
+/// A perfect machine (a machine error that turns with the main axis inflates the standard errors at an
+/// offset, docs/rate_platform.md), the default drift truth and noise, the rate errors of issue 12, and
+/// counter rate offsets of both signs at two speeds.
+Scenario rate_platform_scenario() {
+  Scenario s = default_scenario();
+  s.errors = CentrifugeErrors{};
+  s.gyro_rate = {150.0, -25.0, 40.0};
+  s.test.rates_rad_s = {9.9, 4.95};
+  s.test.counter_rate_offsets_rad_s = {0.0, 0.25, -0.25};
+  s.test.sample_rate_hz = sanitized() ? 30.0 : 50.0;
+  s.test.revolutions = 30;
+  s.test.settle_s = 1.0;
+  return s;
+}
+
+const EstimateDistribution& estimate(const MonteCarloResult& r, const std::string& name) {
+  for (const EstimateDistribution& e : r.estimates)
+    if (e.name == name) return e;
+  throw std::runtime_error("no estimate " + name);
+}
+
+TEST(MonteCarloRateTerms, ZScoresOfScaleFactorAndMisalignmentTowardSHaveUnitSpreadInBothModes) {
+  // Over the trials, (estimate - truth) / the std the calibration states has unit spread for e and dS: in the
+  // samples mode each trial simulates, reduces and calibrates a record with drift+rate and states its own
+  // std; the fast mode's linear prediction carries the rate errors too (the unknowns are linear in the
+  // reduced outputs), and its spread must match both the samples mode's and the budget's.
+  const Scenario s = rate_platform_scenario();
+  MonteCarloOptions o;
+  o.calibration.gyro_model = GyroModel::kDriftRate;
+  o.seed = 11;
+  o.trials = sanitized() ? 100 : 120;  // the spread of a std is about 1/sqrt(2 trials) = 0.07
+  o.mode = MonteCarloMode::kSamples;
+  const MonteCarloModel model = prepare_monte_carlo(s, o);
+  const MonteCarloResult slow = run_monte_carlo(model, o);
+  o.trials = 40000;
+  o.mode = MonteCarloMode::kFast;
+  const MonteCarloResult fast = run_monte_carlo(model, o);
+  EXPECT_EQ(slow.gyro_model, GyroModel::kDriftRate);
+  for (const char* name : {"scale_factor_error_ppm", "input_axis_misalignment_S_arcsec"}) {
+    const EstimateDistribution &a = estimate(slow, name), &b = estimate(fast, name);
+    EXPECT_EQ(a.unit, std::string(name) == "scale_factor_error_ppm" ? "ppm" : "arcsec");
+    EXPECT_EQ(a.truth, std::string(name) == "scale_factor_error_ppm" ? 150.0 : 40.0);
+    EXPECT_GT(a.z_std, 0.85) << name;
+    EXPECT_LT(a.z_std, 1.15) << name;
+    EXPECT_LT(std::abs(a.z_mean), 4.0 / std::sqrt(static_cast<double>(slow.trials))) << name;
+    EXPECT_GT(b.z_std, 0.85) << name;
+    EXPECT_LT(b.z_std, 1.15) << name;
+    expect_variance_matches(b.std, b.predicted_std, fast.trials, name);
+    EXPECT_EQ(b.budget.at(0), 1.0) << name;  // no machine uncertainty: all noise
+    std::printf(
+        "%s: z std %.3f (samples, %lld trials), %.3f (fast); std %.4g (samples), %.4g (fast), %.4g "
+        "(predicted) %s\n",
+        name, a.z_std, slow.trials, b.z_std, a.std, b.std, b.predicted_std, a.unit.c_str());
+    // The two modes agree (the samples mode's few trials set the bound).
+    EXPECT_GT(a.std / b.std, 0.8) << name;
+    EXPECT_LT(a.std / b.std, 1.2) << name;
+  }
+}
+
+TEST(MonteCarloRateTerms, ARateErrorThePlanCannotIdentifyIsNamedWithItsReasonNotGivenADistribution) {
+  // Without offsets, on a perfect machine, only the Earth rate's horizontal part reaches O and the plan
+  // cannot separate dO (docs/rate_platform.md): named with the reason, no statistics (a spread there would be
+  // the solver's arbitrary choice, not an uncertainty).
+  Scenario s = small_plan(default_scenario());
+  s.errors = CentrifugeErrors{};
+  MonteCarloOptions o;
+  o.trials = 1000;
+  o.calibration.gyro_model = GyroModel::kDriftRate;
+  const MonteCarloResult r = monte_carlo(s, o);
+  const std::string dO = "input_axis_misalignment_O_arcsec";
+  ASSERT_EQ(r.not_identifiable.size(), 1u);
+  EXPECT_EQ(r.not_identifiable[0].first, dO);
+  EXPECT_NE(r.not_identifiable[0].second.find("Earth rate"), std::string::npos);
+  EXPECT_THROW(estimate(r, dO), std::runtime_error);
+  const nlohmann::json j = montecarlo_to_json(r);
+  EXPECT_EQ(j["gyro_model"], "drift+rate");
+  EXPECT_FALSE(j["coefficients"].contains(dO));
+  EXPECT_EQ(j["not_identifiable"][dO], r.not_identifiable[0].second);
+  EXPECT_TRUE(j["coefficients"].contains("scale_factor_error_ppm"));
+  EXPECT_TRUE(j["budget"]["scale_factor_error_ppm"].contains("noise"));
 }
 
 }  // namespace

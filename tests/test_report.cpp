@@ -363,6 +363,50 @@ TEST(Report, CoefficientsTableShowsWhateverCoefficientsTheResultHolds) {
   EXPECT_EQ(plots[0]["labels"], json::array({"dI", "scale_factor_error_ppm"}));
 }
 
+TEST(Report, SensitivityAndMonteCarloShowTheRateErrorsAndSayWhichAreNotIdentifiable) {
+  // docs/physics.md section 15: with the gyro model drift+rate, least squares' shifts of the scale-factor
+  // error and the misalignments per machine error (in their units, shaded from 1 sigma), their Monte Carlo
+  // statistics, and the rate error the plan cannot identify named with its reason in both sections.
+  const json r = json::parse(R"({
+    "sensitivity": {
+      "gyro_model": "drift+rate",
+      "rows": [{"error": "counter_perpendicularity_y", "harmonic": 0, "value": -2, "unit": "arcsec",
+                "shift": {"none": {"dI": 0.5}, "full": {"dI": 0.0}},
+                "least_squares": {"none": {"dI": 0.5, "scale_factor_error_ppm": 1.91,
+                                           "input_axis_misalignment_S_arcsec": -0.0835},
+                                  "full": {"dI": 0.0, "scale_factor_error_ppm": 4.5e-8,
+                                           "input_axis_misalignment_S_arcsec": -5e-12}}}],
+      "noise_std": {"dI": 0.01},
+      "least_squares_noise_std": {"dI": 0.01, "scale_factor_error_ppm": 0.52,
+                                  "input_axis_misalignment_S_arcsec": 0.11},
+      "units": {"dI": "deg/h/g", "scale_factor_error_ppm": "ppm", "input_axis_misalignment_S_arcsec": "arcsec"},
+      "not_identifiable": {"input_axis_misalignment_O_arcsec": "only the Earth rate's horizontal part reaches O"}},
+    "montecarlo": {
+      "trials": 1000, "gyro_model": "drift+rate",
+      "coefficients": {"scale_factor_error_ppm": {"mean": 0.01, "std": 0.52, "unit": "ppm",
+                                                  "predicted_std": 0.5, "z_std": 1.04}},
+      "budget": {"scale_factor_error_ppm": {"noise": 1.0}},
+      "not_identifiable": {"input_axis_misalignment_O_arcsec": "only the Earth rate's horizontal part reaches O"}}
+  })");
+  std::vector<std::string> problems;
+  gyrocal::HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string html = gyrocal::render_html_report(r, options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  EXPECT_NE(html.find("<h3>Rate errors (least squares, gyro model drift+rate)</h3>"), std::string::npos);
+  // The shift of e without compensation, 1.91 ppm, is more than its sigma (0.52 ppm): shaded; dS's 0.0835
+  // arcsec is less than its 0.11: not.
+  EXPECT_NE(html.find("<td class=\"num far\">1.91</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num\">-0.0835</td>"), std::string::npos);
+  EXPECT_NE(html.find("[ppm], none"), std::string::npos);
+  EXPECT_NE(html.find("[arcsec], full"), std::string::npos);
+  // Named with its reason in the sensitivity and in the Monte Carlo, never given a number.
+  EXPECT_EQ(count(html, "is not identifiable from this plan: only the Earth rate&#39;s horizontal part"), 2u)
+      << html;
+  // The Monte Carlo's row: its own unit, the predicted std and the z-scores' spread.
+  EXPECT_NE(html.find("<td class=\"num\">1.04</td><td>ppm</td>"), std::string::npos);
+}
+
 /// A hand-written result of `gyrocal noise --json`: N = 0.01 deg/sqrt(h), B = 0.05 deg/h, K = 0.3
 /// deg/h/sqrt(h).
 json noise_sample() {

@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal::cli {
@@ -17,13 +18,17 @@ namespace {
 
 std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
   std::string s = fmt::format(
-      "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, which knows the configured "
-      "errors only.\nError = estimate - truth. Predicted: the linearised model (mean = noise-free error "
-      "at the configured errors).\n\n",
+      "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, gyro model {}, which knows the "
+      "configured errors only.\nError = estimate - truth. Predicted: the linearised model (mean = noise-free "
+      "error at the configured errors). z std: the std over the trials of error / the std the calibration "
+      "states ({}).\n\n",
       r.trials, to_string(r.mode), r.seed, seconds, to_string(r.method),
-      r.self ? std::string("self") : to_string(r.compensation));
-  s += fmt::format("{:<16}{:>13}{:>13}{:>13}{:>13}  {:<10} {}\n", "estimate", "mean error", "std",
-                   "pred. mean", "pred. std", "unit", "largest shares of the variance");
+      r.self ? std::string("self") : to_string(r.compensation), to_string(r.gyro_model),
+      r.mode == MonteCarloMode::kSamples ? "each trial's own" : "the configured machine's calibration's");
+  std::size_t width = 16;  // the rate errors' names are longer than the coefficients'
+  for (const EstimateDistribution& e : r.estimates) width = std::max(width, e.name.size() + 2);
+  s += fmt::format("{:<{}}{:>13}{:>13}{:>13}{:>13}{:>8}  {:<10} {}\n", "estimate", width, "mean error", "std",
+                   "pred. mean", "pred. std", "z std", "unit", "largest shares of the variance");
   for (const EstimateDistribution& e : r.estimates) {
     std::vector<std::size_t> order(r.sources.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -34,9 +39,12 @@ std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
       if (e.budget[order[k]] >= 0.005)
         shares += fmt::format("{}{} {:.0f}%", shares.empty() ? "" : ", ", r.sources[order[k]],
                               100.0 * e.budget[order[k]]);
-    s += fmt::format("{:<16}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}  {:<10} {}\n", e.name, e.mean, e.std,
-                     e.predicted_mean, e.predicted_std, e.unit, shares);
+    s += fmt::format("{:<{}}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}{:>8.3g}  {:<10} {}\n", e.name, width, e.mean,
+                     e.std, e.predicted_mean, e.predicted_std, e.z_std, e.unit, shares);
   }
+  // docs/physics.md section 15: what the plan cannot identify has no distribution, and is said why.
+  for (const auto& [name, reason] : r.not_identifiable)
+    s += fmt::format("{:<{}}not identifiable: {}\n", name, width, reason);
   s += "\nsources:";
   for (std::size_t k = 0; k < r.sources.size(); ++k)
     s += fmt::format("  {} {:g} {}", r.sources[k], r.source_std[k], r.source_units[k]);
@@ -55,6 +63,7 @@ constexpr long long kMaxSampleTrials = 100'000;
 void register_montecarlo(CLI::App& app) {
   struct Options {
     std::string config, json, method = "least-squares", compensation = "full";
+    std::string gyro_model;  // empty: [calibration] gyro_model
     long long trials = 0;
     std::uint64_t seed = 0;
     bool samples = false;
@@ -77,6 +86,10 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--compensation", opt->compensation,
                   "none, seed, full (default) or self (the counter platform's errors estimated; two speeds)")
       ->check(CLI::IsMember({"none", "seed", "full", "self"}));
+  sub->add_option("--gyro-model", opt->gyro_model,
+                  "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input "
+                  "axis' misalignments; least squares); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt, seed] {
     const long long most = opt->samples ? kMaxSampleTrials : kMaxFastTrials;
@@ -101,6 +114,8 @@ void register_montecarlo(CLI::App& app) {
     options.calibration.method = parse_method(opt->method);
     options.self = opt->compensation == "self";
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
+    options.calibration.gyro_model =
+        opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);

@@ -8,6 +8,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/sensitivity.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 
 namespace gyrocal::cli {
@@ -22,6 +23,42 @@ std::string magnitude(const SensitivityRow& row) {
 std::string row_label(const SensitivityRow& row) {
   if (row.term.harmonic == 0) return row.term.error;
   return fmt::format("{} h{} @{:g}", row.term.error, row.term.harmonic, row.term.phase_rad * kRadToDeg);
+}
+
+/// docs/physics.md section 15: least squares' shift of each rate error per machine error and compensation, in
+/// the rate error's unit (ppm, arcsec); a rate error the plan does not identify is named with its reason.
+std::string rate_terms_table(const SensitivityResult& r) {
+  std::string s = fmt::format(
+      "\nleast squares, gyro model drift+rate: shift of the rate errors in their units; * = more than {} "
+      "sigma\n",
+      r.threshold);
+  for (std::size_t k = 0; k < kNumRateTerms; ++k) {
+    const std::string name(kRateTermNames[k]);
+    if (const auto it = r.not_identifiable.find(name); it != r.not_identifiable.end()) {
+      s += fmt::format("\n{}: not identifiable: {}\n", name, it->second);
+      continue;
+    }
+    const auto sigma = r.least_squares_noise_std.find(name);
+    s += fmt::format("\n{} ({}; sigma {:.3g})\n{:<30}{:>18}", name, kRateTermUnits[k],
+                     sigma != r.least_squares_noise_std.end() ? sigma->second : NAN, "machine error",
+                     "magnitude");
+    for (const char* c : kCompensationNames) s += fmt::format("{:>12}", c);
+    if (r.has_self) s += fmt::format("{:>12}", "self");
+    s += "\n";
+    const auto cell = [&](const ShiftMap& shifts, const std::vector<std::string>& matters) {
+      const auto it = shifts.find(name);
+      if (it == shifts.end()) return fmt::format("{:>12}", "-");
+      const bool m = std::find(matters.begin(), matters.end(), name) != matters.end();
+      return fmt::format("{:>12}", fmt::format("{:.3g}{}", it->second, m ? "*" : ""));
+    };
+    for (const SensitivityRow& row : r.rows) {
+      s += fmt::format("{:<30}{:>18}", row_label(row), magnitude(row));
+      for (std::size_t c = 0; c < 3; ++c) s += cell(row.least_squares[c], row.least_squares_matters[c]);
+      if (r.has_self) s += cell(row.self, row.self_matters);
+      s += "\n";
+    }
+  }
+  return s;
 }
 
 /// Per compensation: the closed forms' shifts in units of their noise std, '.' below the threshold.
@@ -74,6 +111,7 @@ std::string sensitivity_table(const SensitivityResult& r) {
     }
     s += fmt::format("{:<30}{:>18}{}\n", row_label(row), magnitude(row), line);
   }
+  if (r.gyro_model == GyroModel::kDriftRate) s += rate_terms_table(r);
   return s;
 }
 
@@ -82,6 +120,7 @@ std::string sensitivity_table(const SensitivityResult& r) {
 void register_sensitivity(CLI::App& app) {
   struct Options {
     std::string config, json;
+    std::string gyro_model;  // empty: [calibration] gyro_model
     double threshold = 0.1;
     int threads = 0;
   };
@@ -96,10 +135,17 @@ void register_sensitivity(CLI::App& app) {
       ->check(kFinite & CLI::PositiveNumber);
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
       ->check(CLI::NonNegativeNumber);
+  sub->add_option("--gyro-model", opt->gyro_model,
+                  "drift (the ten coefficients) or drift+rate (least squares also gives the shifts of the "
+                  "scale-factor error and the input axis' misalignments); default: [calibration] gyro_model, "
+                  "else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
     const Scenario scenario = load_configuration(opt->config);
     SensitivityOptions options;
+    options.calibration.gyro_model =
+        opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
     options.threshold = opt->threshold;
     options.threads = opt->threads;
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("sensitivity");

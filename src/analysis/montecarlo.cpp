@@ -23,18 +23,33 @@ namespace gyrocal {
 namespace {
 
 /// The estimates of a calibration, as errors: (value - true value) per name, in `names` order; an estimate
-/// missing from `r` is NaN. Fills names, units, truth when `names` is empty.
+/// missing from `r` is NaN. With the gyro model drift+rate, the identifiable rate errors are estimates too,
+/// measured from `rate_truth` (docs/physics.md section 15). Fills names, units, truth when `names` is empty;
+/// `stated_std` (when given) gets the standard uncertainty the calibration states for each, NaN where
+/// missing.
 std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoefficients& truth,
-                                    std::vector<std::string>& names, std::vector<std::string>* units,
-                                    std::vector<double>* true_values) {
-  std::vector<std::pair<std::string, double>> value, true_value;
-  std::vector<std::string> unit;
+                                    const GyroRateErrors& rate_truth, std::vector<std::string>& names,
+                                    std::vector<std::string>* units, std::vector<double>* true_values,
+                                    std::vector<double>* stated_std = nullptr) {
+  struct Entry {
+    std::string name;
+    double value = 0.0, truth = 0.0, std = 0.0;
+    std::string unit;
+  };
+  std::vector<Entry> entries;
   for (std::size_t k = 0; k < kNumCoefficients; ++k)
-    if (r.coefficients[k].identifiable) {
-      value.emplace_back(std::string(kCoefficientNames[k]), r.coefficients[k].value);
-      true_value.emplace_back(std::string(kCoefficientNames[k]), truth.values[k]);
-      unit.emplace_back(kCoefficientUnits[k]);
-    }
+    if (r.coefficients[k].identifiable)
+      entries.push_back({std::string(kCoefficientNames[k]), r.coefficients[k].value, truth.values[k],
+                         r.coefficients[k].std, std::string(kCoefficientUnits[k])});
+  if (r.gyro_model == GyroModel::kDriftRate) {
+    const double rate_truths[kNumRateTerms] = {rate_truth.scale_factor_error_ppm,
+                                               rate_truth.input_axis_misalignment_O_arcsec,
+                                               rate_truth.input_axis_misalignment_S_arcsec};
+    for (std::size_t k = 0; k < kNumRateTerms; ++k)
+      if (r.rate_terms[k].identifiable)
+        entries.push_back({std::string(kRateTermNames[k]), r.rate_terms[k].value, rate_truths[k],
+                           r.rate_terms[k].std, std::string(kRateTermUnits[k])});
+  }
   if (r.method == Method::kClosedForm) {
     // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
     const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
@@ -43,37 +58,36 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoeff
                                                       {"dIS_b", Coefficient::dIS}};
     for (const NamedEstimate& e : r.alternatives)
       for (const auto& [n, c] : of)
-        if (e.name == n) {
-          value.emplace_back(e.name, e.value);
-          true_value.emplace_back(e.name, truth[c]);
-          unit.push_back(e.unit);
-        }
+        if (e.name == n) entries.push_back({e.name, e.value, truth[c], e.std, e.unit});
   }
   for (const NamedEstimate& e : r.combinations) {
     double t = 0.0;
     for (std::size_t k = 0; k < e.coefficients.size() && k < kNumCoefficients; ++k)
       t += e.coefficients[k] * truth.values[k];
-    value.emplace_back(e.name, e.value);
-    true_value.emplace_back(e.name, t);
-    unit.push_back(e.unit);
+    entries.push_back({e.name, e.value, t, e.std, e.unit});
   }
   if (names.empty()) {
-    for (const auto& v : value) names.push_back(v.first);
-    if (units) *units = unit;
-    if (true_values)
-      for (const auto& t : true_value) true_values->push_back(t.second);
+    for (const Entry& e : entries) {
+      names.push_back(e.name);
+      if (units) units->push_back(e.unit);
+      if (true_values) true_values->push_back(e.truth);
+    }
   }
   std::vector<double> out(names.size(), std::numeric_limits<double>::quiet_NaN());
+  if (stated_std) stated_std->assign(names.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < names.size(); ++i)
-    for (std::size_t j = 0; j < value.size(); ++j)
-      if (value[j].first == names[i]) out[i] = value[j].second - true_value[j].second;
+    for (const Entry& e : entries)
+      if (e.name == names[i]) {
+        out[i] = e.value - e.truth;
+        if (stated_std) (*stated_std)[i] = e.std;
+      }
   return out;
 }
 
 /// Noise-free reduced outputs (deg/h) of scenario s's test, in plan order.
 Eigen::VectorXd noise_free_outputs(const Scenario& s, const ReduceOptions& ro) {
   Reduction r = planned_reduction(s);
-  set_noise_free_outputs(r, reduce_model_channels(r, s.model(), ro), s.gyro);
+  set_noise_free_outputs(r, reduce_model_channels(r, s.model(), ro), s.gyro, s.gyro_rate);
   Eigen::VectorXd w(static_cast<Eigen::Index>(r.positions.size()));
   for (std::size_t i = 0; i < r.positions.size(); ++i)
     w[static_cast<Eigen::Index>(i)] = r.positions[i].mean_deg_h;
@@ -129,7 +143,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
   // The outputs are the true machine's (the told one differs under "self").
   set_noise_free_outputs(r0, options.self ? reduce_model_channels(r0, scenario.model(), ro) : ch0,
-                         scenario.gyro);
+                         scenario.gyro, scenario.gyro_rate);
   set_predicted_std_errors(r0, scenario.noise, scenario.test.sample_rate_hz, ro);
   const auto np = static_cast<Eigen::Index>(r0.positions.size());
   m.positions = static_cast<int>(np);
@@ -140,13 +154,21 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean_deg_h += dw[i];
     return identify(r, ch0, model0, m.calibration);
   };
-  m.bias =
-      estimate_errors(identify_at(Eigen::VectorXd::Zero(np)), scenario.gyro, m.names, &m.units, &m.truth);
+  const CalibrationResult configured = identify_at(Eigen::VectorXd::Zero(np));
+  m.bias = estimate_errors(configured, scenario.gyro, scenario.gyro_rate, m.names, &m.units, &m.truth,
+                           &m.stated_std);
+  // docs/physics.md section 15: a rate error the plan cannot identify has no distribution; it is said why.
+  if (configured.gyro_model == GyroModel::kDriftRate)
+    for (std::size_t k = 0; k < kNumRateTerms; ++k)
+      if (!configured.rate_terms[k].identifiable)
+        m.not_identifiable.emplace_back(std::string(kRateTermNames[k]), configured.rate_terms[k].reason);
   const auto ne = static_cast<Eigen::Index>(m.names.size());
   Eigen::MatrixXd map(ne, np);
+  // Affine in W: the unknowns are linear in the reduced outputs (identify/unknowns.hpp); the misalignments'
+  // division by (1 + e) bends it by e's change per deg/h of output, parts per million of theirs.
   for (Eigen::Index k = 0; k < np; ++k) {
-    const std::vector<double> e =
-        estimate_errors(identify_at(Eigen::VectorXd::Unit(np, k)), scenario.gyro, m.names, nullptr, nullptr);
+    const std::vector<double> e = estimate_errors(identify_at(Eigen::VectorXd::Unit(np, k)), scenario.gyro,
+                                                  scenario.gyro_rate, m.names, nullptr, nullptr);
     for (Eigen::Index i = 0; i < ne; ++i)
       map(i, k) = e[static_cast<std::size_t>(i)] - m.bias[static_cast<std::size_t>(i)];
   }
@@ -195,12 +217,15 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   if (!options.IsValid(&error)) throw Error("Monte Carlo options: " + error + ".");
   const std::size_t ne = m.names.size(), nc = m.columns(), ns = m.sources.size();
   const bool fast = options.mode == MonteCarloMode::kFast;
+  // Values per trial: the estimates' errors, and in the samples mode their z-scores against the standard
+  // uncertainty each trial's calibration states (the fast mode's is the configured calibration's, fixed).
+  const std::size_t nv = fast ? ne : 2 * ne;
   const auto trials = static_cast<std::size_t>(options.trials);
 
   // The samples mode's fixed parts: the configured model the calibration knows.
   const CentrifugeModel model0 = m.told.model();
 
-  // Trial k's estimate errors into out[0..ne).
+  // Trial k's estimate errors into out[0..ne), in the samples mode their z-scores into out[ne..2 ne).
   const auto trial = [&](std::size_t k, double* out) {
     RandomSource rng(options.seed, k);
     if (fast) {
@@ -231,9 +256,13 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     const Reduction r = reducer.finish();
     const auto channels = reduce_model_channels(r, model0, m.calibration.reduce);
     std::vector<std::string> names = m.names;
-    const std::vector<double> e = estimate_errors(identify(r, channels, model0, m.calibration),
-                                                  m.scenario.gyro, names, nullptr, nullptr);
+    std::vector<double> stated;
+    const std::vector<double> e =
+        estimate_errors(identify(r, channels, model0, m.calibration), m.scenario.gyro, m.scenario.gyro_rate,
+                        names, nullptr, nullptr, &stated);
     std::copy(e.begin(), e.end(), out);
+    for (std::size_t i = 0; i < ne; ++i)
+      out[ne + i] = stated[i] > 0.0 ? e[i] / stated[i] : std::numeric_limits<double>::quiet_NaN();
   };
 
   // Chunks of trials in a fixed partition: statistics are combined in chunk order, so they do not depend
@@ -244,7 +273,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   const std::size_t chunks = (trials + chunk - 1) / chunk;
   const std::size_t batch = 1024;
   std::vector<ChunkStats> stats(std::min(chunks, batch));
-  std::vector<double> stored(fast ? 0 : trials * ne);
+  std::vector<double> stored(fast ? 0 : trials * nv);
   std::atomic<std::size_t> done{0};
   const double passes = fast ? 2.0 : 1.0;
   const auto tick = [&] {
@@ -254,8 +283,8 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   };
   // Chan et al.'s pairwise update, chunk by chunk in order, per estimate.
   double n_all = 0;
-  std::vector<double> mean_all(ne, 0.0), m2_all(ne, 0.0), lo_all(ne, std::numeric_limits<double>::infinity()),
-      hi_all(ne, -std::numeric_limits<double>::infinity());
+  std::vector<double> mean_all(nv, 0.0), m2_all(nv, 0.0), lo_all(nv, std::numeric_limits<double>::infinity()),
+      hi_all(nv, -std::numeric_limits<double>::infinity());
   for (std::size_t first = 0; first < chunks; first += batch) {
     const std::size_t count = std::min(batch, chunks - first);
     parallel_for(
@@ -263,26 +292,26 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
         [&](std::size_t b) {
           const std::size_t c = first + b;
           const std::size_t begin = c * chunk, end = std::min(trials, begin + chunk);
-          std::vector<double> values((end - begin) * ne);
-          for (std::size_t k = begin; k < end; ++k) trial(k, values.data() + (k - begin) * ne);
+          std::vector<double> values((end - begin) * nv);
+          for (std::size_t k = begin; k < end; ++k) trial(k, values.data() + (k - begin) * nv);
           ChunkStats& st = stats[b];
           st.n = static_cast<long long>(end - begin);
-          st.mean.assign(ne, 0.0);
-          st.m2.assign(ne, 0.0);
-          st.lo.assign(ne, std::numeric_limits<double>::infinity());
-          st.hi.assign(ne, -std::numeric_limits<double>::infinity());
-          for (std::size_t i = 0; i < ne; ++i) {
-            for (std::size_t k = 0; k < end - begin; ++k) st.mean[i] += values[k * ne + i];
+          st.mean.assign(nv, 0.0);
+          st.m2.assign(nv, 0.0);
+          st.lo.assign(nv, std::numeric_limits<double>::infinity());
+          st.hi.assign(nv, -std::numeric_limits<double>::infinity());
+          for (std::size_t i = 0; i < nv; ++i) {
+            for (std::size_t k = 0; k < end - begin; ++k) st.mean[i] += values[k * nv + i];
             st.mean[i] /= static_cast<double>(st.n);
             for (std::size_t k = 0; k < end - begin; ++k) {
-              const double v = values[k * ne + i];
+              const double v = values[k * nv + i];
               st.m2[i] += (v - st.mean[i]) * (v - st.mean[i]);
               st.lo[i] = std::min(st.lo[i], v);
               st.hi[i] = std::max(st.hi[i], v);
             }
           }
           if (!fast)
-            std::copy(values.begin(), values.end(), stored.begin() + static_cast<std::ptrdiff_t>(begin * ne));
+            std::copy(values.begin(), values.end(), stored.begin() + static_cast<std::ptrdiff_t>(begin * nv));
           done += end - begin;
         },
         tick);
@@ -290,7 +319,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
       const ChunkStats& st = stats[b];
       const auto nb = static_cast<double>(st.n);
       const double total = n_all + nb;
-      for (std::size_t i = 0; i < ne; ++i) {
+      for (std::size_t i = 0; i < nv; ++i) {
         const double delta = st.mean[i] - mean_all[i];
         mean_all[i] += delta * nb / total;
         m2_all[i] += st.m2[i] + delta * delta * n_all * nb / total;
@@ -308,6 +337,8 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   result.method = m.calibration.method;
   result.self = !m.calibration.estimate.empty();
   result.compensation = m.calibration.compensation;
+  result.gyro_model = m.calibration.gyro_model;
+  result.not_identifiable = m.not_identifiable;
   result.sources.push_back("noise");
   result.source_std.push_back(m.scenario.noise.angle_random_walk_deg_rt_h);
   result.source_units.push_back("deg/sqrt(h)");
@@ -326,6 +357,16 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     double lo = lo_all[i], hi = hi_all[i];
     d.mean = mean_all[i];
     d.std = std::sqrt(m2_all[i] / (n_all - 1));
+    // The z-scores (error / the stated standard uncertainty): the samples mode's per trial; the fast mode's
+    // against the configured calibration's stated std, the same in every trial.
+    d.stated_std = m.stated_std[i];
+    if (!fast) {
+      d.z_mean = mean_all[ne + i];
+      d.z_std = std::sqrt(m2_all[ne + i] / (n_all - 1));
+    } else if (d.stated_std > 0.0) {
+      d.z_mean = d.mean / d.stated_std;
+      d.z_std = d.std / d.stated_std;
+    }
     if (!(hi > lo)) {
       const double pad = std::max(std::abs(lo) * 1e-6, 1e-12);
       lo -= pad;
@@ -380,7 +421,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     }
   } else {
     for (std::size_t k = 0; k < trials; ++k)
-      for (std::size_t i = 0; i < ne; ++i) ++result.estimates[i].counts[bin_of(i, stored[k * ne + i])];
+      for (std::size_t i = 0; i < ne; ++i) ++result.estimates[i].counts[bin_of(i, stored[k * nv + i])];
   }
   if (options.progress) options.progress(1.0);
   return result;

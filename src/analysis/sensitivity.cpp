@@ -93,6 +93,11 @@ std::vector<std::pair<std::string, std::pair<double, double>>> estimates(const C
   for (std::size_t k = 0; k < kNumCoefficients; ++k)
     if (r.coefficients[k].identifiable)
       out.push_back({std::string(kCoefficientNames[k]), {r.coefficients[k].value, r.coefficients[k].std}});
+  // docs/physics.md section 15: the rate errors, in ppm and arcsec, where the plan identifies them.
+  if (r.gyro_model == GyroModel::kDriftRate)
+    for (std::size_t k = 0; k < kNumRateTerms; ++k)
+      if (r.rate_terms[k].identifiable)
+        out.push_back({std::string(kRateTermNames[k]), {r.rate_terms[k].value, r.rate_terms[k].std}});
   if (r.method == Method::kClosedForm)
     for (const NamedEstimate& e : r.alternatives) out.push_back({e.name, {e.value, e.std}});
   for (const NamedEstimate& e : r.combinations) {
@@ -113,7 +118,7 @@ PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
   PlannedTest p;
   p.reduction = planned_reduction(s);
   p.channels = reduce_model_channels(p.reduction, s.model(), ro, kMaxModelSamplesPerDwell);
-  set_noise_free_outputs(p.reduction, p.channels, s.gyro);
+  set_noise_free_outputs(p.reduction, p.channels, s.gyro, s.gyro_rate);
   set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz);
   return p;
 }
@@ -130,6 +135,8 @@ SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base)
     for (int c = 0; c < 3; ++c) {
       CalibrationOptions o = base;
       o.method = m == 0 ? Method::kClosedForm : Method::kLeastSquares;
+      // The closed forms identify the drift coefficients only (docs/physics.md section 15).
+      if (m == 0) o.gyro_model = GyroModel::kDrift;
       o.compensation = kCompensations[c];
       out[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] =
           identify(p.reduction, p.channels, model, o);
@@ -211,6 +218,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   const std::vector<std::pair<MachineErrorTerm, double>> terms = sensitivity_terms(scenario.errors);
   SensitivityResult result;
   result.threshold = options.threshold;
+  result.gyro_model = options.calibration.gyro_model;
   result.rows.resize(terms.size());
   // Item 0 is the base case (no machine error), items 1.. the rows; every item is independent.
   std::vector<SixCalibrations> runs(terms.size() + 1);
@@ -246,6 +254,13 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
     }
     for (std::size_t k = 0; k < kNumCoefficients; ++k)
       result.units[std::string(kCoefficientNames[k])] = std::string(kCoefficientUnits[k]);
+    if (result.gyro_model == GyroModel::kDriftRate)
+      for (std::size_t k = 0; k < kNumRateTerms; ++k) {
+        result.units[std::string(kRateTermNames[k])] = std::string(kRateTermUnits[k]);
+        // What the plan cannot identify is said with its reason (least squares' base case).
+        if (m == 1 && !r0.rate_terms[k].identifiable)
+          result.not_identifiable[std::string(kRateTermNames[k])] = r0.rate_terms[k].reason;
+      }
     for (const NamedEstimate& e : r0.alternatives) result.units[e.name] = e.unit;
     for (const NamedEstimate& e : r0.combinations) result.units[e.name] = e.unit;
   }

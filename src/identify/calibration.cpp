@@ -169,7 +169,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   };
   for (const LinearForm& f : cf.primary) {
     for (std::size_t c = 0; c < kNumCoefficients; ++c)
-      if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), std_of(f), true};
+      if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), std_of(f), true, {}};
   }
   for (const LinearForm& f : cf.alternatives)
     r.alternatives.push_back({f.name, f.unit, f.value(w), std_of(f), {}});
@@ -354,18 +354,34 @@ void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
         "then separate from the counter rate mismatch and the drift less well than with offsets of both "
         "signs "
         "(docs/physics.md section 15).");
-  if (d_o.identifiable)
+  if (d_o.identifiable) {
     r.warnings.push_back(fmt::format(
         "input_axis_misalignment_O_arcsec is weakly identifiable (standard uncertainty {:.3g} arcsec): a "
         "rotation about Up never turns the gyro about O, which stays horizontal, so only the Earth rate's "
         "horizontal part (about 11 deg/h at 39 deg latitude) reaches it (docs/physics.md section 15).",
         d_o.std));
-  else
-    r.warnings.push_back(
-        "input_axis_misalignment_O_arcsec is not identifiable from this plan: only the Earth rate's "
-        "horizontal "
-        "part reaches O (a rotation about Up never does), and this plan cannot separate it (docs/physics.md "
-        "section 15).");
+  } else {
+    d_o.reason =
+        "only the Earth rate's horizontal part reaches O (a rotation about Up never does), and this plan "
+        "cannot separate it (docs/physics.md section 15).";
+    r.warnings.push_back("input_axis_misalignment_O_arcsec is not identifiable from this plan: " +
+                         d_o.reason);
+  }
+  // Each rate error the plan leaves unidentifiable gets its reason, so that a study of the result (the
+  // sensitivity, the Monte Carlo) can say why it shows no number.
+  const char* const advice =
+      "; counter rate offsets of both signs ([test] counter_rate_offsets_rad_s) turn the gyro about I and S "
+      "(docs/physics.md section 15).";
+  for (CoefficientEstimate* c : {&e, &d_s})
+    if (!c->identifiable)
+      c->reason = offsets ? std::string(
+                                "this plan cannot separate it from the drift coefficients and the "
+                                "other rate errors (see the unidentifiable directions)") +
+                                advice
+                          : std::string(
+                                "without counter rate offsets only the Earth rate (at most 15 "
+                                "deg/h) turns the gyro about I and S") +
+                                advice;
 }
 
 void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
@@ -436,8 +452,8 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   for (std::size_t c = 0; c < unknowns.size(); ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
     if (!sol.identifiable[c]) continue;
-    const CoefficientEstimate estimate = {sol.estimate[ci],
-                                          sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true};
+    const CoefficientEstimate estimate = {
+        sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true, {}};
     if (c < kNumCoefficients)
       r.coefficients[c] = estimate;
     else

@@ -364,6 +364,89 @@ void positions(const json& result, Page& page, std::string& out) {
       "standard error of the mean.</p>\n";
 }
 
+/// The rate errors of the gyro model drift+rate are least squares' alone (docs/physics.md section 15): the
+/// closed forms' heat maps do not hold them. With docs/contract.md's `not_identifiable` {name: reason}, a
+/// rate error the plan cannot identify.
+constexpr const char* kRateErrorNames[] = {"scale_factor_error_ppm", "input_axis_misalignment_O_arcsec",
+                                           "input_axis_misalignment_S_arcsec"};
+
+/// The estimates a result names unidentifiable (`not_identifiable`, {name: reason}), each with its reason,
+/// as a highlighted list; empty when there are none.
+std::string not_identifiable_notes(const json* not_identifiable, std::string_view where) {
+  if (not_identifiable == nullptr) return "";
+  expect(*not_identifiable, json::value_t::object, where);
+  if (not_identifiable->empty()) return "";
+  std::string items;
+  for (const auto& name : ordered_keys(*not_identifiable))
+    items += fmt::format("<li><strong>{}</strong> is not identifiable from this plan: {}</li>\n", esc(name),
+                         esc(scalar_text((*not_identifiable)[name])));
+  return "<div class=\"warnings\"><ul>\n" + items + "</ul></div>\n";
+}
+
+/// Least squares' shift of the scale-factor error and the input axis' misalignments per machine error and
+/// compensation, in their units; a cell of at least 1 sigma (least_squares_noise_std) is shaded.
+void sensitivity_rate_errors(const json& result, const json& s, const std::vector<std::string>& row_labels,
+                             std::string& out) {
+  const json& rows_j = s["rows"];
+  const json* sigma_j = find(s, "least_squares_noise_std");
+  if (sigma_j) expect(*sigma_j, json::value_t::object, "sensitivity.least_squares_noise_std");
+  const json* units_j = find(s, "units");
+  std::vector<std::string> names, compensations;
+  for (const char* name : kRateErrorNames)
+    for (const auto& row : rows_j)
+      if (const json* ls = find(row, "least_squares"); ls && ls->is_object()) {
+        for (const auto& [comp, m] : ls->items())
+          if (m.is_object() && m.contains(name)) {
+            if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+            if (std::find(compensations.begin(), compensations.end(), comp) == compensations.end())
+              compensations.push_back(comp);
+          }
+      }
+  const json* not_identifiable = find(s, "not_identifiable");
+  if (names.empty() && (not_identifiable == nullptr || not_identifiable->empty())) return;
+  std::vector<std::string> ordered_comp;
+  for (const char* c : {"none", "seed", "full", "self"})
+    if (std::find(compensations.begin(), compensations.end(), c) != compensations.end())
+      ordered_comp.push_back(c);
+  out +=
+      "<h3>Rate errors (least squares, gyro model drift+rate)</h3>\n<p class=\"note\">Each machine error "
+      "alone shifts the scale-factor error and the input axis' misalignments by the amounts below, in their "
+      "units; shaded where the shift is at least the estimate's noise standard uncertainty \xCF\x83.</p>\n";
+  out += not_identifiable_notes(not_identifiable, "sensitivity.not_identifiable");
+  if (names.empty()) return;
+  std::vector<std::string> header = {"machine error", "magnitude"};
+  for (const auto& name : names) {
+    std::string unit = units_j && units_j->is_object() ? string_or(*units_j, name) : "";
+    if (unit.empty()) unit = unit_of(result, name);
+    const auto sigma = sigma_j ? number(*sigma_j, name, "sensitivity.least_squares_noise_std") : std::nullopt;
+    for (const auto& comp : ordered_comp)
+      header.push_back(fmt::format("{} [{}], {}{}", name, unit, comp,
+                                   sigma ? fmt::format(" (\xCF\x83 {})", num(sigma, 2)) : std::string()));
+  }
+  std::vector<std::vector<Cell>> rows;
+  for (std::size_t k = 0; k < rows_j.size(); ++k) {
+    const json& row = rows_j[k];
+    const std::string where = fmt::format("sensitivity.rows[{}].least_squares", k);
+    std::vector<Cell> cells = {
+        text_cell(row_labels[k]),
+        num_cell(fmt::format("{} {}", num(number(row, "value", where)), string_or(row, "unit")))};
+    const json* ls = find(row, "least_squares");
+    for (const auto& name : names) {
+      // Zero where no sigma is given: then no cell is shaded.
+      const double sigma =
+          sigma_j ? number(*sigma_j, name, "sensitivity.least_squares_noise_std").value_or(0.0) : 0.0;
+      for (const auto& comp : ordered_comp) {
+        const json* m = ls ? find(*ls, comp) : nullptr;
+        const auto shift = m && m->contains(name) ? number(*m, name, where + "." + comp) : std::nullopt;
+        const bool far = sigma > 0 && std::fabs(shift.value_or(0.0)) >= sigma;
+        cells.push_back(num_cell(num(shift, 3), far ? "far" : ""));
+      }
+    }
+    rows.push_back(std::move(cells));
+  }
+  out += table(header, rows, "wrap");
+}
+
 void sensitivity(const json& result, Page& page, std::string& out) {
   const json& s = member(result, "sensitivity", "the result");
   const json& rows_j = member(s, "rows", "sensitivity");
@@ -515,6 +598,7 @@ void sensitivity(const json& result, Page& page, std::string& out) {
   for (const auto& comp : ordered_comp) header.push_back("compensation " + comp);
   out += normalised ? "<h3>Shifts of at least 1\xCF\x83</h3>\n" : "<h3>Largest shifts</h3>\n";
   out += table(header, significant_rows, "wrap");
+  sensitivity_rate_errors(result, s, row_labels, out);
 }
 
 void montecarlo(const json& result, Page& page, std::string& out) {
@@ -531,8 +615,12 @@ void montecarlo(const json& result, Page& page, std::string& out) {
       const json& e = (*c)[name];
       expect(e, json::value_t::object, where);
       const auto mean = number(e, "mean", where), std_dev = number(e, "std", where);
+      // The entry's own unit (a rate error's ppm or arcsec), else the result's coefficients'.
+      std::string unit = string_or(e, "unit");
+      if (unit.empty()) unit = unit_of(result, name);
       rows.push_back({text_cell(name), num_cell(num(mean, 4)), num_cell(num(std_dev, 3)),
-                      text_cell(unit_of(result, name))});
+                      num_cell(num(number(e, "predicted_std", where), 3)),
+                      num_cell(num(number(e, "z_std", where), 3)), text_cell(unit)});
       const json* h = find(e, "histogram");
       if (h == nullptr) continue;
       const json& edges = member(*h, "edges", where + ".histogram");
@@ -551,7 +639,6 @@ void montecarlo(const json& result, Page& page, std::string& out) {
         values.push_back(opt_json(n));
         tips.push_back(fmt::format("[{}, {})", num(lo, 4), num(hi, 4)));
       }
-      const std::string unit = unit_of(result, name);
       const HistogramChart chart{
           .labels = labels,
           .counts = values,
@@ -562,7 +649,10 @@ void montecarlo(const json& result, Page& page, std::string& out) {
       grid += page.plot(chart.to_json(), 220, "histogram of " + name + " over the Monte Carlo trials",
                         "plot cell");
     }
-    out += table({"estimate", "mean", "standard deviation", "unit"}, rows, "compact");
+    out += table({"estimate", "mean", "standard deviation", "predicted std",
+                  "z std (error / stated \xCF\x83)", "unit"},
+                 rows, "compact");
+    out += not_identifiable_notes(find(m, "not_identifiable"), "montecarlo.not_identifiable");
     if (!grid.empty()) out += "<h3>Distributions</h3>\n<div class=\"grid\">\n" + grid + "</div>\n";
   }
   if (const json* b = find(m, "budget")) {

@@ -41,6 +41,8 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
           {"std", c.identifiable ? number_or_null(c.std) : nlohmann::json(nullptr)},
           {"unit", kRateTermUnits[k]},
           {"identifiable", c.identifiable}};
+      if (!c.identifiable && !c.reason.empty())
+        coefficients[std::string(kRateTermNames[k])]["reason"] = c.reason;
     }
   j["coefficients"] = coefficients;
   j["combinations"] = nlohmann::json::array();

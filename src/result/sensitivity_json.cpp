@@ -1,6 +1,7 @@
 #include "gyrocal/result/sensitivity_json.hpp"
 
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 
 namespace gyrocal {
 
@@ -46,6 +47,10 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
     out["least_squares_noise_std"][name] = r.least_squares_noise_std.at(name);
   if (r.has_self) out["self_noise_std"] = r.self_noise_std;
   out["units"] = r.units;
+  // docs/physics.md section 15: the gyro model least squares fitted, and the rate errors it could not
+  // identify with the reason (the others' shifts are in least_squares, by name).
+  out["gyro_model"] = to_string(r.gyro_model);
+  if (r.gyro_model == GyroModel::kDriftRate) out["not_identifiable"] = r.not_identifiable;
   return out;
 }
 

@@ -15,6 +15,7 @@
 // seed gives the same result whatever the number of threads.
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,9 +32,11 @@ struct MonteCarloOptions {
   long long trials = 10000;  ///< number of trials (>= 2)
   std::uint64_t seed = 1;    ///< trial k draws from RandomSource(seed, k)
   MonteCarloMode mode = MonteCarloMode::kFast;
-  int threads = 0;                 ///< worker threads; 0 = hardware concurrency
-  CalibrationOptions calibration;  ///< method (default least squares), compensation (default full)
-  int histogram_bins = 30;         ///< bins between the smallest and largest error
+  int threads = 0;  ///< worker threads; 0 = hardware concurrency
+  /// Method (default least squares), compensation (default full), gyro model (default drift; drift+rate adds
+  /// the rate errors of docs/physics.md section 15 to the estimates, least squares only).
+  CalibrationOptions calibration;
+  int histogram_bins = 30;  ///< bins between the smallest and largest error
   /// Compensation "self" (docs/self_calibration.md): least squares told every configured error but
   /// kSelfCalibratedErrors, which each trial estimates from its data (their configured values are not used).
   /// Needs a plan with two non-zero speeds to identify them. Default false.
@@ -63,8 +66,14 @@ struct MonteCarloModel {
   std::vector<std::string> units;
   std::vector<double> truth;  ///< true value of each estimate (a combination's, for its coefficients)
   std::vector<double> bias;   ///< noise-free error of each estimate at the configured errors
-  int positions = 0;          ///< reduced positions (noise columns)
-  std::vector<double> gain;   ///< G, row-major, names.size() x (sources.size() + positions)
+  /// The standard uncertainty the calibration of the configured machine states for each estimate (white
+  /// noise, as `plan` weights); the fast mode's z-scores are measured against it.
+  std::vector<double> stated_std;
+  /// With drift+rate: each rate error the plan cannot identify (kRateTermNames) and why
+  /// (CoefficientEstimate::reason); it is not among the estimates.
+  std::vector<std::pair<std::string, std::string>> not_identifiable;
+  int positions = 0;         ///< reduced positions (noise columns)
+  std::vector<double> gain;  ///< G, row-major, names.size() x (sources.size() + positions)
   std::size_t columns() const { return sources.size() + static_cast<std::size_t>(positions); }
 };
 
@@ -78,7 +87,15 @@ struct EstimateDistribution {
   double mean = 0.0, std = 0.0;  ///< of the error estimate - truth, over the trials
   double predicted_mean = 0.0;   ///< the linear model's: the noise-free error at the configured errors
   double predicted_std = 0.0;    ///< the linear model's: sqrt of the budget's total variance
-  std::vector<double> edges;     ///< histogram_bins + 1 edges, in the estimate's unit
+  /// The standard uncertainty the calibration states (MonteCarloModel::stated_std), and the mean and std
+  /// over the trials of the z-score (estimate - truth) / stated std: in the samples mode each trial's own
+  /// stated std, in the fast mode the configured calibration's. A z std near 1 says the stated uncertainty
+  /// is honest; above 1, the trials carry what the calibration does not count (the machine's
+  /// uncertainties). NaN where the stated std is zero (no noise).
+  double stated_std = std::numeric_limits<double>::quiet_NaN();
+  double z_mean = std::numeric_limits<double>::quiet_NaN();
+  double z_std = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> edges;  ///< histogram_bins + 1 edges, in the estimate's unit
   std::vector<long long> counts;
   /// Share of each source's variance in the predicted total, in MonteCarloResult::sources order; sums to 1.
   std::vector<double> budget;
@@ -90,7 +107,10 @@ struct MonteCarloResult {
   std::uint64_t seed = 0;
   Method method = Method::kLeastSquares;
   Compensation compensation = Compensation::kFull;
-  bool self = false;                 ///< compensation "self" (MonteCarloOptions::self)
+  bool self = false;  ///< compensation "self" (MonteCarloOptions::self)
+  GyroModel gyro_model = GyroModel::kDrift;
+  /// With drift+rate: the rate errors the plan cannot identify, with the reason (no distribution).
+  std::vector<std::pair<std::string, std::string>> not_identifiable;
   std::vector<std::string> sources;  ///< "noise", then each uncertainty entry's label
   std::vector<double>
       source_std;  ///< the uncertainty in its configuration unit (noise: the ARW, deg/sqrt(h))

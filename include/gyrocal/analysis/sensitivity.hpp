@@ -47,7 +47,10 @@ std::vector<std::pair<MachineErrorTerm, double>> nonzero_error_terms(const Centr
 std::vector<std::pair<MachineErrorTerm, double>> sensitivity_terms(const CentrifugeErrors& configured);
 
 struct SensitivityOptions {
-  CalibrationOptions calibration;  ///< reduction and solver options; method and compensation are set per run
+  /// Reduction and solver options and the gyro model; method and compensation are set per run. With
+  /// gyro_model drift+rate, least squares also identifies the rate errors (docs/physics.md section 15) and
+  /// the study gives their shifts; the closed forms identify the drift coefficients only.
+  CalibrationOptions calibration;
   /// An estimate "matters" for an error when |shift| > threshold * its predicted noise std. Default 0.1.
   double threshold = 0.1;
   int threads = 0;  ///< worker threads; 0 = hardware concurrency. Results do not depend on it.
@@ -65,8 +68,9 @@ struct SensitivityRow {
   /// Closed forms (primary dI dO dS dIS dIO dOS, alternatives dI_1g dO_1g dS_1g dIS_b, the three
   /// combinations), per compensation none, seed, full (index = Compensation).
   std::array<ShiftMap, 3> closed_form;
-  /// Least squares: identifiable coefficients and combinations, per compensation. A combination's shift is
-  /// that of its estimation error (estimate - true value of the combination least squares estimates).
+  /// Least squares: identifiable coefficients, with drift+rate the identifiable rate errors (in their units,
+  /// ppm and arcsec), and combinations, per compensation. A combination's shift is that of its estimation
+  /// error (estimate - true value of the combination least squares estimates).
   std::array<ShiftMap, 3> least_squares;
   /// Names whose |shift| > threshold * noise std, per compensation, in the estimates' order.
   std::array<std::vector<std::string>, 3> closed_form_matters, least_squares_matters;
@@ -94,11 +98,17 @@ struct SensitivityResult {
   bool has_self = false;
   std::map<std::string, double> self_noise_std;
   double threshold = 0.1;
+  /// The gyro model least squares identified (SensitivityOptions::calibration.gyro_model).
+  GyroModel gyro_model = GyroModel::kDrift;
+  /// With drift+rate: each rate error (kRateTermNames) the plan leaves unidentifiable, with the reason
+  /// (CoefficientEstimate::reason). It has no shift and no noise std: a number there would mean nothing.
+  std::map<std::string, std::string> not_identifiable;
 };
 
-/// The study on `scenario`: its test, truth, noise and site; the base case has no machine error, each row
-/// one error alone, identified with compensation none, seed and full (the compensation told that error), and,
-/// with two non-zero speeds, "self" (SensitivityRow::self).
+/// The study on `scenario`: its test, truth (the drift coefficients and the rate errors), noise and site; the
+/// base case has no machine error, each row one error alone, identified with compensation none, seed and full
+/// (the compensation told that error), and, with two non-zero speeds, "self" (SensitivityRow::self). Least
+/// squares fits options.calibration.gyro_model.
 /// Throws Error if the plan lacks the 16 positions of docs/physics.md section 7 (the closed forms need them).
 SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options = {});
 

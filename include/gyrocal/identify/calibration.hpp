@@ -64,6 +64,9 @@ struct CoefficientEstimate {
   double value = std::numeric_limits<double>::quiet_NaN();
   double std = std::numeric_limits<double>::quiet_NaN();
   bool identifiable = false;
+  /// Why not identifiable, one sentence with the advice; given for the rate errors of drift+rate
+  /// (docs/physics.md section 15), empty when identifiable.
+  std::string reason;
 };
 
 struct NamedEstimate {
