@@ -88,6 +88,11 @@ TEST(DwellReduction, FactoryPicksTheTypeFromStaticAndMethod) {
   EXPECT_TRUE(std::holds_alternative<StaticMean>(make_dwell_reduction(window, {0.0}, true, 1, true)));
   EXPECT_TRUE(std::holds_alternative<HarmonicFit>(make_dwell_reduction(harmonic, kGammas, false, 1, true)));
   EXPECT_TRUE(std::holds_alternative<WindowMean>(make_dwell_reduction(window, kGammas, false, 1, true)));
+  // The accumulator holds the factory's choice.
+  EXPECT_TRUE(std::holds_alternative<WindowMean>(
+      DwellAccumulator(window, kGammas, false, 1, 10.0, true).reduction()));
+  EXPECT_TRUE(
+      std::holds_alternative<StaticMean>(DwellAccumulator(window, {0.0}, true, 1, 10.0, true).reduction()));
 }
 
 TEST(DwellReduction, HarmonicFitEqualsADirectLeastSquaresSolve) {
