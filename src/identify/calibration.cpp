@@ -9,6 +9,7 @@
 #include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/closed_form.hpp"
 #include "gyrocal/identify/identifiability.hpp"
 #include "gyrocal/identify/named_combinations.hpp"
@@ -19,7 +20,7 @@ namespace gyrocal {
 namespace {
 
 bool same_angle(double a_rad, double b_deg) {
-  return std::abs(std::remainder(a_rad * kRadToDeg - b_deg, 360.0)) < 1e-6;
+  return std::abs(wrap_deg(a_rad * kRadToDeg - b_deg)) < 1e-6;
 }
 
 double first_spinning_rate(const std::vector<ReducedPosition>& positions) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "gyrocal/core/parallel.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
@@ -15,7 +16,7 @@ namespace {
 std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samples_per_revolution) {
   const auto tries = static_cast<std::size_t>(std::ceil(samples_per_revolution)) + 2;
   for (std::size_t s = at_least; s < at_least + tries; ++s) {
-    const double step = std::abs(std::remainder(static_cast<double>(s) * gamma_step_rad, 2.0 * kPi));
+    const double step = std::abs(wrap_rad(static_cast<double>(s) * gamma_step_rad));
     if (step >= 2.0 * kPi / 40.0 && step <= 2.0 * kPi / 10.0) return s;
   }
   return at_least;  // not reached for >= 14 samples per revolution (reduce/feasibility.hpp)

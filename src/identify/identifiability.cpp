@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/named_combinations.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/model/nominal.hpp"
@@ -128,7 +129,7 @@ int directions_identified(const MatrixXd& x, const MatrixXd& v) {
 
 bool has_angle(const std::vector<double>& angles_rad, double deg) {
   for (double a : angles_rad)
-    if (std::abs(std::remainder(a * kRadToDeg - deg, 360.0)) < 1e-6) return true;
+    if (std::abs(wrap_deg(a * kRadToDeg - deg)) < 1e-6) return true;
   return false;
 }
 

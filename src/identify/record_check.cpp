@@ -53,7 +53,7 @@ bool same(double a, double b, double relative, double absolute) {
 }
 
 bool same_angle_deg(double a, double b) {
-  return std::abs(std::remainder(a - b, 360.0)) <= 1e-9;
+  return std::abs(wrap_deg(a - b)) <= 1e-9;
 }
 
 std::string list_text(const std::vector<double>& values, double scale) {

@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 
+#include "gyrocal/reduce/dwell_reduction.hpp"
+
 namespace gyrocal {
 
 /// How a dwell is reduced. Defaults as stated; IsValid() checks them.
@@ -110,6 +112,12 @@ struct DwellValues {
 
 /// Accumulates one dwell's samples (streaming, memory independent of the dwell's length) and reduces them.
 /// Spinning dwell: the values at each gamma of `gammas_rad`. Static hold: one value (the mean).
+///
+/// The method's own sums live in a DwellReduction (reduce/dwell_reduction.hpp: StaticMean, HarmonicFit or
+/// WindowMean, picked by make_dwell_reduction); this class holds what every method shares: the samples' time
+/// and angle span, the outlier rule with its pending block, the periods (revolutions of a spinning dwell,
+/// batches of a static hold) and the scatter of their values, with the heading's sweep at a counter rate
+/// offset.
 class DwellAccumulator {
  public:
   /// columns: how many value columns each sample carries (1 for the gyro output, more for model channels).
@@ -154,6 +162,8 @@ class DwellAccumulator {
   /// The time series breaks here (a gap): the revolution in progress is incomplete, so it does not count in
   /// the scatter between revolutions (its samples still enter the dwell's fit).
   void break_revolution();
+  /// The method reducing this dwell (make_dwell_reduction's choice).
+  const DwellReduction& reduction() const { return reduction_; }
 
  private:
   struct Pending {
@@ -163,28 +173,34 @@ class DwellAccumulator {
   void accumulate(double time_s, double gamma_rad, const double* values, bool after_break);
   void test_block();
   void flush();
+  int revolution_of(double gamma_rad) const;
+  int period_of(double time_s, double gamma_rad) const;
   bool last_revolution_complete() const;
+  double scaled_time(double time_s) const { return (time_s - t_first_) / duration_s_ - 0.5; }
+  double scaled_mid_time() const;
   int detection_size() const;
   void detection_basis(double gamma_rad, double t_scaled, double* out) const;
-  void close_revolution();
-  int basis_size() const;
-  void basis(double gamma_rad, double t_scaled, double* out) const;
 
   ReduceOptions options_;
-  std::vector<double> gammas_;
-  bool static_;
-  int columns_;
+  bool spinning_;
+  std::size_t gammas_;  // how many values per column
   double duration_s_;
   double sweep_scaled_ = 0.0;  // the sweep's phase per unit of scaled time (sweep rate * planned duration)
   bool with_std_err_;
+  DwellReduction reduction_;
 
   std::size_t samples_ = 0;
   double t_first_ = 0.0, t_last_ = 0.0;
   double gamma_first_ = 0.0, gamma_last_ = 0.0;
-  int revolution_ = 0;              // of the samples accumulated
-  bool break_next_ = false;         // break_revolution() was called: the next sample follows a gap
-  bool revolution_broken_ = false;  // the revolution in progress holds a gap: it does not count
   bool finished_ = false;
+
+  // Periods (with_std_err): revolutions of a spinning dwell, batches of a static hold's planned duration. A
+  // period's values of column 0 enter the scatter when the next one begins; a revolution with a gap does not
+  // (its fit would be of part of a turn), a batch does (a gap only shortens it).
+  int period_ = 0;              // of the samples accumulated
+  bool break_next_ = false;     // break_revolution() was called: the next sample follows a gap
+  bool period_broken_ = false;  // the revolution in progress holds a gap: it does not count
+  RevolutionSums scatter_;
 
   // Outlier rejection (docs/physics.md section 14): the block waiting to be tested, and the normal equations
   // of the dwell's fit (harmonics and drift; a static hold: mean and drift) on every sample accumulated so
@@ -198,44 +214,6 @@ class DwellAccumulator {
   double last_scale_ = 0.0;
   std::size_t outliers_ = 0;
   std::vector<double> scratch_basis_;  // the block's detection basis, sample by sample
-
-  // Harmonic fit over the whole dwell: normal equations of the (well-conditioned) harmonic basis.
-  Eigen::MatrixXd normal_;  // basis x basis
-  Eigen::MatrixXd rhs_;     // basis x columns
-  // Per revolution (std err): the same fit without drift, on column 0 only.
-  Eigen::MatrixXd rev_normal_;
-  Eigen::VectorXd rev_rhs_;
-  std::size_t rev_samples_ = 0;
-  double rev_time_sum_ = 0.0;
-  // Window mean: per gamma, sums over the whole dwell (with drift: also t and t^2) and per revolution.
-  Eigen::MatrixXd window_sum_;                                             // gamma x columns
-  Eigen::MatrixXd window_tsum_;                                            // gamma x columns: sum of t*value
-  Eigen::Vector<double, Eigen::Dynamic> window_n_, window_t_, window_tt_;  // per gamma
-  Eigen::VectorXd rev_window_sum_, rev_window_n_, rev_window_t_;           // per gamma, column 0
-  // Per-revolution (or batch) values of column 0 at every gamma, as sums for straight-line fits in time
-  // and their cross products.
-  struct RevolutionSums {
-    /// The sweep's phase per unit of scaled time (0: none): then the fit in time is of 1, t, cos, sin of it.
-    double sweep = 0.0;
-    Eigen::MatrixXd bb, bv;  // with a sweep: sums of b b' and b (v - v0)', b = (1, t, cos, sin)
-    double n = 0, t = 0, tt = 0;
-    Eigen::VectorXd v0;     // the first values: sums are of deviations from them (no cancellation)
-    Eigen::VectorXd v, tv;  // sums of (v - v0) and t (v - v0)
-    Eigen::MatrixXd vv;
-    void add(double ti, const Eigen::VectorXd& vi);
-    /// Covariance of the lines' predictions at t_mid (of the means without drift); NaN without enough
-    /// revolutions.
-    Eigen::MatrixXd covariance_at(double t_mid, bool drift) const;
-    /// The parameters of the fit in time: the mean, the drift, the sweep's two.
-    double parameters(bool drift) const { return 1.0 + (drift ? 1.0 : 0.0) + (sweep != 0.0 ? 2.0 : 0.0); }
-  };
-  RevolutionSums trend_;
-  // Static hold: sums per column, and batch means of column 0.
-  Eigen::VectorXd static_sum_;
-  double batch_sum_ = 0.0;
-  std::size_t batch_n_ = 0;
-  int batch_index_ = 0;
-  RevolutionSums batches_;
 };
 
 }  // namespace gyrocal

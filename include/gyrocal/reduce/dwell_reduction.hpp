@@ -1,0 +1,179 @@
+#pragma once
+// The three ways of reducing one dwell (a static hold's mean, a spinning dwell's harmonic fit or window
+// means), each a type of its own behind one interface (the concept DwellReductionMethod), held by
+// DwellAccumulator (reduce/dwell_accumulator.hpp) in the variant DwellReduction. Each type owns only its own
+// sums; what all three share (outlier rejection, counting revolutions, the scatter between revolutions, the
+// heading's sweep) is written once, in DwellAccumulator. docs/architecture.md says why a variant.
+//
+// Every type sees a sample as (t_scaled, gamma_rad, values): t_scaled is the time scaled to about [-0.5, 0.5]
+// over the planned dwell, (t - t_first) / planned_duration - 0.5, for well-conditioned drift columns;
+// gamma_rad is the arm angle, rad, unwrapped. The values per gamma are evaluated at t_mid, on the same scale.
+#include <concepts>
+#include <cstddef>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace gyrocal {
+
+struct ReduceOptions;  // reduce/dwell_accumulator.hpp
+struct DwellValues;    // reduce/dwell_accumulator.hpp
+
+/// The harmonic basis in the arm angle: 1, cos g, sin g, ..., cos Ng, sin Ng into out[0 .. 2N] (N = order;
+/// cos kg and sin kg by angle addition from cos g and sin g). The harmonic fit's basis and, whatever the
+/// method, the outlier rule's.
+void harmonic_basis(double gamma_rad, int order, double* out);
+
+/// Per-revolution (or per-batch) values of column 0 at every gamma of a dwell, as sums for straight-line fits
+/// in time and their cross products: their scatter is the level of the reduced values' covariance
+/// (docs/calibration.md).
+struct RevolutionSums {
+  /// The sweep's phase per unit of scaled time (0: none): then the fit in time is of 1, t, cos, sin of it
+  /// (docs/physics.md section 15).
+  double sweep = 0.0;
+  Eigen::MatrixXd bb, bv;  // with a sweep: sums of b b' and b (v - v0)', b = (1, t, cos, sin)
+  double n = 0, t = 0, tt = 0;
+  Eigen::VectorXd v0;     // the first values: sums are of deviations from them (no cancellation)
+  Eigen::VectorXd v, tv;  // sums of (v - v0) and t (v - v0)
+  Eigen::MatrixXd vv;
+  /// One period's values vi (one per gamma) at its mean scaled time ti.
+  void add(double ti, const Eigen::VectorXd& vi);
+  /// Covariance of the lines' predictions at t_mid (of the means without drift); NaN without enough
+  /// revolutions.
+  Eigen::MatrixXd covariance_at(double t_mid, bool drift) const;
+  /// The parameters of the fit in time: the mean, the drift, the sweep's two.
+  double parameters(bool drift) const { return 1.0 + (drift ? 1.0 : 0.0) + (sweep != 0.0 ? 2.0 : 0.0); }
+};
+
+/// A static hold: the mean of each column (no drift: held still, the output's drift is the noise's). Its
+/// periods, for the scatter, are batches of time (DwellAccumulator cuts them); their means enter the scatter
+/// at time 0, about their mean.
+class StaticMean {
+ public:
+  /// gammas: the hold's gamma (one value; more are allowed and stay NaN). columns: values per sample.
+  /// with_periods: also keep the batch's sum of column 0 (for the scatter).
+  StaticMean(std::size_t gammas, int columns, bool with_periods);
+  void add(double t_scaled, double gamma_rad, const double* values);
+  /// The batch's mean of column 0 into `scatter` (if it holds a sample); the batch starts again.
+  void close_period(RevolutionSums& scatter);
+  void discard_period();
+  /// value[0] = the mean of `column`, samples[0] = the samples.
+  void values(int column, double t_mid, DwellValues& out) const;
+  /// gain[0] = 1 / samples (NaN elsewhere); the covariance is its diagonal.
+  std::vector<double> white_noise_gain(double t_mid) const;
+  Eigen::MatrixXd white_noise_covariance(double t_mid) const;
+  /// Whether the values and the scatter carry a linear drift in time: never (a mean).
+  bool fits_drift() const { return false; }
+  std::size_t samples() const { return samples_; }
+
+ private:
+  std::size_t gammas_;
+  bool with_periods_;
+  std::size_t samples_ = 0;
+  Eigen::VectorXd sum_;  // per column
+  double batch_sum_ = 0.0;
+  std::size_t batch_n_ = 0;
+};
+
+/// A spinning dwell: a least-squares fit of 1, cos k gamma, sin k gamma (k = 1..order) and, with drift,
+/// t_scaled, to the whole dwell's samples (normal equations, lower triangle), evaluated at each gamma of the
+/// plan at t_mid. Its periods are revolutions: per revolution, the same fit without drift on column 0.
+class HarmonicFit {
+ public:
+  HarmonicFit(std::vector<double> gammas_rad, int order, bool linear_drift, int columns, bool with_periods);
+  void add(double t_scaled, double gamma_rad, const double* values);
+  /// The revolution's fit (without drift) at every gamma, at its mean time, into `scatter` if it holds at
+  /// least two samples per parameter; the revolution's sums start again.
+  void close_period(RevolutionSums& scatter);
+  void discard_period();
+  void values(int column, double t_mid, DwellValues& out) const;
+  /// Per gamma: b' (Phi' Phi)^-1 b, b the basis at the gamma and t_mid.
+  std::vector<double> white_noise_gain(double t_mid) const;
+  /// B' (Phi' Phi)^-1 B: the values at different gammas share the fit's coefficients, so they correlate.
+  Eigen::MatrixXd white_noise_covariance(double t_mid) const;
+  bool fits_drift() const { return drift_; }
+  std::size_t samples() const { return samples_; }
+  /// The fit's basis at (gamma, t_scaled): 1, cos g, sin g, ..., cos Ng, sin Ng [, t_scaled].
+  int basis_size() const { return 2 * order_ + 1 + (drift_ ? 1 : 0); }
+  void basis(double gamma_rad, double t_scaled, double* out) const;
+
+ private:
+  std::vector<double> gammas_;
+  int order_;
+  bool drift_;
+  int columns_;
+  bool with_periods_;
+  std::size_t samples_ = 0;
+  Eigen::MatrixXd normal_;  // basis x basis
+  Eigen::MatrixXd rhs_;     // basis x columns
+  // The revolution's fit without drift, column 0.
+  Eigen::MatrixXd rev_normal_;
+  Eigen::VectorXd rev_rhs_;
+  std::size_t rev_samples_ = 0;
+  double rev_time_sum_ = 0.0;
+};
+
+/// A spinning dwell: per gamma of the plan, the mean of the samples within +-window/2 of it (wrapped) and,
+/// with drift, a straight line in time through them evaluated at t_mid. Its periods are revolutions: per
+/// revolution, each window's plain mean of column 0; a revolution counts when it passed through every window.
+class WindowMean {
+ public:
+  WindowMean(std::vector<double> gammas_rad, double window_deg, bool linear_drift, int columns,
+             bool with_periods);
+  void add(double t_scaled, double gamma_rad, const double* values);
+  void close_period(RevolutionSums& scatter);
+  void discard_period();
+  /// Per gamma: the window's mean (or line at t_mid) and its samples; NaN and 0 for a window with none.
+  void values(int column, double t_mid, DwellValues& out) const;
+  /// Per gamma: 1/n (+ (t_mid - tbar)^2 / Stt with drift); NaN for an empty window.
+  std::vector<double> white_noise_gain(double t_mid) const;
+  /// Diagonal: the windows do not overlap, so their means do not correlate.
+  Eigen::MatrixXd white_noise_covariance(double t_mid) const;
+  bool fits_drift() const { return drift_; }
+  std::size_t samples() const { return samples_; }
+
+ private:
+  std::vector<double> gammas_;
+  double half_width_rad_;
+  bool drift_;
+  int columns_;
+  bool with_periods_;
+  std::size_t samples_ = 0;
+  Eigen::MatrixXd sum_;                      // gamma x columns
+  Eigen::MatrixXd tsum_;                     // gamma x columns: sum of t*value
+  Eigen::VectorXd n_, t_, tt_;               // per gamma
+  Eigen::VectorXd rev_sum_, rev_n_, rev_t_;  // per gamma, column 0, this revolution
+};
+
+/// The one interface of the three: whole-dwell sums (add), the period's values into the scatter
+/// (close_period) or thrown away (discard_period, a revolution broken by a gap), the reduced values of a
+/// column, the operator's white-noise gain and covariance (per unit variance of white noise on each sample),
+/// and whether its fit carries a drift in time (the scatter's fit does as the values' does).
+template <class M>
+concept DwellReductionMethod = requires(M& m, const M& cm, double t, double gamma, const double* values,
+                                        RevolutionSums& scatter, int column, DwellValues& out) {
+  m.add(t, gamma, values);
+  m.close_period(scatter);
+  m.discard_period();
+  cm.values(column, t, out);
+  { cm.white_noise_gain(t) } -> std::same_as<std::vector<double>>;
+  { cm.white_noise_covariance(t) } -> std::same_as<Eigen::MatrixXd>;
+  { cm.fits_drift() } -> std::same_as<bool>;
+  { cm.samples() } -> std::same_as<std::size_t>;
+};
+static_assert(DwellReductionMethod<StaticMean>);
+static_assert(DwellReductionMethod<HarmonicFit>);
+static_assert(DwellReductionMethod<WindowMean>);
+
+/// One dwell's reduction, whichever method.
+using DwellReduction = std::variant<StaticMean, HarmonicFit, WindowMean>;
+
+/// The method of a dwell: a static hold (main axis stopped) is reduced by its mean whatever options.method; a
+/// spinning dwell by options.method's fit (harmonic_order, linear_drift) or window means (window_deg,
+/// linear_drift). gammas_rad: the plan's gammas of the dwell (a static hold: its one gamma). columns: values
+/// per sample. with_periods: also keep column 0's sums per revolution (or batch) for the scatter.
+DwellReduction make_dwell_reduction(const ReduceOptions& options, std::vector<double> gammas_rad,
+                                    bool is_static, int columns, bool with_periods);
+
+}  // namespace gyrocal
