@@ -27,6 +27,7 @@ std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
       r.mode == MonteCarloMode::kSamples ? "each trial's own" : "the configured machine's calibration's");
   std::size_t width = 16;  // the rate errors' names are longer than the coefficients'
   for (const EstimateDistribution& e : r.estimates) width = std::max(width, e.name.size() + 2);
+  for (const auto& entry : r.not_identifiable) width = std::max(width, entry.first.size() + 2);
   s += fmt::format("{:<{}}{:>13}{:>13}{:>13}{:>13}{:>8}  {:<10} {}\n", "estimate", width, "mean error", "std",
                    "pred. mean", "pred. std", "z std", "unit", "largest shares of the variance");
   for (const EstimateDistribution& e : r.estimates) {

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -162,6 +163,16 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (std::size_t k = 0; k < kNumRateTerms; ++k)
       if (!configured.rate_terms[k].identifiable)
         m.not_identifiable.emplace_back(std::string(kRateTermNames[k]), configured.rate_terms[k].reason);
+  // Compensation "self" (docs/self_calibration.md): a machine error the plan cannot estimate stays at zero in
+  // every trial, and its effect moves the estimates (their mean error); it is named with the reason, never
+  // left to a mean error nobody explains.
+  for (const MachineErrorEstimate& e : configured.machine_errors)
+    if (!e.identifiable)
+      m.not_identifiable.emplace_back(
+          e.error,
+          fmt::format("{} Under compensation self it stays at zero, so the estimates above carry the "
+                      "effect of its true value (their mean error).",
+                      e.reason));
   const auto ne = static_cast<Eigen::Index>(m.names.size());
   Eigen::MatrixXd map(ne, np);
   // Affine in W: the unknowns are linear in the reduced outputs (identify/unknowns.hpp); the misalignments'

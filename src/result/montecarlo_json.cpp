@@ -38,7 +38,7 @@ nlohmann::json montecarlo_to_json(const MonteCarloResult& r) {
   }
   // docs/physics.md section 15: the gyro model, and the rate errors the plan cannot identify with the reason.
   j["gyro_model"] = to_string(r.gyro_model);
-  if (r.gyro_model == GyroModel::kDriftRate) {
+  if (r.gyro_model == GyroModel::kDriftRate || !r.not_identifiable.empty()) {
     j["not_identifiable"] = nlohmann::json::object();
     for (const auto& [name, reason] : r.not_identifiable) j["not_identifiable"][name] = reason;
   }

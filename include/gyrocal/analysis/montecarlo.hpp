@@ -70,7 +70,8 @@ struct MonteCarloModel {
   /// noise, as `plan` weights); the fast mode's z-scores are measured against it.
   std::vector<double> stated_std;
   /// With drift+rate: each rate error the plan cannot identify (kRateTermNames) and why
-  /// (CoefficientEstimate::reason); it is not among the estimates.
+  /// (CoefficientEstimate::reason); it is not among the estimates. With compensation "self": each machine
+  /// error the plan cannot estimate (MachineErrorEstimate::error) and why.
   std::vector<std::pair<std::string, std::string>> not_identifiable;
   int positions = 0;         ///< reduced positions (noise columns)
   std::vector<double> gain;  ///< G, row-major, names.size() x (sources.size() + positions)
@@ -109,7 +110,8 @@ struct MonteCarloResult {
   Compensation compensation = Compensation::kFull;
   bool self = false;  ///< compensation "self" (MonteCarloOptions::self)
   GyroModel gyro_model = GyroModel::kDrift;
-  /// With drift+rate: the rate errors the plan cannot identify, with the reason (no distribution).
+  /// With drift+rate: the rate errors the plan cannot identify, with the reason (no distribution); with
+  /// compensation "self": the machine errors it cannot estimate, with the reason.
   std::vector<std::pair<std::string, std::string>> not_identifiable;
   std::vector<std::string> sources;  ///< "noise", then each uncertainty entry's label
   std::vector<double>
