@@ -101,6 +101,7 @@ void register_montecarlo(CLI::App& app) {
     options.calibration.method = parse_method(opt->method);
     options.self = opt->compensation == "self";
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
+    options.calibration.reduce = scenario.reduce;  // [reduce]: --samples reduces each trial's record with it
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);
