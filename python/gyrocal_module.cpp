@@ -44,18 +44,21 @@ py::object json_to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
 }
 
-CalibrationOptions calibration_options(const std::string& method, const std::string& compensation,
-                                       const std::string& reduction,
+/// The options `gyrocal calibrate` builds: the scenario's [reduce] and [calibration] reduction, the method
+/// overridden by `reduction` unless it is empty (None in Python).
+CalibrationOptions calibration_options(const Scenario& scenario, const std::string& method,
+                                       const std::string& compensation, const std::string& reduction,
                                        const std::vector<std::string>& estimate) {
   CalibrationOptions options;
   options.estimate = parse_machine_error_names(estimate, "estimate");
   options.method = parse_method(method);
   options.compensation = parse_compensation(compensation);
+  options.reduce = scenario.reduce;
   if (reduction == "harmonic") {
     options.reduce.method = ReduceOptions::Method::kHarmonicFit;
   } else if (reduction == "window") {
     options.reduce.method = ReduceOptions::Method::kWindowMean;
-  } else {
+  } else if (!reduction.empty()) {
     throw Error("unknown reduction '" + reduction + "': use harmonic or window.");
   }
   return options;
@@ -132,7 +135,7 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
 py::object calibrate_path_py(const std::string& path, const Scenario& scenario, const std::string& method,
                              const std::string& compensation, const std::string& reduction,
                              const std::vector<std::string>& estimate) {
-  const CalibrationOptions options = calibration_options(method, compensation, reduction, estimate);
+  const CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
   nlohmann::json j;
   {
     py::gil_scoped_release release;
@@ -148,7 +151,7 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
                                const std::string& method, const std::string& compensation,
                                const std::string& reduction, const std::vector<std::string>& estimate,
                                const std::string& name) {
-  const CalibrationOptions options = calibration_options(method, compensation, reduction, estimate);
+  const CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
   check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
   nlohmann::json j;

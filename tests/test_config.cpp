@@ -77,6 +77,55 @@ void expect_same(const CentrifugeErrors& a, const CentrifugeErrors& b, const std
   expect_same(a.lever_arm_m, b.lever_arm_m, w + "lever_arm");
 }
 
+/// Every ReduceOptions field, listed here by hand (not from the configuration's key table).
+void expect_same(const ReduceOptions& a, const ReduceOptions& b) {
+  EXPECT_EQ(a.method, b.method) << "reduce method";
+  EXPECT_EQ(a.harmonic_order, b.harmonic_order) << "reduce.harmonic_order";
+  EXPECT_EQ(a.linear_drift, b.linear_drift) << "reduce.linear_drift";
+  expect_same(a.window_deg, b.window_deg, "reduce.window_deg");
+  expect_same(a.window_s, b.window_s, "reduce.window_s");
+  expect_same(a.angle_tolerance_deg, b.angle_tolerance_deg, "reduce.angle_tolerance_deg");
+  expect_same(a.beta_tolerance_deg, b.beta_tolerance_deg, "reduce.beta_tolerance_deg");
+  expect_same(a.rate_tolerance, b.rate_tolerance, "reduce.rate_tolerance");
+  expect_same(a.rate_steadiness, b.rate_steadiness, "reduce.rate_steadiness");
+  expect_same(a.static_rate_tolerance_rad_s, b.static_rate_tolerance_rad_s, "reduce.static_rate_tolerance");
+  expect_same(a.wander_warning_deg, b.wander_warning_deg, "reduce.wander_warning_deg");
+  expect_same(a.gap_intervals, b.gap_intervals, "reduce.gap_intervals");
+  EXPECT_EQ(a.encoder_glitch_rows, b.encoder_glitch_rows) << "reduce.encoder_glitch_rows";
+  expect_same(a.leave_guard_s, b.leave_guard_s, "reduce.leave_guard_s");
+  EXPECT_EQ(a.max_stretches_per_dwell, b.max_stretches_per_dwell) << "reduce.max_stretches_per_dwell";
+  EXPECT_EQ(a.static_batches, b.static_batches) << "reduce.static_batches";
+  EXPECT_EQ(a.model_samples_per_revolution, b.model_samples_per_revolution)
+      << "reduce.model_samples_per_revolution";
+  expect_same(a.outlier_threshold, b.outlier_threshold, "reduce.outlier_threshold");
+  EXPECT_EQ(a.outlier_block_samples, b.outlier_block_samples) << "reduce.outlier_block_samples";
+}
+
+/// Every ReduceOptions field away from its default, within its range.
+ReduceOptions changed_reduce_options() {
+  ReduceOptions o;
+  o.method = ReduceOptions::Method::kWindowMean;
+  o.harmonic_order = 5;
+  o.linear_drift = false;
+  o.window_deg = 7.5;
+  o.window_s = 0.75;
+  o.angle_tolerance_deg = 0.35;
+  o.beta_tolerance_deg = 0.15;
+  o.rate_tolerance = 5e-3;
+  o.rate_steadiness = 2.5e-3;
+  o.static_rate_tolerance_rad_s = 0.02;
+  o.wander_warning_deg = 0.03;
+  o.gap_intervals = 2.5;
+  o.encoder_glitch_rows = 5;
+  o.leave_guard_s = 0.4;
+  o.max_stretches_per_dwell = 100;
+  o.static_batches = 10;
+  o.model_samples_per_revolution = 64;
+  o.outlier_threshold = 8.0;
+  o.outlier_block_samples = 256;
+  return o;
+}
+
 void expect_same(const Scenario& a, const Scenario& b) {
   expect_same(a.site.latitude_rad, b.site.latitude_rad, "site.latitude");
   expect_same(a.site.gravity_m_s2, b.site.gravity_m_s2, "site.gravity");
@@ -102,6 +151,7 @@ void expect_same(const Scenario& a, const Scenario& b) {
   expect_same(a.test.rates_rad_s, b.test.rates_rad_s, "test.rates");
   EXPECT_EQ(a.test.seed, b.test.seed);
   expect_same(a.uncertainty, b.uncertainty, "uncertainty.");
+  expect_same(a.reduce, b.reduce);
 }
 
 Scenario round_trip(const Scenario& s) {
@@ -154,6 +204,7 @@ Scenario changed_scenario() {
   u.counter_rate_mismatch_rad_s = 1e-7;
   u.mount_misalignment_rad = Eigen::Vector3d(1.0, 2.0, 3.0) * kArcsecToRad;
   u.lever_arm_m = Eigen::Vector3d(1e-3, 2e-3, 3e-3);
+  s.reduce = changed_reduce_options();
   return s;
 }
 
@@ -385,6 +436,141 @@ TEST(ConfigErrors, SyntaxError) {
   const std::string message = error_of("[site]\nlatitude_deg = 1.0\nlatitude_deg = = 3\n");
   EXPECT_NE(message.find("bad.toml, line 3:"), std::string::npos) << message;
   EXPECT_NE(message.find("TOML syntax error"), std::string::npos) << message;
+}
+
+// ---- [reduce] and [calibration] reduction ----------------------------------------------------------------
+
+TEST(ConfigReduce, EveryKeyIsReadInItsOwnUnit) {
+  // Written by hand, so that the reader is checked independently of the writer.
+  const Scenario s = parse_scenario(R"([calibration]
+reduction = "window"
+[reduce]
+harmonic_order = 5
+linear_drift = false
+window_deg = 7.5
+window_s = 0.75
+angle_tolerance_deg = 0.35
+beta_tolerance_deg = 0.15
+rate_tolerance = 5e-3
+rate_steadiness = 2.5e-3
+static_rate_tolerance_rad_s = 0.02
+wander_warning_deg = 0.03
+gap_intervals = 2.5
+encoder_glitch_rows = 5
+leave_guard_s = 0.4
+max_stretches_per_dwell = 100
+static_batches = 10
+model_samples_per_revolution = 64
+outlier_threshold = 8
+outlier_block_samples = 256
+)",
+                                    "reduce.toml");
+  expect_same(s.reduce, changed_reduce_options());
+  // The comparison sees every field: each differs from its default.
+  const ReduceOptions d;
+  const ReduceOptions c = changed_reduce_options();
+  EXPECT_NE(c.method, d.method);
+  for (const auto& [changed, original] : {std::pair{c.window_deg, d.window_deg},
+                                          {c.window_s, d.window_s},
+                                          {c.angle_tolerance_deg, d.angle_tolerance_deg},
+                                          {c.beta_tolerance_deg, d.beta_tolerance_deg},
+                                          {c.rate_tolerance, d.rate_tolerance},
+                                          {c.rate_steadiness, d.rate_steadiness},
+                                          {c.static_rate_tolerance_rad_s, d.static_rate_tolerance_rad_s},
+                                          {c.wander_warning_deg, d.wander_warning_deg},
+                                          {c.gap_intervals, d.gap_intervals},
+                                          {c.leave_guard_s, d.leave_guard_s},
+                                          {c.outlier_threshold, d.outlier_threshold}})
+    EXPECT_NE(changed, original);
+  for (const auto& [changed, original] : {std::pair{c.harmonic_order, d.harmonic_order},
+                                          {c.encoder_glitch_rows, d.encoder_glitch_rows},
+                                          {c.max_stretches_per_dwell, d.max_stretches_per_dwell},
+                                          {c.static_batches, d.static_batches},
+                                          {c.model_samples_per_revolution, d.model_samples_per_revolution},
+                                          {c.outlier_block_samples, d.outlier_block_samples}})
+    EXPECT_NE(changed, original);
+  EXPECT_NE(c.linear_drift, d.linear_drift);
+  // Without the section every option keeps ReduceOptions' default.
+  expect_same(parse_scenario("", "empty.toml").reduce, ReduceOptions{});
+  EXPECT_EQ(parse_scenario("[calibration]\nreduction = \"harmonic\"\n", "h.toml").reduce.method,
+            ReduceOptions::Method::kHarmonicFit);
+}
+
+TEST(ConfigReduce, InitWritesEveryKeyWithItsUnitDefaultAndReasonAndReadsBack) {
+  // init's text (the default scenario) reads back to the default options, and a changed scenario's text to
+  // the changed ones (every key written, none lost).
+  const std::string text = scenario_to_toml(default_scenario());
+  expect_same(parse_scenario(text, "init.toml").reduce, ReduceOptions{});
+  Scenario s = default_scenario();
+  s.reduce = changed_reduce_options();
+  expect_same(round_trip(s).reduce, s.reduce);
+  // Each key on its own line in [reduce], its comment giving the unit and the default with its reason.
+  const std::size_t section = text.find("\n[reduce]\n");
+  ASSERT_NE(section, std::string::npos) << text;
+  for (const char* line :
+       {"harmonic_order = 3 ", "linear_drift = true ", "window_deg = 10.0 ", "window_s = 0.5 ",
+        "angle_tolerance_deg = 0.5 ", "beta_tolerance_deg = 0.2 ", "rate_tolerance = 0.002 ",
+        "rate_steadiness = 0.001 ", "static_rate_tolerance_rad_s = 0.01 ", "wander_warning_deg = 0.01 ",
+        "gap_intervals = 1.5 ", "encoder_glitch_rows = 3 ", "leave_guard_s = 0.25 ",
+        "max_stretches_per_dwell = 4096 ", "static_batches = 16 ", "model_samples_per_revolution = 0 ",
+        "outlier_threshold = 6.0 ", "outlier_block_samples = 128 "}) {
+    const std::size_t at = text.find(std::string("\n") + line, section);
+    ASSERT_NE(at, std::string::npos) << line << "\n" << text;
+    const std::string key_line = text.substr(at + 1, text.find('\n', at + 1) - at - 1);
+    EXPECT_NE(key_line.find("# "), std::string::npos) << key_line;
+    EXPECT_NE(key_line.find("; default "), std::string::npos) << key_line;
+  }
+  EXPECT_NE(text.find("rate_tolerance = 0.002"), std::string::npos);
+  EXPECT_NE(text.find("# relative; default 0.002: a steady rate matches a planned rate"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("reduction = \"harmonic\" "), std::string::npos) << text;
+}
+
+TEST(ConfigReduce, EachOutOfRangeValueIsRefusedNamingItsKey) {
+  // One value beyond each key's range (ReduceOptions::IsValid), each at line 3.
+  const std::pair<const char*, const char*> bad[] = {
+      {"harmonic_order = 13", "between 0 and 12"},
+      {"window_deg = 90.0", "(0, 90)"},
+      {"window_s = 0.0", "(0, 60]"},
+      {"angle_tolerance_deg = -0.5", "(0, 90)"},
+      {"beta_tolerance_deg = 0.0", "positive"},
+      {"rate_tolerance = 0.5", "(0, 0.5)"},
+      {"rate_steadiness = 0.0", "(0, 0.5)"},
+      {"static_rate_tolerance_rad_s = -0.01", "positive"},
+      {"wander_warning_deg = 0.0", "positive"},
+      {"gap_intervals = 1.0", "above 1"},
+      {"encoder_glitch_rows = -1", "between 0 and 1000"},
+      {"leave_guard_s = 61", "[0, 60]"},
+      {"max_stretches_per_dwell = 0", "at least 1"},
+      {"static_batches = 1", "at least 2"},
+      {"model_samples_per_revolution = 8", "at least 16"},
+      {"outlier_threshold = 2.5", "between 3 and 1e6"},
+      {"outlier_block_samples = 8", "between 16 and 4096"},
+  };
+  for (const auto& [line, why] : bad) {
+    const std::string key(std::string_view(line).substr(0, std::string_view(line).find(' ')));
+    const std::string value(std::string_view(line).substr(std::string_view(line).find("= ") + 2));
+    const std::string input = std::string("[reduce]\n# a comment\n") + line + "\n";
+    expect_refused(input, 3, "reduce." + key + " must", why);
+    // The value at fault is quoted (shortest form, so 90.0 reads "90").
+    const std::string message = error_of(input);
+    EXPECT_NE(message.find(", not "), std::string::npos) << message;
+  }
+  expect_refused("[reduce]\nrate_tolerance = 0.7\n", 2, "reduce.rate_tolerance must be in (0, 0.5), not 0.7",
+                 "");
+}
+
+TEST(ConfigReduce, WrongTypesAndUnknownKeysAreRefused) {
+  expect_refused("[reduce]\nencoder_glitch_rows = 2.5\n", 2, "reduce.encoder_glitch_rows",
+                 "must be an integer");
+  expect_refused("[reduce]\nlinear_drift = 1\n", 2, "reduce.linear_drift", "must be true or false");
+  expect_refused("[reduce]\nrate_tolerance = \"2e-3\"\n", 2, "reduce.rate_tolerance", "must be a number");
+  expect_refused("[reduce]\nrate_tolerance = nan\n", 2, "reduce.rate_tolerance", "finite");
+  expect_refused("[reduce]\n\nrate_tol = 1e-3\n", 3, "unknown key reduce.rate_tol", "rate_tolerance");
+  expect_refused("[reduce]\nmethod = \"window\"\n", 2, "unknown key reduce.method", "expected one of");
+  expect_refused("[calibration]\nreduction = \"mean\"\n", 2, "calibration.reduction",
+                 "\"harmonic\" or \"window\"");
+  expect_refused("reduce = 3\n", 1, "reduce", "must be a table");
 }
 
 // ---- files ----------------------------------------------------------------------------------------------

@@ -103,5 +103,106 @@ TEST(RigRecord, EveryImperfectionAtOnceInTheRigsLayoutCalibratesToTheTruthThroug
   std::filesystem::remove_all(dir);
 }
 
+/// The text `gyrocal init` writes for s, with one line of [reduce] edited as a lab would edit it.
+std::string with_reduce_line(const Scenario& s, const std::string& key, const std::string& value) {
+  std::string text = scenario_to_toml(s);
+  const std::size_t at = text.find("\n" + key + " = ", text.find("\n[reduce]\n"));
+  EXPECT_NE(at, std::string::npos) << key;
+  if (at == std::string::npos) return text;
+  const std::size_t end = text.find('\n', at + 1);
+  return text.replace(at + 1, end - at - 1, key + " = " + value);
+}
+
+/// Calibrates `record` with the configuration text `toml` through the command line.
+test::CliOutcome calibrate_with(const std::filesystem::path& dir, const std::string& record,
+                                const std::string& toml_text, const std::string& extra = "") {
+  {
+    std::ofstream toml(dir / "rig.toml");
+    toml << toml_text;
+  }
+  return test::run_cli("calibrate " + (dir / record).string() + " --config " + (dir / "rig.toml").string() +
+                           " --json -" + extra,
+                       dir);
+}
+
+TEST(RigRecord, ARateToleranceSetInTheConfigurationChangesWhatTheReducerAccepts) {
+  // The drive turns 0.3 % off its nominal rates: beyond the default rate_tolerance (2e-3), within 5e-3.
+  Scenario s = default_scenario();
+  s.test.sample_rate_hz = 50.0;
+  s.test.revolutions = 8;
+  s.test.rates_rad_s = {9.9, 7.0};
+  testing::RigImperfections drive;
+  drive.rate_offset = 3e-3;
+  std::vector<testing::RigRow> rows;
+  testing::rig_rows(s, drive, testing::RigMotion{}, 11, [&](const testing::RigRow& r) { rows.push_back(r); });
+  const std::filesystem::path dir = test::fresh_test_folder("gyrocal-rig-rate-tolerance");
+  {
+    std::ofstream out(dir / "rig.csv");
+    testing::write_native(out, rows);
+  }
+
+  // The default: refused, the reason naming the tolerance and the measured offset.
+  const test::CliOutcome refused = calibrate_with(dir, "rig.csv", scenario_to_toml(s));
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.err.find("3.00e-03 (relative) from the planned 9.9 rad/s (rate_tolerance 2e-03)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_TRUE(refused.out.empty()) << refused.out;
+
+  // [reduce] rate_tolerance = 5e-3: the same record calibrates to the truth within its uncertainties.
+  const test::CliOutcome c = calibrate_with(dir, "rig.csv", with_reduce_line(s, "rate_tolerance", "5e-3"));
+  ASSERT_EQ(c.status, 0) << c.err;
+  const nlohmann::json j = nlohmann::json::parse(c.out);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    const nlohmann::json& e = j.at("coefficients").at(std::string(kCoefficientNames[k]));
+    ASSERT_TRUE(e.at("identifiable").get<bool>()) << kCoefficientNames[k];
+    EXPECT_NEAR(e.at("value").get<double>(), s.gyro.values[k], 4.0 * e.at("std").get<double>())
+        << kCoefficientNames[k];
+  }
+  // Each dwell measured its rate 0.3 % above the plan's.
+  for (const nlohmann::json& d : j.at("data_quality").at("dwells")) {
+    const double planned = d.at("rate_rad_s").get<double>(),
+                 measured = d.at("measured_rate_rad_s").get<double>();
+    EXPECT_NEAR(measured / planned - 1.0, 3e-3, 1e-4) << d.dump();
+  }
+
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RigRecord, TheReductionMethodComesFromTheConfigurationUnlessTheCommandLineSaysOtherwise) {
+  Scenario s = default_scenario();
+  s.test.sample_rate_hz = 50.0;
+  s.test.revolutions = 8;
+  s.test.rates_rad_s = {9.9, 7.0};
+  std::vector<testing::RigRow> rows;
+  testing::rig_rows(s, testing::RigImperfections{}, testing::RigMotion{}, 5,
+                    [&](const testing::RigRow& r) { rows.push_back(r); });
+  const std::filesystem::path dir = test::fresh_test_folder("gyrocal-rig-reduction");
+  {
+    std::ofstream out(dir / "rig.csv");
+    testing::write_native(out, rows);
+  }
+  const auto coefficients = [](const test::CliOutcome& o) {
+    EXPECT_EQ(o.status, 0) << o.err;
+    return o.status == 0 ? nlohmann::json::parse(o.out).at("coefficients") : nlohmann::json();
+  };
+  const std::string harmonic = scenario_to_toml(s);
+  std::string window = harmonic;
+  const std::size_t at = window.find("\nreduction = \"harmonic\"");
+  ASSERT_NE(at, std::string::npos) << window;
+  window.replace(at + 1, std::string("reduction = \"harmonic\"").size(), "reduction = \"window\"");
+
+  const nlohmann::json by_default = coefficients(calibrate_with(dir, "rig.csv", harmonic));
+  const nlohmann::json by_flag =
+      coefficients(calibrate_with(dir, "rig.csv", harmonic, " --reduction window"));
+  const nlohmann::json by_config = coefficients(calibrate_with(dir, "rig.csv", window));
+  const nlohmann::json overridden =
+      coefficients(calibrate_with(dir, "rig.csv", window, " --reduction harmonic"));
+  EXPECT_NE(by_flag, by_default);  // the two methods differ on a noisy record
+  EXPECT_EQ(by_config, by_flag);
+  EXPECT_EQ(overridden, by_default);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace gyrocal

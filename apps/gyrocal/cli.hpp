@@ -17,9 +17,9 @@ namespace gyrocal::cli {
 Scenario load_configuration(const std::string& path);
 
 /// The check that plan, simulate and calibrate share (reduce/feasibility.hpp), its refusal naming the
-/// configuration file (or the built-in scenario).
-void check_feasible(const Scenario& scenario, const std::string& config_path,
-                    const ReduceOptions& options = ReduceOptions{});
+/// configuration file (or the built-in scenario). options: the reduction that will run (scenario.reduce,
+/// with the command line's overrides).
+void check_feasible(const Scenario& scenario, const std::string& config_path, const ReduceOptions& options);
 
 /// An output: standard output for "-", else an AtomicOutputFile (a regular file through a temporary and a
 /// rename; a device or FIFO written straight through; anything else refused). An existing regular file is

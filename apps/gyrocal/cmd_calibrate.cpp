@@ -12,9 +12,9 @@ namespace gyrocal::cli {
 
 void register_calibrate(CLI::App& app) {
   struct Options {
-    std::string record, config, json, method = "least-squares", compensation = "full", estimate,
-                                      reduction = "harmonic";
+    std::string record, config, json, method = "least-squares", compensation = "full", estimate;
     std::string gyro_model;  // empty: [calibration] gyro_model
+    std::string reduction;   // empty: [calibration] reduction
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
@@ -28,7 +28,8 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
       ->check(CLI::IsMember({"none", "seed", "full"}));
   sub->add_option("--reduction", opt->reduction,
-                  "harmonic (default: harmonic fit in gamma with drift) or window (mean around each gamma)")
+                  "harmonic (harmonic fit in gamma with drift) or window (mean around each gamma); default: "
+                  "[calibration] reduction, else harmonic")
       ->check(CLI::IsMember({"harmonic", "window"}));
   sub->add_option(
       "--estimate", opt->estimate,
@@ -51,8 +52,11 @@ void register_calibrate(CLI::App& app) {
                            ? parse_machine_error_names(s.estimate, "[calibration] estimate")
                            : parse_machine_error_names(split_names(opt->estimate), "--estimate");
     options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
-    options.reduce.method =
-        opt->reduction == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
+    // [reduce] and [calibration] reduction (docs/contract.md), the method overridden by --reduction.
+    options.reduce = s.reduce;
+    if (!opt->reduction.empty())
+      options.reduce.method = opt->reduction == "window" ? ReduceOptions::Method::kWindowMean
+                                                         : ReduceOptions::Method::kHarmonicFit;
     check_feasible(s, opt->config, options.reduce);
     require_angle_columns(s.record, opt->record);
     // The record's metadata against the configuration, before the record is read (docs/interface.md).

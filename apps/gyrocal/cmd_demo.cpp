@@ -64,6 +64,7 @@ void register_demo(CLI::App& app) {
       CalibrationOptions options;
       options.method = run.method;
       options.compensation = run.compensation;
+      options.reduce = s.reduce;
       labels.push_back(run.label);
       results.push_back(calibrate_record(record_staged, s.model(), s.test, options));
     }

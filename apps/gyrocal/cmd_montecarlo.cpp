@@ -117,6 +117,7 @@ void register_montecarlo(CLI::App& app) {
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
     options.calibration.gyro_model =
         opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
+    options.calibration.reduce = scenario.reduce;  // [reduce]: --samples reduces each trial's record with it
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);

@@ -42,6 +42,7 @@ void register_plan(CLI::App& app) {
                            ? parse_machine_error_names(s.estimate, "[calibration] estimate")
                            : parse_machine_error_names(split_names(opt->estimate), "--estimate");
     options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
+    options.reduce = s.reduce;  // [reduce] and [calibration] reduction: the reduction the prediction models
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {

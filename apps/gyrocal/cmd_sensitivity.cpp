@@ -148,6 +148,7 @@ void register_sensitivity(CLI::App& app) {
         opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
     options.threshold = opt->threshold;
     options.threads = opt->threads;
+    options.calibration.reduce = scenario.reduce;  // [reduce]: the reduction the study's calibrations use
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("sensitivity");
     const SensitivityResult result = sensitivity_study(scenario, options);
     if (!opt->json.empty()) write_output(opt->json, sensitivity_to_json(result).dump(2) + "\n", true);

@@ -68,7 +68,7 @@ void register_simulate(CLI::App& app) {
     refuse_to_overwrite_input(opt->out, opt->config);
     const Scenario scenario = load_configuration(opt->config);
     // A record that calibrate would refuse is not written (the same check as plan's and calibrate's).
-    check_feasible(scenario, opt->config);
+    check_feasible(scenario, opt->config, scenario.reduce);
     SimulationOptions options;
     if (seed->count()) options.seed = opt->seed;
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("simulating");

@@ -52,18 +52,20 @@ def simulate(scenario, seed=None):
     return _gyrocal._simulate(scenario, None if seed is None else int(seed))
 
 
-def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=(), reduction="harmonic"):
+def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=(), reduction=None):
     """`gyrocal calibrate --json` as a dict. rec is a record's path (read through the scenario's [record]
     layout when its configuration has one, as `gyrocal calibrate --config`) or a mapping of arrays (a dict such
     as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
     method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
-    "window". estimate: machine errors estimated with the coefficients (self-calibration, as --estimate:
+    "window" (None: the scenario's [calibration] reduction, else "harmonic"; the scenario's [reduce] options
+    apply either way). estimate: machine errors estimated with the coefficients (self-calibration, as --estimate:
     NAME, NAME_I/_O/_S, NAME:N; docs/self_calibration.md), a list of names or one name."""
     if estimate is None:
         estimate = ()
     if isinstance(estimate, str):
         estimate = [estimate]
     estimate = [str(name) for name in estimate]
+    reduction = "" if reduction is None else str(reduction)
     if _is_path(rec):
         return _gyrocal._calibrate_path(os.fspath(rec), scenario, method, compensation, reduction, estimate)
     columns = [_column(rec, name) for name in RECORD_COLUMNS]

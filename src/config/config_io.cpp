@@ -111,6 +111,74 @@ const std::vector<ErrorKey>& error_keys() {
   return keys;
 }
 
+/// A key of [reduce]: one ReduceOptions field (reduce/dwell_accumulator.hpp, where each default's full reason
+/// is written), in the unit its name carries (the field's own, so no conversion), as a number, an integer or
+/// a boolean (one member set). The comment gives the unit and the reason for the default, which `init` writes
+/// after the key with the default's value; the range is ReduceOptions::IsValid's, whose refusal names the
+/// key.
+struct ReduceKey {
+  std::string_view key;
+  double ReduceOptions::*number = nullptr;
+  int ReduceOptions::*integer = nullptr;
+  bool ReduceOptions::*flag = nullptr;
+  std::string_view unit;
+  std::string_view reason;
+};
+
+/// The keys of [reduce], in the order `init` writes them: the fit, then finding dwells (docs/calibration.md,
+/// "Cutting a record into dwells"), then the outlier rule ("Spikes"). The method itself is [calibration]
+/// reduction (harmonic or window), which --reduction overrides.
+constexpr ReduceKey kReduceKeys[] = {
+    {"harmonic_order", nullptr, &ReduceOptions::harmonic_order, nullptr, "integer",
+     "harmonic fit: orders 0..n in gamma; order 3 needs 14 samples per revolution"},
+    {"linear_drift", nullptr, nullptr, &ReduceOptions::linear_drift, "true or false",
+     "harmonic fit and window mean: a linear drift in time, so a slow drift of the bias does not bias the "
+     "values at the dwell's mid-time"},
+    {"window_deg", &ReduceOptions::window_deg, nullptr, nullptr, "deg",
+     "window mean: full width of the window around each gamma"},
+    {"window_s", &ReduceOptions::window_s, nullptr, nullptr, "s",
+     "windows of encoder readings that recognise a steady state; physics.md section 14 asks >= 0.25 s, "
+     "0.5 s measures 10 rad/s to ~4e-5 through 0.1 deg quantisation at 200 Hz"},
+    {"angle_tolerance_deg", &ReduceOptions::angle_tolerance_deg, nullptr, nullptr, "deg",
+     "a reading this far from its window's line leaves the steady state: ten times what 0.1 deg "
+     "quantisation, 0.1 ms stamp jitter at 10 rad/s and 2e-4 rate ripple explain together"},
+    {"beta_tolerance_deg", &ReduceOptions::beta_tolerance_deg, nullptr, nullptr, "deg",
+     "beta (and a static hold's gamma) matches the plan and stays put within it: four 0.1 deg quanta "
+     "and a toggling count, far below any two planned positions' separation"},
+    {"rate_tolerance", &ReduceOptions::rate_tolerance, nullptr, nullptr, "relative",
+     "a steady rate matches a planned rate, and the counter platform minus the main rate, within it: "
+     "a drive may differ from its nominal by up to 1e-3 (the measured rate is used), twice that for margin"},
+    {"rate_steadiness", &ReduceOptions::rate_steadiness, nullptr, nullptr, "relative",
+     "each window's rate stays this close to the dwell's: rate ripple up to 2e-4, five times"},
+    {"static_rate_tolerance_rad_s", &ReduceOptions::static_rate_tolerance_rad_s, nullptr, nullptr, "rad/s",
+     "below it the main axis (or a platform) counts as stopped"},
+    {"wander_warning_deg", &ReduceOptions::wander_warning_deg, nullptr, nullptr, "deg RMS",
+     "a dwell's main encoder off its constant-rate line by more than this, beyond its scatter, is warned "
+     "about (the model's channels follow the line)"},
+    {"gap_intervals", &ReduceOptions::gap_intervals, nullptr, nullptr, "planned sample intervals",
+     "a longer interval between two rows is a gap; a dwell with gaps is still one dwell"},
+    {"encoder_glitch_rows", nullptr, &ReduceOptions::encoder_glitch_rows, nullptr, "rows",
+     "up to this many consecutive rows whose encoders leave the dwell's line and come back are dropped "
+     "as a glitch; more end the dwell"},
+    {"leave_guard_s", &ReduceOptions::leave_guard_s, nullptr, nullptr, "s",
+     "samples this close to the end of a run that left its steady state are dropped: a platform starting "
+     "to move at 20 deg/s^2 leaves beta_tolerance_deg only after 0.14 s, and the glitch rows follow"},
+    {"max_stretches_per_dwell", nullptr, &ReduceOptions::max_stretches_per_dwell, nullptr, "stretches",
+     "a dwell broken into more stretches (by gaps and glitches) is refused: it bounds the channels' memory"},
+    {"static_batches", nullptr, &ReduceOptions::static_batches, nullptr, "batches",
+     "a static hold's standard error comes from this many batch means"},
+    {"model_samples_per_revolution", nullptr, &ReduceOptions::model_samples_per_revolution, nullptr,
+     "samples",
+     "the model's channels on every k-th sample, keeping this many per revolution; 0 = every sample, the "
+     "only choice exact on any configuration (32 left 4.3e-6 deg/h/g^2 on dOS with large machine errors)"},
+    {"outlier_threshold", &ReduceOptions::outlier_threshold, nullptr, nullptr, "robust standard deviations",
+     "an output sample further than this from its block's median residual about the dwell's fit is an "
+     "outlier, counted and replaced by the fit (0 = no rejection): Gaussian noise passes 6 once in 5e8"},
+    {"outlier_block_samples", nullptr, &ReduceOptions::outlier_block_samples, nullptr, "samples",
+     "the outlier rule tests blocks of whole revolutions of at least this many samples, enough for the "
+     "median absolute deviation to be a good scale (+-13 % at 128); the memory of one block"},
+};
+
 // ---------------------------------------------------------------------------------------------------------
 // Numbers as text.
 
@@ -236,6 +304,13 @@ class Reader {
       fail(node.source(),
            path + " must be an integer <= " + std::to_string(max) + ", not " + std::to_string(value));
     return value;
+  }
+
+  /// A boolean.
+  bool boolean(const toml::node& node, const std::string& path) const {
+    const auto* flag = node.as_boolean();
+    if (flag == nullptr) fail(node.source(), path + " must be true or false, not " + type_name(node));
+    return flag->get();
   }
 
   /// A string.
@@ -513,6 +588,45 @@ RecordLayout read_record(const Reader& reader, Section& section, const toml::tab
   return layout;
 }
 
+/// The value of a [reduce] key as the file writes it.
+std::string reduce_value(const ReduceKey& k, const ReduceOptions& o) {
+  if (k.number != nullptr) return toml_number(o.*k.number);
+  if (k.integer != nullptr) return std::to_string(o.*k.integer);
+  return o.*k.flag ? "true" : "false";
+}
+
+/// [reduce] (kReduceKeys) into options, whose method [calibration] reduction has set. The ranges are
+/// ReduceOptions::IsValid's: its refusal begins with the field's name, which is the key's, so the message
+/// names the key and its line (the whole options are checked, so a rule that ties two keys is refused too,
+/// at the line of the key it names).
+void read_reduce(const Reader& reader, Section& section, const toml::table* table, ReduceOptions& options) {
+  for (const ReduceKey& k : kReduceKeys) {
+    const toml::node* node = section.find(k.key);
+    if (node == nullptr) continue;
+    const std::string path = section.path(k.key);
+    if (k.number != nullptr) {
+      options.*k.number = reader.number(*node, path, kAnyValue);
+    } else if (k.integer != nullptr) {
+      options.*k.integer = static_cast<int>(reader.integer(*node, path, INT_MIN, INT_MAX));
+    } else {
+      options.*k.flag = reader.boolean(*node, path);
+    }
+  }
+  section.reject_unknown();
+  std::string error;
+  if (options.IsValid(&error)) return;
+  const std::string_view name = std::string_view(error).substr(0, error.find(' '));
+  const auto key = std::find_if(std::begin(kReduceKeys), std::end(kReduceKeys),
+                                [name](const ReduceKey& k) { return k.key == name; });
+  const toml::node* node = table != nullptr && !name.empty() ? table->get(name) : nullptr;
+  if (node == nullptr || key == std::end(kReduceKeys)) {
+    // Not a key of the file (cannot happen with the defaults valid); still refused, naming the section.
+    if (table != nullptr) reader.fail(table->source(), "[reduce]: " + error);
+    throw Error("[reduce]: " + error + ".");
+  }
+  reader.fail(node->source(), "reduce." + error + ", not " + reduce_value(*key, options));
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Writing.
 
@@ -540,17 +654,51 @@ class TomlWriter {
       begin = end + 1;
     }
   }
+  /// "key = value  # note"; a note of several lines (separated by \n) continues on comment lines aligned
+  /// with its first.
   void key(std::string_view key, const std::string& value, std::string_view note) {
     constexpr std::size_t kCommentColumn = 44;
     std::string line = std::string(key) + " = " + value;
     line.resize(std::max(line.size() + 2, kCommentColumn), ' ');
-    out_ << line << "# " << note << "\n";
+    const std::size_t first_end = std::min(note.find('\n'), note.size());
+    out_ << line << "# " << note.substr(0, first_end) << "\n";
+    for (std::size_t begin = first_end + 1; begin < note.size();) {
+      const std::size_t end = std::min(note.find('\n', begin), note.size());
+      out_ << std::string(kCommentColumn, ' ') << "# " << note.substr(begin, end - begin) << "\n";
+      begin = end + 1;
+    }
   }
   std::string text() const { return out_.str(); }
 
  private:
   std::ostringstream out_;
 };
+
+/// text broken into lines (separated by \n) of at most `width` characters, at spaces (a longer word stays
+/// whole).
+std::string wrapped(std::string_view text, std::size_t width) {
+  std::string out;
+  std::size_t line_length = 0;
+  for (std::size_t begin = 0; begin < text.size();) {
+    const std::size_t end = std::min(text.find(' ', begin), text.size());
+    const std::string_view word = text.substr(begin, end - begin);
+    if (line_length > 0 && line_length + 1 + word.size() > width) {
+      out += '\n';
+      line_length = 0;
+    } else if (line_length > 0) {
+      out += ' ';
+      ++line_length;
+    }
+    out += word;
+    line_length += word.size();
+    begin = end + 1;
+  }
+  return out;
+}
+
+/// The width of a [reduce] key's comment lines: with the comment column (44), lines of at most 118
+/// characters.
+constexpr std::size_t kReduceCommentWidth = 72;
 
 std::string number_array(const std::vector<double>& values_si, double to_si) {
   std::string text = "[";
@@ -795,7 +943,17 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
       reader.fail(node->source(), "calibration.gyro_model must be \"drift\" or \"drift+rate\"");
     s.gyro_model = *text == "drift" ? GyroModel::kDrift : GyroModel::kDriftRate;
   }
+  if (const toml::node* node = calibration.find("reduction")) {
+    const std::optional<std::string> text = node->value<std::string>();
+    if (!text || (*text != "harmonic" && *text != "window"))
+      reader.fail(node->source(), "calibration.reduction must be \"harmonic\" or \"window\"");
+    s.reduce.method =
+        *text == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
+  }
   calibration.reject_unknown();
+  const toml::table* reduce_table = top.table("reduce");
+  Section reduce(reader, reduce_table, "reduce");
+  read_reduce(reader, reduce, reduce_table, s.reduce);
   if (const toml::table* record_table = top.table("record")) {
     Section record(reader, record_table, "record");
     s.record = read_record(reader, record, *record_table);
@@ -925,6 +1083,21 @@ std::string scenario_to_toml(const Scenario& s) {
         "NAME:N");
   w.key("gyro_model", s.gyro_model == GyroModel::kDrift ? "\"drift\"" : "\"drift+rate\"",
         "\"drift\" or \"drift+rate\" (docs/physics.md section 15)");
+  w.key("reduction", s.reduce.method == ReduceOptions::Method::kWindowMean ? "\"window\"" : "\"harmonic\"",
+        "\"harmonic\" (fit in gamma with drift) or \"window\" (mean around each gamma); as --reduction");
+
+  w.section(
+      "reduce",
+      "How a record is cut into dwells and each dwell reduced (docs/calibration.md). Each comment gives\n"
+      "the key's unit, its default and the reason for it; the ranges are checked when the file is read.");
+  const ReduceOptions defaults;
+  for (const ReduceKey& k : kReduceKeys) {
+    w.key(
+        k.key, reduce_value(k, s.reduce),
+        wrapped(std::string(k.unit) + "; default " + reduce_value(k, defaults) + ": " + std::string(k.reason),
+                kReduceCommentWidth));
+  }
+
   constexpr std::string_view kRecordNote =
       "How to read a rig's own record (docs/contract.md, \"Records\"; docs/records.md). Without a [record]\n"
       "section a record is gyrocal's own format, whose first line is \"# gyrocal-record 1\"; with one (even\n"

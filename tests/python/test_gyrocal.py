@@ -186,6 +186,26 @@ def test_calibrate_from_arrays_and_path_equal_cli(small, tmp_path, method, compe
     assert len(from_arrays["coefficients"]) == 10 and len(values) >= 5 and all(map(math.isfinite, values))
 
 
+def test_calibrate_takes_the_scenarios_reduction_and_reduce_options(tmp_path):
+    # [calibration] reduction and [reduce] as `gyrocal calibrate --config` takes them: reduction=None keeps the
+    # scenario's method, a named one overrides it, and the [reduce] options apply either way.
+    config = tmp_path / "window.toml"
+    config.write_text(SMALL_TEST + '[calibration]\nreduction = "window"\n[reduce]\nwindow_deg = 20.0\n')
+    sc = gyrocal.Scenario.load(str(config))
+    record = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--out", record)
+    for flag, reduction in [([], None), (["--reduction", "harmonic"], "harmonic")]:
+        result = tmp_path / "result.json"
+        run_cli("calibrate", record, "--config", config, *flag, "--json", result)
+        expected = json.loads(result.read_text())
+        assert gyrocal.calibrate(str(record), sc, reduction=reduction) == expected
+    # Not vacuous: the scenario's window of 20 deg changes the result from the default window's.
+    plain = tmp_path / "plain.toml"
+    plain.write_text(SMALL_TEST)
+    with_default_window = gyrocal.calibrate(str(record), gyrocal.Scenario.load(str(plain)), reduction="window")
+    assert gyrocal.calibrate(str(record), sc)["coefficients"] != with_default_window["coefficients"]
+
+
 def test_calibrate_takes_a_mapping_with_more_columns(small):
     _, sc = small
     rec = gyrocal.simulate(sc, seed=2)

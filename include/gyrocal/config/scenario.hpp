@@ -11,6 +11,7 @@
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/record/record_layout.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal {
 
@@ -31,6 +32,10 @@ struct Scenario {
   /// [record]: how to read a rig's own record (docs/records.md); nullopt (no [record] section) means
   /// gyrocal's own format, magic line required.
   std::optional<RecordLayout> record;
+  /// [reduce]: how the reducer finds dwells in a record and reduces them (tolerances, the outlier rule, the
+  /// harmonic order...), and [calibration] reduction: its method. Defaults: ReduceOptions{}, whose header
+  /// gives each default's reason. The command line's --reduction overrides the method.
+  ReduceOptions reduce;
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
