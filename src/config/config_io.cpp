@@ -21,6 +21,7 @@
 #include <toml++/toml.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 
 namespace gyrocal {
@@ -465,7 +466,7 @@ void reject_repeats(const Reader& reader, const toml::node& node, const std::str
   for (std::size_t j = 1; j < values.size(); ++j) {
     for (std::size_t i = 0; i < j; ++i) {
       const double a = values[i], b = values[j];
-      const bool same = angle ? std::abs(std::remainder(a - b, 360.0)) <= 1e-3
+      const bool same = angle ? std::abs(wrap_deg(a - b)) <= 1e-3
                               : std::abs(a - b) <= 1e-3 * std::max(std::abs(a), std::abs(b));
       if (!same) continue;
       const std::string why = angle    ? " (the same angle modulo 360 deg, within 0.001 deg)"
