@@ -12,26 +12,13 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
 
-struct Pipeline {
-  Reduction reduction;
-  std::vector<PositionChannels> channels;
-};
-
-/// Simulate the scenario's test in memory and reduce it.
-Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
-  Reducer reducer(s.test, ro, "simulated", s.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  Pipeline p;
-  p.reduction = reducer.finish();
-  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
-  return p;
-}
+using testing::Pipeline;
+using testing::run;
 
 CalibrationResult calibrate(const Scenario& s, const Pipeline& p, Method m, Compensation c) {
   CalibrationOptions o;

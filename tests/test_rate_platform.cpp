@@ -17,6 +17,7 @@
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -25,21 +26,8 @@ bool sanitized() {
   return std::getenv("GYROCAL_SANITIZED") != nullptr;
 }
 
-struct Pipeline {
-  Reduction reduction;
-  std::vector<PositionChannels> channels;
-};
-
-Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
-  Reducer reducer(s.test, ro, "simulated", s.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  Pipeline p;
-  p.reduction = reducer.finish();
-  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
-  return p;
-}
+using testing::Pipeline;
+using testing::run;
 
 CalibrationResult identify_with(const Scenario& s, const Pipeline& p, GyroModel g,
                                 Method m = Method::kLeastSquares) {

@@ -1,0 +1,32 @@
+#pragma once
+// For tests: the scenario's test simulated in memory (simulate/simulator.hpp), streamed through the reducer
+// (reduce/reducer.hpp), and the model's channels reduced on the same dwells (identify/channels.hpp): what
+// `gyrocal simulate` then `gyrocal calibrate` do, without a file.
+#include <cstdint>
+#include <vector>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace gyrocal::testing {
+
+struct Pipeline {
+  Reduction reduction;
+  std::vector<PositionChannels> channels;
+};
+
+/// Simulates the scenario's test with `seed`, reduces it with `ro`, and reduces the exact model's channels.
+inline Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
+  Reducer reducer(s.test, ro, "simulated", s.centrifuge.rate_rad_s);
+  SimulationOptions so;
+  so.seed = seed;
+  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
+  Pipeline p;
+  p.reduction = reducer.finish();
+  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
+  return p;
+}
+
+}  // namespace gyrocal::testing
