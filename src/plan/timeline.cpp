@@ -195,24 +195,20 @@ class Builder {
     }
     if (rate == rate_ && offset == offset_) return;
     if (!servoed_) engage_counter();
-    if (rate != rate_) {
-      const double ramp_s = std::abs(rate - rate_) / limits_.main_accel_rad_s2;
-      main_ = {t_, main_at(main_, t_).angle_rad, rate_,
-               std::copysign(limits_.main_accel_rad_s2, rate - rate_)};
-      add(SegmentKind::kMainRamp, ramp_s);
-      main_ = {t_, main_at(main_, t_).angle_rad, rate, 0.0};
-      rate_ = rate;
-    }
-    if (offset != offset_) {
-      // docs/physics.md section 15: the counter platform changes its rate offset as a platform accelerates;
-      // phi and its rate stay continuous.
-      const double ramp_s = std::abs(offset - offset_) / limits_.platform_accel_rad_s2;
-      offset_motion_ = {t_, main_at(offset_motion_, t_).angle_rad, offset_,
-                        std::copysign(limits_.platform_accel_rad_s2, offset - offset_)};
-      add(SegmentKind::kOffsetRamp, ramp_s);
-      offset_motion_ = {t_, main_at(offset_motion_, t_).angle_rad, offset, 0.0};
-      offset_ = offset;
-    }
+    if (rate != rate_) ramp(SegmentKind::kMainRamp, main_, rate_, rate, limits_.main_accel_rad_s2);
+    // docs/physics.md section 15: the counter platform changes its rate offset as a platform accelerates;
+    // phi and its rate stay continuous.
+    if (offset != offset_)
+      ramp(SegmentKind::kOffsetRamp, offset_motion_, offset_, offset, limits_.platform_accel_rad_s2);
+  }
+
+  /// A ramp of `motion` from rate `from` to `to` at `accel` (rad/s^2): its angle and rate continuous; `from`
+  /// becomes `to`.
+  void ramp(SegmentKind kind, MainMotion& motion, double& from, double to, double accel) {
+    motion = {t_, main_at(motion, t_).angle_rad, from, std::copysign(accel, to - from)};
+    add(kind, std::abs(to - from) / accel);
+    motion = {t_, main_at(motion, t_).angle_rad, to, 0.0};
+    from = to;
   }
 
   /// From rest: the counter platform moves onto its servo law (which drifts at delta omega meanwhile).
