@@ -144,8 +144,9 @@ constexpr ReduceKey kReduceKeys[] = {
      "a reading this far from its window's line leaves the steady state: ten times what 0.1 deg "
      "quantisation, 0.1 ms stamp jitter at 10 rad/s and 2e-4 rate ripple explain together"},
     {"beta_tolerance_deg", &ReduceOptions::beta_tolerance_deg, nullptr, nullptr, "deg",
-     "beta (and a static hold's gamma) matches the plan and stays put within it: four 0.1 deg quanta "
-     "and a toggling count, far below any two planned positions' separation"},
+     "beta (and a static hold's gamma) matches the plan, and beta (and a static hold's main and counter "
+     "angles) stays put within it: four 0.1 deg quanta and a toggling count, far below any two planned "
+     "positions' separation"},
     {"rate_tolerance", &ReduceOptions::rate_tolerance, nullptr, nullptr, "relative",
      "a steady rate matches a planned rate, and the counter platform minus the main rate, within it: "
      "a drive may differ from its nominal by up to 1e-3 (the measured rate is used), twice that for margin"},

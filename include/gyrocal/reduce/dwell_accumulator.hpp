@@ -36,9 +36,9 @@ struct ReduceOptions {
   /// ten times what 0.1 deg quantisation (+-0.05), 0.1 ms stamp jitter at 10 rad/s (+-0.06) and 2e-4 rate
   /// ripple (0.01) can explain together; a ramp away from 10 rad/s at 2 rad/s^2 crosses it within 0.1 s.
   double angle_tolerance_deg = 0.5;
-  /// Beta (and a static hold's gamma) matches the plan within this, and stays within it of the dwell's
-  /// value, deg: four 0.1 deg encoder quanta and a toggling count, far below any two planned positions'
-  /// separation.
+  /// Beta (and a static hold's gamma) matches the plan within this, and beta (and a static hold's main and
+  /// counter angles) stays within it of the dwell's value, deg: four 0.1 deg encoder quanta and a toggling
+  /// count, far below any two planned positions' separation.
   double beta_tolerance_deg = 0.2;
   /// A steady rate matches a planned rate within this (relative), and the counter platform turns at minus
   /// the main rate within it: a drive may differ from its nominal rate by up to 1e-3 (the measured rate is
