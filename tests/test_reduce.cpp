@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include <gtest/gtest.h>
 
 #include "gyrocal/config/scenario.hpp"
@@ -296,6 +298,33 @@ TEST(Revolutions, TooFewForAScatterIsARefusalSayingHowManyAreNeeded) {
     const std::string m = e.what();
     EXPECT_NE(m.find("revolutions"), std::string::npos) << m;
     EXPECT_NE(m.find("at least 3"), std::string::npos) << m;
+  }
+}
+
+TEST(RecordEnd, ARecordThatEndsRightAfterASettleTimeIsRefusedWithItsReason) {
+  // The rows after a run's settle time wait for two windows to agree before the run is matched to the plan
+  // (docs/calibration.md): a record that ends in between must give the dwell's reason, never touch a dwell
+  // that was not started. The second dwell follows a position move (its first window may hold the move's
+  // end); the record is cut at many instants after its settle time.
+  const Scenario s = small_test(20);
+  const Timeline tl = make_timeline(s.test, s.model());
+  ASSERT_GE(tl.measurements.size(), 2u);
+  const MeasurementInterval& second = tl.measurements[1];
+  const std::vector<RecordSample> rows = record_of(s, 1);
+  for (double after_s = 0.0; after_s < 0.6; after_s += 0.04) {
+    Reducer reducer(s.test, ReduceOptions{}, "cut.csv", s.centrifuge.rate_rad_s);
+    for (const RecordSample& x : rows) {
+      if (x.time_s > second.start_s + after_s) break;
+      reducer.push(x);
+    }
+    try {
+      reducer.finish();
+      FAIL() << "a record of less than two dwells cannot give every position";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(fmt::format("position {} (", second.position_index)), std::string::npos) << m;
+      EXPECT_NE(m.find("the record ends"), std::string::npos) << after_s << ": " << m;
+    }
   }
 }
 

@@ -421,7 +421,12 @@ struct Reducer::State {
     r.match = match_to_plan(plan, options, r.rate_theta * kDegToRad, r.rate_psi * kDegToRad, r.beta_deg,
                             r.gamma_deg);
     r.matched = r.match.why_not.empty();
-    if (!r.matched) return;
+    if (!r.matched) {
+      // The rows that waited for the match belong to no dwell.
+      r.quality.settle_rows += r.guard.size();
+      r.guard.clear();
+      return;
+    }
     // A spinning dwell: whole revolutions of gamma, which turns at rate - offset (docs/physics.md section
     // 15).
     const double rate = r.match.planned_rate_rad_s, offset = r.match.planned_counter_rate_offset_rad_s;
@@ -676,7 +681,10 @@ struct Reducer::State {
   void end_run(std::string reason, Ending how) {
     if (!run) return;
     if (how == Ending::kRecordEnds) {
-      while (run && !run->guard.empty()) {
+      // The record ends while the run waits for two windows to agree: it is matched on its last window, so
+      // that a dwell cut short is measured (or refused) as one.
+      if (!run->decided && !run->guard.empty()) decide(*run, run->t_prev);
+      while (run && run->matched && !run->guard.empty()) {
         const Run::Waiting w = run->guard.front();
         run->guard.pop_front();
         measure(w.u, w.gap, w.dropped, w.t_record);
