@@ -704,9 +704,12 @@ struct Reducer::State {
     }
     if (!run) return;
     for (const Run::Waiting& w : run->guard) {
-      // Beyond the planned duration they would not have been measured anyway.
+      // Beyond the planned duration they would not have been measured anyway; before the match they are
+      // settle rows.
       const bool beyond = run->measuring && w.u.t >= run->t_first + run->planned_duration - 1e-9;
-      ++(beyond ? run->quality.beyond_planned_rows : run->quality.before_leaving_rows);
+      ++(!run->decided ? run->quality.settle_rows
+         : beyond      ? run->quality.beyond_planned_rows
+                       : run->quality.before_leaving_rows);
     }
     run->guard.clear();
     Run r = std::move(*run);
