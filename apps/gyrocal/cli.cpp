@@ -76,4 +76,16 @@ void ProgressBar::operator()(double fraction) {
   std::fflush(stderr);
 }
 
+void add_gyro_model_option(CLI::App* sub, std::string& value) {
+  sub->add_option(
+         "--gyro-model", value,
+         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
+         "misalignments, by least squares); default: [calibration] gyro_model, else drift")
+      ->check(CLI::IsMember({"drift", "drift+rate"}));
+}
+
+GyroModel chosen_gyro_model(const std::string& option, const Scenario& scenario) {
+  return option.empty() ? scenario.gyro_model : parse_gyro_model(option);
+}
+
 }  // namespace gyrocal::cli

@@ -9,6 +9,7 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/atomic_file.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
@@ -51,6 +52,12 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
   int percent_ = -1;
 };
+
+/// --gyro-model drift|drift+rate (docs/physics.md section 15) on `sub`, into `value` (empty when not given).
+void add_gyro_model_option(CLI::App* sub, std::string& value);
+
+/// The gyro model a command identifies: `option` (--gyro-model) when given, else [calibration] gyro_model.
+GyroModel chosen_gyro_model(const std::string& option, const Scenario& scenario);
 
 /// A check for a numeric option: refuses NaN and infinities ("--beta-deg nan"), which CLI11 parses.
 extern const CLI::Validator kFinite;

@@ -87,10 +87,7 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--compensation", opt->compensation,
                   "none, seed, full (default) or self (the counter platform's errors estimated; two speeds)")
       ->check(CLI::IsMember({"none", "seed", "full", "self"}));
-  sub->add_option("--gyro-model", opt->gyro_model,
-                  "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input "
-                  "axis' misalignments; least squares); default: [calibration] gyro_model, else drift")
-      ->check(CLI::IsMember({"drift", "drift+rate"}));
+  add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->callback([opt, seed] {
     const long long most = opt->samples ? kMaxSampleTrials : kMaxFastTrials;
@@ -115,8 +112,7 @@ void register_montecarlo(CLI::App& app) {
     options.calibration.method = parse_method(opt->method);
     options.self = opt->compensation == "self";
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
-    options.calibration.gyro_model =
-        opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
+    options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
     options.calibration.reduce = scenario.reduce;  // [reduce]: --samples reduces each trial's record with it
     if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();

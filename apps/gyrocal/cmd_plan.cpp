@@ -26,11 +26,7 @@ void register_plan(CLI::App& app) {
       "--estimate", opt->estimate,
       "Machine errors estimated from the data with the coefficients, NAME[,NAME...] (NAME, NAME_I/_O/_S, "
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
-  sub->add_option(
-         "--gyro-model", opt->gyro_model,
-         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
-         "misalignments); default: [calibration] gyro_model, else drift")
-      ->check(CLI::IsMember({"drift", "drift+rate"}));
+  add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -41,7 +37,7 @@ void register_plan(CLI::App& app) {
     options.estimate = opt->estimate.empty()
                            ? parse_machine_error_names(s.estimate, "[calibration] estimate")
                            : parse_machine_error_names(split_names(opt->estimate), "--estimate");
-    options.gyro_model = opt->gyro_model.empty() ? s.gyro_model : parse_gyro_model(opt->gyro_model);
+    options.gyro_model = chosen_gyro_model(opt->gyro_model, s);
     options.reduce = s.reduce;  // [reduce] and [calibration] reduction: the reduction the prediction models
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);

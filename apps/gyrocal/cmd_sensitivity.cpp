@@ -135,17 +135,12 @@ void register_sensitivity(CLI::App& app) {
       ->check(kFinite & CLI::PositiveNumber);
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--gyro-model", opt->gyro_model,
-                  "drift (the ten coefficients) or drift+rate (least squares also gives the shifts of the "
-                  "scale-factor error and the input axis' misalignments); default: [calibration] gyro_model, "
-                  "else drift")
-      ->check(CLI::IsMember({"drift", "drift+rate"}));
+  add_gyro_model_option(sub, opt->gyro_model);
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
     const Scenario scenario = load_configuration(opt->config);
     SensitivityOptions options;
-    options.calibration.gyro_model =
-        opt->gyro_model.empty() ? scenario.gyro_model : parse_gyro_model(opt->gyro_model);
+    options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
     options.threshold = opt->threshold;
     options.threads = opt->threads;
     options.calibration.reduce = scenario.reduce;  // [reduce]: the reduction the study's calibrations use
