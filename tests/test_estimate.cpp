@@ -21,6 +21,7 @@
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/cli_run.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -52,13 +53,7 @@ Scenario configured(const Scenario& truth) {
   return c;
 }
 
-Reduction simulate_and_reduce(const Scenario& s, std::uint64_t seed) {
-  Reducer reducer(s.test, ReduceOptions{}, "simulated", s.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  return reducer.finish();
-}
+using testing::simulate_and_reduce;
 
 CalibrationResult self_calibrate(const Scenario& config, const Reduction& reduction,
                                  const std::vector<std::string>& names) {

@@ -21,6 +21,7 @@
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -52,13 +53,8 @@ Scenario scenario(const Plan& plan, bool noisy) {
 
 /// simulate -> reduce -> channels -> least squares, as `gyrocal simulate` + `gyrocal calibrate` do.
 CalibrationResult calibrate_simulated(const Scenario& s, std::uint64_t seed = 7) {
-  Reducer reducer(s.test, ReduceOptions{}, "simulated", s.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  const Reduction reduction = reducer.finish();
-  const std::vector<PositionChannels> channels = reduce_model_channels(reduction, s.model(), ReduceOptions{});
-  return identify(reduction, channels, s.model(), CalibrationOptions{});
+  const testing::Pipeline p = testing::run(s, seed);
+  return identify(p.reduction, p.channels, s.model(), CalibrationOptions{});
 }
 
 const Plan kSingleSpeed = {"single speed", {9.9}, {0, 180, 90, 270}, {0, 180, 90, 270}};

@@ -16,6 +16,7 @@
 #include "gyrocal/identify/channels.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -39,13 +40,8 @@ Scenario coloured_scenario(double b, double k) {
 
 /// The calibration of one simulated record of `s` with `seed`.
 CalibrationResult calibrate_simulated(const Scenario& s, std::uint64_t seed) {
-  Reducer reducer(s.test, ReduceOptions{}, "simulated", s.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  const Reduction reduction = reducer.finish();
-  return identify(reduction, reduce_model_channels(reduction, s.model(), ReduceOptions{}), s.model(),
-                  CalibrationOptions{});
+  const testing::Pipeline p = testing::run(s, seed);
+  return identify(p.reduction, p.channels, s.model(), CalibrationOptions{});
 }
 
 TEST(PredictNoise, WithoutColouredNoiseTheGainRouteEqualsTheWhiteNoisePrediction) {

@@ -16,6 +16,7 @@
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -202,9 +203,7 @@ Scenario rate_platform_scenario() {
 /// weights: the record's positions are weighted as the study weights its planned ones (the configured
 /// noise through the reduction operator), not by the scatter a noise-free record happens to show.
 CalibrationResult simulate_and_calibrate(const Scenario& s) {
-  Reducer reducer(s.test, ReduceOptions{}, "simulated", s.centrifuge.rate_rad_s);
-  simulate(s, SimulationOptions{}, [&](const RecordSample& sample) { reducer.push(sample); });
-  Reduction reduction = reducer.finish();
+  Reduction reduction = testing::simulate_and_reduce(s, std::nullopt);
   set_predicted_std_errors(reduction, s.noise, s.test.sample_rate_hz);
   CalibrationOptions o;
   o.gyro_model = GyroModel::kDriftRate;

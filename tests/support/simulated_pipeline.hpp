@@ -3,6 +3,7 @@
 // (reduce/reducer.hpp), and the model's channels reduced on the same dwells (identify/channels.hpp): what
 // `gyrocal simulate` then `gyrocal calibrate` do, without a file.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "gyrocal/config/scenario.hpp"
@@ -17,14 +18,20 @@ struct Pipeline {
   std::vector<PositionChannels> channels;
 };
 
-/// Simulates the scenario's test with `seed`, reduces it with `ro`, and reduces the exact model's channels.
-inline Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
+/// Simulates the scenario's test with `seed` (none: the scenario's test.seed) and reduces it with `ro`.
+inline Reduction simulate_and_reduce(const Scenario& s, std::optional<std::uint64_t> seed,
+                                     const ReduceOptions& ro = {}) {
   Reducer reducer(s.test, ro, "simulated", s.centrifuge.rate_rad_s);
   SimulationOptions so;
   so.seed = seed;
   simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
+  return reducer.finish();
+}
+
+/// Simulates the scenario's test with `seed`, reduces it with `ro`, and reduces the exact model's channels.
+inline Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
   Pipeline p;
-  p.reduction = reducer.finish();
+  p.reduction = simulate_and_reduce(s, seed, ro);
   p.channels = reduce_model_channels(p.reduction, s.model(), ro);
   return p;
 }
