@@ -191,6 +191,27 @@ main_angle_offset_deg = {3}
     EXPECT_GT(std, 0.0) << kCoefficientNames[k];
     EXPECT_NEAR(e.at("value").get<double>(), s.gyro.values[k], 4.5 * std) << kCoefficientNames[k];
   }
+  // Without the encoder's zero the same record calibrates off the truth: the key is what brings it back.
+  {
+    std::ofstream toml(dir / "rig.toml");
+    std::string unzeroed = mapping;
+    unzeroed.insert(unzeroed.find("main_angle_offset_deg"), "# ");  // the key commented out
+    toml << scenario_to_toml(s) << unzeroed;
+  }
+  const test::CliOutcome off = test::run_cli(
+      "calibrate " + (dir / "rig.csv").string() + " --config " + (dir / "rig.toml").string() + " --json -",
+      dir);
+  double worst_z = 0.0;
+  if (off.status == 0) {
+    const nlohmann::json o = nlohmann::json::parse(off.out);
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      const nlohmann::json& e = o.at("coefficients").at(std::string(kCoefficientNames[k]));
+      if (!e.at("identifiable").get<bool>()) continue;
+      worst_z = std::max(
+          worst_z, std::abs(e.at("value").get<double>() - s.gyro.values[k]) / e.at("std").get<double>());
+    }
+  }
+  EXPECT_TRUE(off.status != 0 || worst_z > 4.5) << worst_z;
   std::filesystem::remove_all(dir);
 }
 
