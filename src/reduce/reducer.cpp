@@ -415,8 +415,10 @@ struct Reducer::State {
     taking = true;
     take_one(raw);
     for (;;) {
-      pending.insert(pending.begin(), handed_back.begin(), handed_back.end());
-      handed_back.clear();
+      if (!handed_back.empty()) {
+        pending.insert(pending.begin(), handed_back.begin(), handed_back.end());
+        handed_back.clear();
+      }
       if (pending.empty()) break;
       const Row q = pending.front();
       pending.pop_front();
