@@ -4,7 +4,8 @@
 // small size chosen from the input's length, and both readings must agree row for row and refusal for
 // refusal: where a line falls across reads must not change what is read. The same twice more through a rig's
 // layout ([record], docs/records.md: ';', a '%' comment, columns by name, ns stamps, counts, radians, a
-// scale), and once through a whitespace-delimited layout.
+// negative scale, offsets, a decimal comma), and once through a whitespace-delimited layout (a preamble line
+// and a units row skipped).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -38,7 +39,13 @@ gyrocal::RecordLayout fuzz_layout(bool blank_delimited) {
   l.angle_unit = gyrocal::AngleUnit::kRadians;
   l.main_counts_per_revolution = 16777216;
   l.output_column = "w";
-  l.output_scale_per_deg_h = 2.5;
+  l.output_scale_per_deg_h = blank_delimited ? 2.5 : -2.5;
+  l.output_offset = 100.0;
+  l.main_angle_offset_deg = 17.2;
+  // The ';' layout reads a decimal comma; the blank-delimited one skips a preamble line and a units row.
+  l.decimal = blank_delimited ? '.' : ',';
+  l.skip_rows = blank_delimited ? 1 : 0;
+  l.units_row = blank_delimited;
   return l;
 }
 
@@ -49,7 +56,9 @@ Reading read_all(const std::string& text, std::size_t chunk_bytes,
     gyrocal::RecordReader reader = gyrocal::RecordReader::from_string(text, layout, "fuzz.csv", chunk_bytes);
     out.metadata = reader.metadata();
     out.columns = reader.columns();
-    if (!layout && reader.extra_column_count() + gyrocal::kRecordColumns.size() != out.columns.size())
+    // gyrocal's own format: the five required columns (or time_s and the output alone), then the extra ones.
+    if (!layout && reader.extra_column_count() + (reader.has_angles() ? gyrocal::kRecordColumns.size() : 2) !=
+                       out.columns.size())
       std::abort();
     gyrocal::RecordSample sample;
     while (reader.next(sample)) out.rows.push_back(sample);

@@ -316,11 +316,11 @@ TEST(RecordMapping, ConfigurationMistakesNameTheKeyAndItsLine) {
        "rig.toml, line 2: record.main_angle_column and record.output_column both name the column 'w'"},
       {"[record]\ncounter_angle_column = \"time_s\"",
        "rig.toml, line 2: record.time_column and record.counter_angle_column both name the column 'time_s'"},
+      // A negative scale reads an inverted output (tests/test_record_rig_keys.cpp); zero reads nothing.
       {"[record]\noutput_scale_per_deg_h = 0",
-       "rig.toml, line 2: record.output_scale_per_deg_h must be > 0, not 0"},
-      {"[record]\noutput_scale_per_deg_h = -2.5", "record.output_scale_per_deg_h must be > 0, not -2.5"},
-      {"[record]\noutput_scale_per_deg_h = nan", "record.output_scale_per_deg_h must be a finite number"},
-      {"[record]\noutput_scale_per_deg_h = inf", "record.output_scale_per_deg_h must be a finite number"},
+       "rig.toml, line 2: record.output_scale_per_deg_h must be a finite non-zero number"},
+      {"[record]\noutput_scale_per_deg_h = nan", "record.output_scale_per_deg_h must be a finite"},
+      {"[record]\noutput_scale_per_deg_h = inf", "record.output_scale_per_deg_h must be a finite"},
       {"[record]\nmain_counts_per_revolution = 1",
        "rig.toml, line 2: record.main_counts_per_revolution must be 0 (the column holds angles in "
        "angle_unit) "
@@ -473,12 +473,33 @@ TEST(RecordMapping, TheCommandLineReadsAMappedRecordForNoiseAndCalibrate) {
   EXPECT_NE(refused.status, 0);
   EXPECT_NE(refused.err.find("this is not a gyrocal record"), std::string::npos) << refused.err;
 
-  const test::CliOutcome native = test::run_cli("noise " + f.native.string() + " --json -", f.dir);
-  const test::CliOutcome mapped =
+  // The simulated record spins: noise refuses it, natively and mapped, naming the motion (docs/interface.md).
+  const test::CliOutcome spinning = test::run_cli("noise " + f.native.string() + " --json -", f.dir);
+  const test::CliOutcome spinning_mapped =
       test::run_cli("noise " + f.foreign.string() + " --config " + f.config.string() + " --json -", f.dir);
+  for (const test::CliOutcome* o : {&spinning, &spinning_mapped}) {
+    EXPECT_NE(o->status, 0);
+    EXPECT_NE(o->err.find("the record is not static: the main axis turns at"), std::string::npos) << o->err;
+  }
+
+  // noise needs only the time and the output: layouts without angle columns read the output as it is, the
+  // native record's and the mapped one's alike.
+  std::ofstream(f.dir / "native_output_only.toml")
+      << "[record]\nmain_angle_column = \"\"\ncounter_angle_column = \"\"\nposition_angle_column = \"\"\n";
+  std::ofstream(f.dir / "output_only.toml")
+      << "[record]\ndelimiter = \";\"\ncomment = \"Kommentar\"\ntime_column = \"t_ms\"\ntime_unit = \"ms\"\n"
+         "main_angle_column = \"\"\ncounter_angle_column = \"\"\nposition_angle_column = \"\"\n"
+         "output_column = \"U_mV\"\noutput_scale_per_deg_h = 2.5\n";
+  const test::CliOutcome native =
+      test::run_cli("noise " + f.native.string() + " --config " +
+                        (f.dir / "native_output_only.toml").string() + " --json -",
+                    f.dir);
+  const test::CliOutcome output_only = test::run_cli(
+      "noise " + f.foreign.string() + " --config " + (f.dir / "output_only.toml").string() + " --json -",
+      f.dir);
   ASSERT_EQ(native.status, 0) << native.err;
-  ASSERT_EQ(mapped.status, 0) << mapped.err;
-  const auto a = nlohmann::json::parse(native.out), b = nlohmann::json::parse(mapped.out);
+  ASSERT_EQ(output_only.status, 0) << output_only.err;
+  const auto a = nlohmann::json::parse(native.out), b = nlohmann::json::parse(output_only.out);
   EXPECT_EQ(a["samples"], b["samples"]);
   ASSERT_EQ(a["allan"].size(), b["allan"].size());
   ASSERT_GT(a["allan"].size(), 4u);
@@ -487,17 +508,6 @@ TEST(RecordMapping, TheCommandLineReadsAMappedRecordForNoiseAndCalibrate) {
     EXPECT_NEAR(b["allan"][i]["adev"].get<double>(), a["allan"][i]["adev"].get<double>(),
                 1e-9 * a["allan"][i]["adev"].get<double>());
   }
-
-  // noise needs only the time and the output: a layout without angle columns reads the same record.
-  std::ofstream(f.dir / "output_only.toml")
-      << "[record]\ndelimiter = \";\"\ncomment = \"Kommentar\"\ntime_column = \"t_ms\"\ntime_unit = \"ms\"\n"
-         "main_angle_column = \"\"\ncounter_angle_column = \"\"\nposition_angle_column = \"\"\n"
-         "output_column = \"U_mV\"\noutput_scale_per_deg_h = 2.5\n";
-  const test::CliOutcome output_only = test::run_cli(
-      "noise " + f.foreign.string() + " --config " + (f.dir / "output_only.toml").string() + " --json -",
-      f.dir);
-  ASSERT_EQ(output_only.status, 0) << output_only.err;
-  EXPECT_EQ(nlohmann::json::parse(output_only.out), b);
   const test::CliOutcome no_angles = test::run_cli(
       "calibrate " + f.foreign.string() + " --config " + (f.dir / "output_only.toml").string(), f.dir);
   EXPECT_NE(no_angles.status, 0);

@@ -1,6 +1,7 @@
 #include "gyrocal/analysis/record_noise.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <span>
@@ -8,10 +9,20 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace gyrocal {
 namespace {
+
+/// The largest excursion of an angle column of a static record, deg: encoder jitter is a few counts (a
+/// 3600-count encoder's quantum is 0.1 deg); more is a machine that moves (docs/noise.md).
+constexpr double kStaticAngleToleranceDeg = 1.0;
+/// A flat top (or bottom): at least this many rows at exactly the extreme value, and more than
+/// kFlatExtremeRatio times as many as at the next value. A noise's tail thins out towards its extreme,
+/// quantised or not (docs/noise.md, "A flat top").
+constexpr std::size_t kFlatExtremeRowsMin = 20;
+constexpr std::size_t kFlatExtremeRatio = 4;
 
 constexpr std::size_t kIntervalSample =
     1001;  // rows whose intervals give the median before checking the rest
@@ -98,11 +109,115 @@ std::size_t count_lines(const std::filesystem::path& path) {
   return lines + 1;
 }
 
+/// The angle columns of a record given to `noise` (docs/noise.md, "Noise terms from a record"): each one
+/// present is unwrapped row to row and its excursion kept, so that a machine that turns or moves is named,
+/// not taken for a static record's noise.
+class MotionCheck {
+ public:
+  void add(const RecordSample& s) {
+    const double angles[3] = {s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg};
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (std::isnan(angles[i])) continue;  // an absent column
+      Axis& a = axes_[i];
+      if (!a.seen) {
+        a.seen = true;
+        a.first_t = s.time_s;
+      } else {
+        a.travel += wrap_deg(angles[i] - a.previous);
+        a.low = std::min(a.low, a.travel);
+        a.high = std::max(a.high, a.travel);
+      }
+      a.previous = angles[i];
+      a.last_t = s.time_s;
+    }
+  }
+
+  /// Throws Error naming the first axis whose angle moves by more than kStaticAngleToleranceDeg.
+  void check(const std::string& name) const {
+    static constexpr const char* kAxes[3] = {"main axis", "counter platform", "position platform"};
+    for (std::size_t i = 0; i < 3; ++i) {
+      const Axis& a = axes_[i];
+      const double excursion = a.high - a.low;
+      if (!a.seen || !(excursion > kStaticAngleToleranceDeg)) continue;
+      const double duration = a.last_t - a.first_t;
+      const double rate_rad_s = duration > 0.0 ? a.travel / duration * kDegToRad : 0.0;
+      // An axis that turns (a whole revolution or more) is named by its mean rate, a move by its extent.
+      const std::string motion =
+          std::abs(a.travel) >= 360.0
+              ? fmt::format(
+                    "the {} turns at {:.4g} rad/s ({:.4g} deg/s; its angle column travels {:.4g} deg "
+                    "in {:.4g} s)",
+                    kAxes[i], rate_rad_s, rate_rad_s * kRadToDeg, a.travel, duration)
+              : fmt::format("the {} moves: its angle column spans {:.4g} deg", kAxes[i], excursion);
+      throw Error(fmt::format(
+          "{}: the record is not static: {}. noise characterises the output of a machine at rest (every "
+          "angle within {} deg); a turning machine's output holds its rate and the rate's changes, which "
+          "would be fitted as noise. Characterise a static hold alone, or, to characterise the output as it "
+          "is, leave the angle columns out (record.main_angle_column = \"\" and the others, "
+          "docs/records.md).",
+          name, motion, kStaticAngleToleranceDeg));
+    }
+  }
+
+ private:
+  struct Axis {
+    bool seen = false;
+    double previous = 0.0, travel = 0.0, low = 0.0, high = 0.0, first_t = 0.0, last_t = 0.0;
+  };
+  std::array<Axis, 3> axes_{};
+};
+
+/// Refuses an output that no noise made: a constant one (a dead or disconnected sensor) or one whose top or
+/// bottom is flat (a saturated, clipped channel: many rows at exactly the extreme value), docs/noise.md.
+void check_output_is_noise(std::span<const double> rate_deg_h, const std::string& name) {
+  if (rate_deg_h.empty()) return;
+  const auto [low_it, high_it] = std::minmax_element(rate_deg_h.begin(), rate_deg_h.end());
+  const double low = *low_it, high = *high_it;
+  const std::size_t n = rate_deg_h.size();
+  if (low == high) {
+    throw Error(fmt::format(
+        "{}: the output reads {} at every one of its {} rows: a dead or disconnected sensor (or a column "
+        "that is not the output); a constant holds no noise to characterise.",
+        name, low, n));
+  }
+  // Per extreme: the rows at it, and at the nearest other value (the next level of a quantised output).
+  std::size_t at_high = 0, at_low = 0, at_next_high = 0, at_next_low = 0;
+  double next_high = low, next_low = high;
+  for (double v : rate_deg_h) {
+    if (v == high) ++at_high;
+    if (v == low) ++at_low;
+    if (v < high && v > next_high) next_high = v;
+    if (v > low && v < next_low) next_low = v;
+  }
+  for (double v : rate_deg_h) {
+    if (v == next_high) ++at_next_high;
+    if (v == next_low) ++at_next_low;
+  }
+  for (const bool top : {true, false}) {
+    const std::size_t at = top ? at_high : at_low, next = top ? at_next_high : at_next_low;
+    const double value = top ? high : low;
+    if (at < kFlatExtremeRowsMin || at <= kFlatExtremeRatio * next) continue;
+    if (2 * at >= n) {
+      throw Error(fmt::format(
+          "{}: {} of the output's {} rows read exactly {}: a dead sensor, or an output resolution coarser "
+          "than its noise; its changes are too rare to characterise a noise.",
+          name, at, n, value));
+    }
+    throw Error(fmt::format(
+        "{}: the output is clipped: {} of its {} rows ({:.3g} %) read exactly its {} {} and only {} the next "
+        "value, a flat {}: a saturated channel (its range exceeded), whose Allan deviation would be the "
+        "clipping's, not the sensor's. Record within the output's range (a lower gain, or a wider range).",
+        name, at, n, 100.0 * static_cast<double>(at) / static_cast<double>(n),
+        top ? "largest value" : "smallest value", value, next, top ? "top" : "bottom"));
+  }
+}
+
 RecordNoise characterise(std::span<const double> rate_deg_h, double interval_s, const std::string& name) {
   if (rate_deg_h.size() < 16) {
     throw Error(fmt::format("{}: noise characterisation needs at least 16 rows, the record has {}.", name,
                             rate_deg_h.size()));
   }
+  check_output_is_noise(rate_deg_h, name);
   RecordNoise result;
   result.sample_rate_hz = 1.0 / interval_s;
   result.samples = rate_deg_h.size();
@@ -130,14 +245,24 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
                                       const std::optional<RecordLayout>& layout) {
   RecordReader reader(path, layout);
   const std::string name = path.string();
+  if (reader.output_unit() != "deg/h") {
+    throw Error(fmt::format(
+        "{}: its output column is {} ({}), an accelerometer's: noise characterises a gyro's output in deg/h "
+        "(angle random walk, bias instability, rate random walk), and this gyrocal has no accelerometer's "
+        "noise terms yet.",
+        name, reader.output_column(), reader.output_unit()));
+  }
+  MotionCheck motion;
   EvenSampling sampling(name, options);
   std::vector<double> rate_deg_h;
   rate_deg_h.reserve(std::min<std::size_t>(count_lines(path), std::size_t{1} << 27));  // at most 1 GiB ahead
   RecordSample sample;
   while (reader.next(sample)) {
     sampling.add(sample.time_s);
+    motion.add(sample);
     rate_deg_h.push_back(sample.gyro_deg_h);
   }
+  motion.check(name);
   return characterise(rate_deg_h, sampling.finish(), name);
 }
 

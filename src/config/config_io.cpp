@@ -537,6 +537,15 @@ constexpr std::pair<std::string_view, std::int64_t RecordLayout::*> kRecordCount
     {"position_counts_per_revolution", &RecordLayout::position_counts_per_revolution},
 };
 
+/// The number keys of [record] (any finite value; RecordLayout::IsValid checks the scale's sign).
+constexpr std::pair<std::string_view, double RecordLayout::*> kRecordNumberKeys[] = {
+    {"output_scale_per_deg_h", &RecordLayout::output_scale_per_deg_h},
+    {"output_offset", &RecordLayout::output_offset},
+    {"main_angle_offset_deg", &RecordLayout::main_angle_offset_deg},
+    {"counter_angle_offset_deg", &RecordLayout::counter_angle_offset_deg},
+    {"position_angle_offset_deg", &RecordLayout::position_angle_offset_deg},
+};
+
 /// [record]: a rig's own record layout (docs/records.md). The layout's own check (RecordLayout::IsValid)
 /// names the key; its line is that key's.
 RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table) {
@@ -578,8 +587,21 @@ RecordLayout read_record(const Reader& reader, Section& section, const toml::tab
       layout.*member = reader.integer(*node, section.path(key), INT64_MIN, INT64_MAX);
     }
   }
-  if (const toml::node* node = section.find("output_scale_per_deg_h")) {
-    layout.output_scale_per_deg_h = reader.number(*node, section.path("output_scale_per_deg_h"), kPositive);
+  // Any finite number: the layout's check refuses a zero scale, naming the key.
+  for (const auto& [key, member] : kRecordNumberKeys) {
+    if (const toml::node* node = section.find(key))
+      layout.*member = reader.number(*node, section.path(key), kAnyValue);
+  }
+  if (const toml::node* node = section.find("skip_rows"))
+    layout.skip_rows = reader.integer(*node, section.path("skip_rows"), 0, INT64_MAX);
+  if (const toml::node* node = section.find("units_row"))
+    layout.units_row = reader.boolean(*node, section.path("units_row"));
+  if (const toml::node* node = section.find("decimal")) {
+    const std::string text = reader.string(*node, section.path("decimal"));
+    if (text != "." && text != ",")
+      reader.fail(node->source(),
+                  "record.decimal must be \".\" or \",\" (the numbers' decimal mark), not \"" + text + "\"");
+    layout.decimal = text.front();
   }
   section.reject_unknown();
   std::string error, key;
@@ -763,7 +785,17 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
   w.key("position_counts_per_revolution", std::to_string(l.position_counts_per_revolution), "likewise");
   w.key("output_column", toml_string(l.output_column), "the gyro's output");
   w.key("output_scale_per_deg_h", toml_number(l.output_scale_per_deg_h),
-        "output units per deg/h (e.g. mV per deg/h): the output is divided by it");
+        "output units per deg/h (e.g. mV per deg/h), non-zero, negative for an inverted output");
+  w.key("output_offset", toml_number(l.output_offset),
+        "what the output reads at zero rate, its own units: deg/h = (output - offset) / scale");
+  w.key("main_angle_offset_deg", toml_number(l.main_angle_offset_deg),
+        "what the main angle reads (deg) at its zero: subtracted");
+  w.key("counter_angle_offset_deg", toml_number(l.counter_angle_offset_deg), "likewise");
+  w.key("position_angle_offset_deg", toml_number(l.position_angle_offset_deg), "likewise");
+  w.key("skip_rows", std::to_string(l.skip_rows), "lines skipped as they are before the header (a preamble)");
+  w.key("units_row", l.units_row ? "true" : "false", "true: the line after the header (units) is skipped");
+  w.key("decimal", toml_string(std::string(1, l.decimal)),
+        "the numbers' decimal mark, \".\" or \",\" (then delimiter \";\")");
 }
 
 template <class S, std::size_t N>

@@ -948,6 +948,7 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
                                    const std::optional<RecordLayout>& layout) {
   require_angle_columns(layout, record_path);
   RecordReader reader(record_path, layout);
+  reader.require_angles();  // a record of the output alone, or a layout's angle column missing
   const Reduction reduction = reduce_record(reader, plan, options.reduce, model.geometry().rate_rad_s);
   const std::vector<PositionChannels> channels = reduce_model_channels(reduction, model, options.reduce);
   return identify(reduction, channels, model, options);

@@ -80,8 +80,9 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
   for (char c : comment) {
     if (is_line_break(c)) return fail("comment", "record.comment must not hold a line break");
   }
-  const auto starts_a_number = [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '+' || c == '-';
+  const auto starts_a_number = [this](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.' || c == decimal || c == '+' ||
+           c == '-';
   };
   if (!comment.empty() && (starts_a_number(comment.front()) || comment.front() == ' ' ||
                            comment.front() == '\t' || comment.front() == delimiter)) {
@@ -89,12 +90,37 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                                        "with: rows would be taken for comments",
                                        comment, printable(comment.front())));
   }
-  if (!(std::isfinite(output_scale_per_deg_h) && output_scale_per_deg_h > 0.0)) {
-    return fail("output_scale_per_deg_h",
-                fmt::format("record.output_scale_per_deg_h must be a finite number > 0 (output units per "
-                            "deg/h; the output is divided by it), not {}",
-                            output_scale_per_deg_h));
+  if (decimal != '.' && decimal != ',') {
+    return fail("decimal",
+                fmt::format("record.decimal must be \".\" or \",\" (the numbers' decimal mark), not {}",
+                            printable(decimal)));
   }
+  if (decimal == delimiter) {
+    return fail("decimal", fmt::format("record.decimal {} is also record.delimiter: a decimal comma needs "
+                                       "another delimiter, such as ';'",
+                                       printable(decimal)));
+  }
+  if (!(std::isfinite(output_scale_per_deg_h) && output_scale_per_deg_h != 0.0)) {
+    return fail(
+        "output_scale_per_deg_h",
+        fmt::format("record.output_scale_per_deg_h must be a finite non-zero number (output units per "
+                    "deg/h, negative for an inverted output; the output is divided by it), not {}",
+                    output_scale_per_deg_h));
+  }
+  const std::array<std::pair<std::string_view, double>, 4> offsets = {{
+      {"output_offset", output_offset},
+      {"main_angle_offset_deg", main_angle_offset_deg},
+      {"counter_angle_offset_deg", counter_angle_offset_deg},
+      {"position_angle_offset_deg", position_angle_offset_deg},
+  }};
+  for (const auto& [name, value] : offsets) {
+    if (!std::isfinite(value))
+      return fail(name, fmt::format("record.{} must be a finite number, not {}", name, value));
+  }
+  if (skip_rows < 0)
+    return fail("skip_rows",
+                fmt::format("record.skip_rows must be 0 or more (lines skipped before the header), not {}",
+                            skip_rows));
   const std::array<std::pair<std::string_view, std::int64_t>, 3> counts = {{
       {"main_counts_per_revolution", main_counts_per_revolution},
       {"counter_counts_per_revolution", counter_counts_per_revolution},
@@ -154,6 +180,12 @@ void require_angle_columns(const std::optional<RecordLayout>& layout, const std:
       fmt::format("Cannot calibrate from {}: {} {} empty (absent), but a calibration reads the main, "
                   "counter and position angles; name their columns in [record].",
                   record_name, empty, empty.find(',') == std::string::npos ? "is" : "are"));
+}
+
+bool RecordLayout::is_default_angle_name(std::string_view name) {
+  const RecordLayout defaults;
+  return name == defaults.main_angle_column || name == defaults.counter_angle_column ||
+         name == defaults.position_angle_column;
 }
 
 bool RecordLayout::has_angles() const {

@@ -101,8 +101,18 @@ struct RecordReader::State {
   std::uint64_t time_ticks_per_s = 1;                     ///< 1000, 1e6 or 1e9 for a time in ms, us or ns
   std::array<double, 3> angle_multiplier{1.0, 1.0, 1.0};  ///< main, counter, position: 360, 180/pi or 1
   std::array<double, 3> angle_divisor{1.0, 1.0, 1.0};     ///< counts per revolution, or 1
+  std::array<double, 3> angle_offset{0.0, 0.0, 0.0};      ///< deg, subtracted after the conversion
   std::array<bool, 3> angle_present{true, true, true};
+  double output_offset = 0.0;
   double output_divisor = 1.0;
+  fast_float::parse_options number_options{fast_float::chars_format::general, '.'};
+  char decimal = '.';
+  // gyrocal's own format with only the time and the output (time_s,gyro_deg_h or time_s,accel_g).
+  bool lone_output = false;
+  std::string output_name = std::string(kRecordColumns[4]);
+  // A layout's angle columns with a default name that the header lacks (absent), each as the sentence
+  // require_angles() refuses a calibration with.
+  std::vector<std::string> missing_angles;
 
   State(std::string name_, std::size_t chunk)
       : name(std::move(name_)), chunk_bytes(std::max<std::size_t>(chunk, 1)) {
@@ -157,7 +167,11 @@ struct RecordReader::State {
       }
       angle_present[i] = !names[i]->empty();
     }
+    angle_offset = {l.main_angle_offset_deg, l.counter_angle_offset_deg, l.position_angle_offset_deg};
+    output_offset = l.output_offset;
     output_divisor = l.output_scale_per_deg_h;
+    decimal = l.decimal;
+    number_options = fast_float::parse_options{fast_float::chars_format::general, l.decimal};
   }
 
   /// Moves the unconsumed bytes to the front and appends up to one chunk; sets at_eof at the end.
@@ -274,21 +288,31 @@ struct RecordReader::State {
     if (parses_as_number(columns.front())) {
       fail(fmt::format("the header line is missing: expected {} before the first row", header_text));
     }
-    for (std::size_t i = 0; i < kRecordColumns.size(); ++i) {
-      if (i == columns.size()) {
-        fail(fmt::format("the header must begin with {}, but it has only {} columns", header_text,
-                         columns.size()));
-      }
-      if (columns[i] != kRecordColumns[i]) {
-        fail(fmt::format("the header must begin with {}, but column {} is {}", header_text, i + 1,
-                         quote(columns[i])));
+    // A record of the output alone (a noise logger's): time_s and the output, no angles (docs/records.md).
+    lone_output = columns.size() >= 2 && columns[0] == kRecordColumns[0] &&
+                  std::find(kLoneOutputColumns.begin(), kLoneOutputColumns.end(), columns[1]) !=
+                      kLoneOutputColumns.end();
+    const std::size_t required = lone_output ? 2 : kRecordColumns.size();
+    if (lone_output) {
+      output_name = columns[1];
+    } else {
+      for (std::size_t i = 0; i < kRecordColumns.size(); ++i) {
+        const std::string_view alone = " (a record of the output alone: time_s,gyro_deg_h)";
+        if (i == columns.size()) {
+          fail(fmt::format("the header must begin with {}, but it has only {} column{}{}", header_text,
+                           columns.size(), columns.size() == 1 ? "" : "s", alone));
+        }
+        if (columns[i] != kRecordColumns[i]) {
+          fail(fmt::format("the header must begin with {}, but column {} is {}{}", header_text, i + 1,
+                           quote(columns[i]), alone));
+        }
       }
     }
-    if (columns.size() > kColumnCountMax) {
-      fail(fmt::format("the header has {} extra columns; at most {} are supported",
-                       columns.size() - kRecordColumns.size(), kMaxExtraColumns));
+    if (columns.size() > required + kMaxExtraColumns) {
+      fail(fmt::format("the header has {} extra columns; at most {} are supported", columns.size() - required,
+                       kMaxExtraColumns));
     }
-    for (std::size_t i = kRecordColumns.size(); i < columns.size(); ++i) {
+    for (std::size_t i = required; i < columns.size(); ++i) {
       if (columns[i].empty()) fail(fmt::format("column {} of the header has no name", i + 1));
       if (std::find(columns.begin(), columns.begin() + static_cast<std::ptrdiff_t>(i), columns[i]) !=
           columns.begin() + static_cast<std::ptrdiff_t>(i)) {
@@ -297,6 +321,11 @@ struct RecordReader::State {
     }
     slot.resize(columns.size());
     for (std::size_t i = 0; i < columns.size(); ++i) slot[i] = static_cast<int>(i);
+    if (lone_output) {
+      // The output into slot 4 and the extra columns after it, as in the full format.
+      slot[1] = 4;
+      for (std::size_t i = 2; i < columns.size(); ++i) slot[i] = static_cast<int>(i + 3);
+    }
   }
 
   /// The layout's column keys and names, in slot order (time, main, counter, position, output).
@@ -313,7 +342,13 @@ struct RecordReader::State {
   void read_mapped_head() {
     std::string_view text;
     const std::string& comment = layout->comment;
-    for (bool first = true;; first = false) {
+    for (std::int64_t i = 0; i < layout->skip_rows; ++i) {
+      if (!next_line(text)) {
+        fail(fmt::format("the record ends within the {} lines record.skip_rows skips before the header",
+                         layout->skip_rows));
+      }
+    }
+    for (bool first = layout->skip_rows == 0;; first = false) {
       if (!next_line(text)) {
         if (first) throw Error(fmt::format("{} is empty; a record has a header line and rows.", name));
         fail("the record ends without a header line naming its columns");
@@ -325,6 +360,9 @@ struct RecordReader::State {
       add_metadata(text.substr(comment.size()));
     }
     read_mapped_header(text);
+    if (layout->units_row && !next_line(text)) {
+      fail("the record ends after its header, where record.units_row = true expects a line of units");
+    }
   }
 
   /// The header's names split at the delimiter, each trimmed of spaces and of surrounding double quotes.
@@ -400,10 +438,18 @@ struct RecordReader::State {
         index = i;
       }
       if (index == columns.size()) {
-        fail(
-            fmt::format("record.{} = '{}' is not a column of the header line {} (split at record.delimiter "
-                        "{}, the columns found are {})",
-                        key, printable(wanted), header, delimiter_text(), found));
+        const std::string problem = fmt::format(
+            "record.{} = '{}' is not a column of the header line {} (split at record.delimiter "
+            "{}, the columns found are {})",
+            key, printable(wanted), header, delimiter_text(), found);
+        // An angle column left at its default name may be missing: it is absent (a noise logger's record);
+        // a calibration then refuses the record with this sentence (require_angles).
+        if (s >= 1 && s <= 3 && RecordLayout::is_default_angle_name(wanted)) {
+          missing_angles.push_back(fmt::format("{}, line {}: {}.", name, line, problem));
+          angle_present[s - 1] = false;
+          continue;
+        }
+        fail(problem);
       }
       slot[index] = static_cast<int>(s);
     }
@@ -469,13 +515,13 @@ struct RecordReader::State {
     }
     const bool integer =
         q != digits &&
-        (q == last || (static_cast<unsigned>(*q - '0') >= 10 && *q != '.' && *q != 'e' && *q != 'E'));
+        (q == last || (static_cast<unsigned>(*q - '0') >= 10 && *q != decimal && *q != 'e' && *q != 'E'));
     if (integer) {
       const double magnitude = nearest_seconds(ticks, time_ticks_per_s);
       seconds = negative ? -magnitude : magnitude;
       return {q, std::errc()};
     }
-    const auto result = fast_float::from_chars(p, last, seconds);
+    const auto result = fast_float::from_chars_advanced(p, last, seconds, number_options);
     seconds /= static_cast<double>(time_ticks_per_s);
     return result;
   }
@@ -508,8 +554,9 @@ struct RecordReader::State {
           p = at == nullptr ? last : static_cast<const char*>(at);
         }
       } else {
-        const auto result = s == 0 && time_ticks_per_s != 1 ? parse_ticks(p, last, values[0])
-                                                            : fast_float::from_chars(p, last, values[s]);
+        const auto result = s == 0 && time_ticks_per_s != 1
+                                ? parse_ticks(p, last, values[0])
+                                : fast_float::from_chars_advanced(p, last, values[s], number_options);
         p = result.ptr;
         const char* const number_end = p;
         while (p != last && blank(*p)) ++p;
@@ -610,7 +657,29 @@ const std::vector<std::string>& RecordReader::columns() const {
   return state_->columns;
 }
 std::size_t RecordReader::extra_column_count() const {
-  return state_->layout ? 0 : state_->columns.size() - kRecordColumns.size();
+  if (state_->layout) return 0;
+  return state_->columns.size() - (state_->lone_output ? 2 : kRecordColumns.size());
+}
+bool RecordReader::has_angles() const {
+  if (!state_->layout) return !state_->lone_output;
+  return state_->angle_present[0] && state_->angle_present[1] && state_->angle_present[2];
+}
+const std::string& RecordReader::output_column() const {
+  return state_->layout ? state_->layout->output_column : state_->output_name;
+}
+std::string_view RecordReader::output_unit() const {
+  return !state_->layout && state_->output_name == kLoneOutputColumns[1] ? "g" : "deg/h";
+}
+void RecordReader::require_angles() const {
+  if (has_angles()) return;
+  if (!state_->layout) {
+    throw Error(
+        fmt::format("Cannot calibrate from {}: its header is time_s,{} (the output alone), but a "
+                    "calibration reads the main, counter and position angles ({}).",
+                    state_->name, state_->output_name, fmt::join(kRecordColumns, ",")));
+  }
+  require_angle_columns(state_->layout, state_->name);
+  if (!state_->missing_angles.empty()) throw Error(state_->missing_angles.front());
 }
 const std::string& RecordReader::name() const {
   return state_->name;
@@ -631,6 +700,13 @@ bool RecordReader::next(RecordSample& sample) {
   } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
   sample.time_s = values[0];
   if (!s.layout) {
+    if (s.lone_output) {
+      constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+      sample.main_angle_deg = sample.counter_angle_deg = sample.position_angle_deg = kNaN;
+      sample.gyro_deg_h = values[4];
+      std::copy(values + kRecordColumns.size(), values + s.columns.size() + 3, sample.extra.begin());
+      return true;
+    }
     sample.main_angle_deg = values[1];
     sample.counter_angle_deg = values[2];
     sample.position_angle_deg = values[3];
@@ -641,10 +717,11 @@ bool RecordReader::next(RecordSample& sample) {
   // A layout's units into deg and deg/h (docs/records.md); an absent angle column reads as NaN.
   double* const angles[3] = {&sample.main_angle_deg, &sample.counter_angle_deg, &sample.position_angle_deg};
   for (std::size_t i = 0; i < 3; ++i) {
-    *angles[i] = s.angle_present[i] ? values[i + 1] * s.angle_multiplier[i] / s.angle_divisor[i]
-                                    : std::numeric_limits<double>::quiet_NaN();
+    *angles[i] = s.angle_present[i]
+                     ? values[i + 1] * s.angle_multiplier[i] / s.angle_divisor[i] - s.angle_offset[i]
+                     : std::numeric_limits<double>::quiet_NaN();
   }
-  sample.gyro_deg_h = values[4] / s.output_divisor;
+  sample.gyro_deg_h = (values[4] - s.output_offset) / s.output_divisor;
   return true;
 }
 

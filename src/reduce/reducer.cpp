@@ -12,6 +12,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
+#include "gyrocal/reduce/record_summary.hpp"
 
 namespace gyrocal {
 namespace {
@@ -297,6 +298,14 @@ struct Reducer::State {
   std::vector<std::string> warnings;
   double worst_rate_offset = 0.0;
   int offset_dwells = 0;
+  double last_run_start_s = -std::numeric_limits<double>::infinity();
+  // take(): rows handed back while a row is being taken, and those waiting their turn.
+  bool taking = false;
+  std::vector<Row> handed_back;
+  std::deque<Row> pending;
+  // What the record holds, for the refusal of a record without a dwell for a planned position.
+  RecordSummary summary;
+  std::optional<RecordLayout> layout;
 
   double hold_duration() const { return plan.revolutions * 2.0 * kPi / std::abs(reference_rate); }
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
@@ -350,6 +359,11 @@ struct Reducer::State {
         break;
       --first;
     }
+    // A run starts after the start of the one before: a run that ended before accepting a row hands its
+    // first row back, and would otherwise start there again, and again (found with encoder counts read as
+    // degrees).
+    while (first != window.end() && first->t <= last_run_start_s) ++first;
+    if (std::distance(first, window.end()) < 8) return;
     start_run(*first, th, ps, beta);
     std::vector<Row> rows_of_run(first, window.end());
     window.clear();
@@ -391,6 +405,29 @@ struct Reducer::State {
   }
 
   void take(const Row& raw) {
+    // Rows handed back while a row is taken (a new run's rows replayed from its start, the rows an ended run
+    // held) are taken after it, in order, not by recursion: a record whose runs start and end every few rows
+    // (encoder counts read as degrees) nested the calls thousands deep and overflowed the stack.
+    if (taking) {
+      handed_back.push_back(raw);
+      return;
+    }
+    taking = true;
+    take_one(raw);
+    for (;;) {
+      if (!handed_back.empty()) {
+        pending.insert(pending.begin(), handed_back.begin(), handed_back.end());
+        handed_back.clear();
+      }
+      if (pending.empty()) break;
+      const Row q = pending.front();
+      pending.pop_front();
+      take_one(q);
+    }
+    taking = false;
+  }
+
+  void take_one(const Row& raw) {
     if (run)
       follow(raw);
     else
@@ -398,6 +435,7 @@ struct Reducer::State {
   }
 
   void start_run(const Row& first, const Line& th, const Line& ps, double beta) {
+    last_run_start_s = first.t;
     Run r;
     r.start_s = r.end_s = first.t;
     r.last_t_record = r.prev_row_t = r.t_prev = first.t - dt_planned;
@@ -658,6 +696,7 @@ struct Reducer::State {
     x.start_s = r.start_s;
     x.end_s = r.end_s;
     x.main_rate_rad_s = r.rate_theta * kDegToRad;
+    x.counter_rate_rad_s = r.rate_psi * kDegToRad;
     x.beta_deg = r.beta_deg;
     x.gamma_deg = r.gamma_deg;
     x.is_static = std::abs(r.rate_theta) * kDegToRad < options.static_rate_tolerance_rad_s &&
@@ -914,12 +953,17 @@ Reducer::Reducer(const PlannedTest& plan, const ReduceOptions& options, std::str
 
 Reducer::~Reducer() = default;
 
+void Reducer::set_record_layout(const std::optional<RecordLayout>& layout) {
+  state_->layout = layout;
+}
+
 void Reducer::push(const RecordSample& s) {
   State& st = *state_;
   if (st.rows > 0 && !(s.time_s > st.t_last))
     throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
   ++st.rows;
   st.t_last = s.time_s;
+  st.summary.add(s);
   st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.gyro_deg_h});
 }
 
@@ -990,8 +1034,9 @@ Reduction Reducer::finish() {
     std::string list;
     for (std::size_t i = 0; i < missing.size() && i < 4; ++i) list += (i ? "; " : "") + missing[i];
     if (missing.size() > 4) list += fmt::format("; and {} more", missing.size() - 4);
-    throw Error(fmt::format("{}: the record has no usable dwell for {} planned position{}: {}.", st.source,
-                            missing.size(), missing.size() > 1 ? "s" : "", list));
+    throw Error(fmt::format("{}: the record has no usable dwell for {} planned position{}: {}. {}", st.source,
+                            missing.size(), missing.size() > 1 ? "s" : "", list,
+                            st.summary.describe(st.plan, st.layout, st.rejected, st.dwells.size())));
   }
   // A standard error is the scatter between revolutions (or batches) about a line: without a degree of
   // freedom left there is no measurement of the noise, and no number may stand in for one
@@ -1050,6 +1095,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s) {
   Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
+  reducer.set_record_layout(reader.layout());
   RecordSample s;
   while (reader.next(s)) reducer.push(s);
   return reducer.finish();

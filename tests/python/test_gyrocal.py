@@ -273,10 +273,33 @@ output_scale_per_deg_h = 4.0
     for name, c in native["coefficients"].items():
         if c["identifiable"]:
             assert abs(expected["coefficients"][name]["value"] - c["value"]) <= 1e-6 * c["std"], name
-    expected_noise = json.loads(run_cli("noise", record, "--config", mapped_config, "--json", "-").stdout)
-    assert gyrocal.noise(str(record), sc) == expected_noise
+    # noise refuses a record whose angles turn, naming the motion (docs/interface.md), in Python as on the command
+    # line; a [record] naming only the time and the output (the angle columns absent) reads its output as it is.
+    with pytest.raises(ValueError, match="the record is not static: the main axis turns at "):
+        gyrocal.noise(str(record), sc)
+    output_only = tmp_path / "output_only.toml"
+    output_only.write_text('[record]\ndelimiter = ";"\ntime_column = "t_ms"\ntime_unit = "ms"\n'
+                           'output_column = "U_mV"\noutput_scale_per_deg_h = 4.0\n')
+    expected_noise = json.loads(run_cli("noise", record, "--config", output_only, "--json", "-").stdout)
+    assert gyrocal.noise(str(record), gyrocal.Scenario.load(str(output_only))) == expected_noise
     with pytest.raises(ValueError, match="this is not a gyrocal record"):
         gyrocal.noise(str(record))
+
+
+def test_noise_of_a_record_of_the_output_alone_equals_the_full_records(tmp_path):
+    """gyrocal's own header time_s,gyro_deg_h (a noise logger's record) gives the full record's Allan deviation."""
+    rng = np.random.default_rng(6)
+    n = 2000
+    time_s = np.arange(n) / 50.0
+    rate = 9.5 + rng.normal(0.0, 2.0, n)
+    full = tmp_path / "full.csv"
+    write_record_csv(full, {"time_s": time_s, "main_angle_deg": np.zeros(n), "counter_angle_deg": np.zeros(n),
+                            "position_angle_deg": np.full(n, 90.0), "gyro_deg_h": rate})
+    alone = tmp_path / "alone.csv"
+    write_record_csv(alone, {"time_s": time_s, "gyro_deg_h": rate})
+    from_full, from_alone = gyrocal.noise(str(full)), gyrocal.noise(str(alone))
+    assert from_alone["allan"] == from_full["allan"]
+    assert from_alone == json.loads(run_cli("noise", alone, "--json", "-").stdout)
 
 
 # --- errors -----------------------------------------------------------------------------------------------------

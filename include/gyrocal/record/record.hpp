@@ -6,6 +6,8 @@
 //   # key = value                      metadata, any number, in order; only before the header
 //   time_s,main_angle_deg,counter_angle_deg,position_angle_deg,gyro_deg_h[,extra...]
 //   0,0,0,0,1.25                       one row per sample; numbers in decimal or e-notation
+// or, for a record of the output alone (a noise logger's; no angles, enough for `noise`):
+//   time_s,gyro_deg_h[,extra...]       or time_s,accel_g[,extra...] (an accelerometer's output, g)
 // Reader decisions:
 // - LF or CRLF line endings. Spaces or tabs around a field or a name are ignored.
 // - A blank line (empty or only spaces) is ignored anywhere.
@@ -43,6 +45,9 @@ inline constexpr std::string_view kRecordMagic = "# gyrocal-record 1";
 /// The required columns, in order.
 inline constexpr std::array<std::string_view, 5> kRecordColumns = {
     "time_s", "main_angle_deg", "counter_angle_deg", "position_angle_deg", "gyro_deg_h"};
+/// The output columns a record of the output alone may hold after time_s: a gyro's (deg/h) or an
+/// accelerometer's (g). Its angles read as NaN.
+inline constexpr std::array<std::string_view, 2> kLoneOutputColumns = {"gyro_deg_h", "accel_g"};
 /// Most extra columns a record may carry after the required ones.
 inline constexpr std::size_t kMaxExtraColumns = 8;
 
@@ -50,14 +55,16 @@ inline constexpr std::size_t kMaxExtraColumns = 8;
 using RecordMetadata = std::vector<std::pair<std::string, std::string>>;
 
 /// One row of a record, in gyrocal's units whatever the record's layout. A column that the layout leaves
-/// absent (an angle column named "") reads as NaN.
+/// absent (an angle column named "", or left at its default name and missing from the header), or that a
+/// record of the output alone lacks, reads as NaN.
 struct RecordSample {
   double time_s = 0.0;              ///< time since the start of the test, s
   double main_angle_deg = 0.0;      ///< main axis encoder θ, deg (wrapped or unwrapped)
   double counter_angle_deg = 0.0;   ///< counter-rotating platform ψr relative to the arm, deg
   double position_angle_deg = 0.0;  ///< position platform β, deg
-  double gyro_deg_h = 0.0;          ///< gyro output, deg/h
-  /// Values of the extra columns, in header order; only the first (column count - 5) are meaningful.
+  double gyro_deg_h = 0.0;          ///< gyro output, deg/h (in g for a record whose output column is accel_g)
+  /// Values of the extra columns, in header order; only the first RecordReader::extra_column_count() are
+  /// meaningful.
   std::array<double, kMaxExtraColumns> extra{};
 };
 
@@ -137,9 +144,20 @@ class RecordReader {
   /// All column names of the header: in gyrocal's own format the five of kRecordColumns, then the extra
   /// ones; through a layout, the header's names in order.
   const std::vector<std::string>& columns() const;
-  /// The number of extra columns (columns().size() - 5) of gyrocal's own format; 0 through a layout (its
-  /// other columns are skipped, RecordSample::extra is not filled).
+  /// The number of extra columns (after the five required ones, or the two of a record of the output alone)
+  /// of gyrocal's own format; 0 through a layout (its other columns are skipped, RecordSample::extra is not
+  /// filled).
   std::size_t extra_column_count() const;
+  /// True when the record holds all three angles (false: a record of the output alone, or a layout whose
+  /// angle columns are absent).
+  bool has_angles() const;
+  /// Throws gyrocal::Error, naming the record (and the [record] key, the header and the columns found), when
+  /// it lacks an angle column: what a calibration calls before reducing it.
+  void require_angles() const;
+  /// The name of the output column ("gyro_deg_h", "accel_g", or the layout's output_column).
+  const std::string& output_column() const;
+  /// The unit of RecordSample::gyro_deg_h: "g" for gyrocal's own format with an accel_g column, else "deg/h".
+  std::string_view output_unit() const;
   /// The layout read through, or nullopt for gyrocal's own format.
   const std::optional<RecordLayout>& layout() const;
   /// The file name used in messages.

@@ -49,14 +49,35 @@ struct RecordLayout {
   std::int64_t position_counts_per_revolution = 0;
   /// The gyro's output column; required. Default "gyro_deg_h".
   std::string output_column = "gyro_deg_h";
-  /// Output units per deg/h (e.g. mV per deg/h): the output is divided by it. Finite and > 0; default 1.
+  /// Output units per deg/h (e.g. mV per deg/h): the output, less output_offset, is divided by it. Finite and
+  /// non-zero; negative for an output whose sign is the opposite of gyrocal's (a cable or a convention).
+  /// Default 1.
   double output_scale_per_deg_h = 1.0;
+  /// What the output column reads at zero rate, in the column's own units (e.g. mV): subtracted before the
+  /// scale, deg/h = (value - output_offset) / output_scale_per_deg_h. Finite; default 0.
+  double output_offset = 0.0;
+  /// What each angle column reads, in deg after its unit's conversion, when its angle is zero (an encoder's
+  /// zero off the machine's): subtracted from every reading. Finite; default 0.
+  double main_angle_offset_deg = 0.0;
+  double counter_angle_offset_deg = 0.0;
+  double position_angle_offset_deg = 0.0;
+  /// Lines skipped as they are, before anything else is read (an uncommented preamble); >= 0, default 0.
+  std::int64_t skip_rows = 0;
+  /// True when the line after the header holds the columns' units (e.g. "s;mV;counts"): it is skipped.
+  bool units_row = false;
+  /// The decimal mark of the numbers: '.' (default) or ',' (then the delimiter must be another character,
+  /// typically ';').
+  char decimal = '.';
 
   /// True when the layout can be read. Otherwise false, with `error` set (when not null) to one sentence
   /// naming the key as `record.<key>` (without a final period), and `key` (when not null) to that key.
   bool IsValid(std::string* error, std::string* key = nullptr) const;
   /// True when all three angle columns are named (what a calibration needs).
   bool has_angles() const;
+  /// True when `name` is the default name of an angle column ("main_angle_deg", …): such a column may be
+  /// missing from a header and is then absent (a noise logger's record through a [record] naming only the
+  /// time and the output; docs/records.md).
+  static bool is_default_angle_name(std::string_view name);
 
   friend bool operator==(const RecordLayout&, const RecordLayout&) = default;
 };

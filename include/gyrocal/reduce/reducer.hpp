@@ -84,6 +84,7 @@ struct Dwell {
 struct RejectedRun {
   double start_s = 0.0, end_s = 0.0;  ///< record time
   double main_rate_rad_s = 0.0;       ///< measured
+  double counter_rate_rad_s = 0.0;    ///< measured (psi_r relative to the arm)
   double beta_deg = 0.0, gamma_deg = 0.0;
   bool is_static = false;
   std::string reason;
@@ -157,6 +158,9 @@ class Reducer {
   Reducer& operator=(const Reducer&) = delete;
 
   void push(const RecordSample& sample);
+  /// The layout the record was read through (nullopt: gyrocal's own format), for the message of finish()
+  /// only: it names the [record] key a unit mistake points to.
+  void set_record_layout(const std::optional<RecordLayout>& layout);
   /// Match the dwells to the plan; an error if a planned position has no dwell.
   Reduction finish();
 
