@@ -623,7 +623,8 @@ void sensitivity(const json& result, Page& page, std::string& out) {
 /// it is part of (or `m` itself), for the estimates' units.
 void montecarlo_run(const json& m, const json& result, Page& page, std::string& out) {
   expect(m, json::value_t::object, "montecarlo");
-  if (const auto trials = number(m, "trials", "montecarlo"))
+  // A run on its own page says its trials in its settings (montecarlo_settings).
+  if (const auto trials = number(m, "trials", "montecarlo"); trials && &m != &result)
     out += fmt::format("<p>{} trials.</p>\n", esc(num(trials, 12)));
   if (const json* c = find(m, "coefficients")) {
     expect(*c, json::value_t::object, "montecarlo.coefficients");
@@ -668,8 +669,8 @@ void montecarlo_run(const json& m, const json& result, Page& page, std::string& 
       grid += page.plot(chart.to_json(), 220, "histogram of " + name + " over the Monte Carlo trials",
                         "plot cell");
     }
-    out += table({"estimate", "mean", "standard deviation", "predicted std",
-                  "z std (error / stated \xCF\x83)", "unit"},
+    out += table({"estimate", "mean error (estimate \xE2\x88\x92 truth)", "standard deviation of the error",
+                  "predicted std", "z std (error / stated \xCF\x83)", "unit"},
                  rows, "compact");
     out += not_identifiable_notes(find(m, "not_identifiable"), "montecarlo.not_identifiable");
     if (!grid.empty()) out += "<h3>Distributions</h3>\n<div class=\"grid\">\n" + grid + "</div>\n";
