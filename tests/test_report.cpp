@@ -292,9 +292,11 @@ TEST(Report, DataQualityShowsCountsAndEveryFieldOfTheDwells) {
   EXPECT_NE(
       html.find("<th>index</th><th>reason</th><th>at_<wbr>s</th><th>limit</th><th>rows_<wbr>dropped</th>"),
       std::string::npos);
-  EXPECT_NE(html.find("<td class=\"sentence\">gap of 0.5 s &lt;inside&gt;</td><td>12.5, 13</td><td>\xE2\x80\x94</td>"
-                      "<td class=\"num\">5000</td>"),
-            std::string::npos);
+  EXPECT_NE(
+      html.find(
+          "<td class=\"sentence\">gap of 0.5 s &lt;inside&gt;</td><td>12.5, 13</td><td>\xE2\x80\x94</td>"
+          "<td class=\"num\">5000</td>"),
+      std::string::npos);
   EXPECT_NE(html.find("<td>sigma: 6</td>"), std::string::npos);
 
   const json bad = {{"data_quality", {{"rows_read", 10}, {"dwells", json::array({1, 2})}}}};
