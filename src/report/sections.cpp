@@ -36,6 +36,14 @@ std::string sensitivity_row_label(const json& row, std::string_view where) {
   return label;
 }
 
+/// A sensitivity row's magnitude with its unit, "(typical)" where the configuration had zero and the study
+/// used a typical magnitude (`typical`).
+std::string sensitivity_magnitude(const json& row, std::string_view where) {
+  const json* typical = find(row, "typical");
+  return fmt::format("{} {}{}", num(number(row, "value", where)), string_or(row, "unit"),
+                     typical && typical->is_boolean() && typical->get<bool>() ? " (typical)" : "");
+}
+
 /// The unit of an estimate: the study's own `units` {name: unit}, else the result's coefficients'.
 std::string estimate_unit(const json& s, const json& result, const std::string& name) {
   if (const json* units = find(s, "units"); units && units->is_object())
@@ -444,9 +452,7 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const json& row = rows_j[k];
     const std::string where = fmt::format("sensitivity.rows[{}].least_squares", k);
-    std::vector<Cell> cells = {
-        text_cell(row_labels[k]),
-        num_cell(fmt::format("{} {}", num(number(row, "value", where)), string_or(row, "unit")))};
+    std::vector<Cell> cells = {text_cell(row_labels[k]), num_cell(sensitivity_magnitude(row, where))};
     const json* ls = find(row, "least_squares");
     for (const auto& name : names) {
       // Zero where no sigma is given: then no cell is shaded.
@@ -552,8 +558,7 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const std::string where = fmt::format("sensitivity.rows[{}]", k);
     significant_rows[k].push_back(text_cell(row_labels[k]));
-    significant_rows[k].push_back(
-        num_cell(fmt::format("{} {}", num(number(rows_j[k], "value", where)), string_or(rows_j[k], "unit"))));
+    significant_rows[k].push_back(num_cell(sensitivity_magnitude(rows_j[k], where)));
   }
   for (const auto& comp : ordered_comp) {
     json colours = json::array(), tips = json::array();
@@ -1045,9 +1050,8 @@ void sensitivity_least_squares(const json& s, Page&, std::string& out) {
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const json& row = rows_j[k];
     const std::string where = fmt::format("rows[{}]", k);
-    std::vector<Cell> cells = {
-        text_cell(sensitivity_row_label(row, where)),
-        num_cell(fmt::format("{} {}", num(number(row, "value", where)), string_or(row, "unit")))};
+    std::vector<Cell> cells = {text_cell(sensitivity_row_label(row, where)),
+                               num_cell(sensitivity_magnitude(row, where))};
     const json* m = find(row, "least_squares_matters");
     for (const auto& comp : ordered_comp) {
       const json* names = m ? find(*m, comp) : nullptr;
