@@ -5,7 +5,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -305,6 +307,127 @@ TEST_F(Cli, SensitivityAndMonteCarloTakeTheGyroModelAndWriteTheRateErrors) {
   EXPECT_NE(closed.status, 0);
   EXPECT_NE(closed.err.find("closed forms identify the ten drift coefficients only"), std::string::npos)
       << closed.err;
+}
+
+// ---- Issue 20: files and messages a user can trust -----------------------------------------------------
+
+// Item 1: --json follows the rule of --html and --out: an existing file is replaced only with --force, or
+// when it is an earlier result of gyrocal (a JSON object with gyrocal's marker).
+TEST_F(Cli, JsonReplacesOnlyAnEarlierResultOfGyrocalWithoutForce) {
+  write("c.toml", short_test_toml());
+  const std::string cfg = " --config " + path("c.toml").string();
+  ASSERT_EQ(run("simulate --out " + path("r.csv").string() + cfg).status, 0);
+  const std::string record = slurp(path("r.csv")), toml = slurp(path("c.toml"));
+  const std::vector<std::pair<std::string, std::string>> commands = {
+      {"calibrate " + path("r.csv").string() + cfg, "calibration"},
+      {"plan" + cfg, "plan"},
+      {"inputs --beta-deg 90 --time-s 1" + cfg, "inputs"},
+      {"sensitivity" + cfg, "sensitivity"},
+      {"montecarlo --trials 100" + cfg, "montecarlo"},
+  };
+  // A copy of the rig record, another configuration, and a JSON file that gyrocal did not write.
+  const std::vector<std::pair<std::string, std::string>> precious = {
+      {"rigcopy.txt", record}, {"other.toml", toml}, {"notes.json", "{\"mine\": [1, 2]}\n"}};
+  for (const auto& [command, kind] : commands) {
+    for (const auto& [name, text] : precious) {
+      write(name, text);
+      const Outcome refused = run(command + " --json " + path(name).string());
+      EXPECT_EQ(refused.status, 1) << command << " --json " << name;
+      EXPECT_NE(refused.err.find(path(name).string()), std::string::npos) << refused.err;
+      EXPECT_NE(refused.err.find("not an earlier gyrocal result"), std::string::npos) << refused.err;
+      EXPECT_NE(refused.err.find("--force"), std::string::npos) << refused.err;
+      EXPECT_EQ(slurp(path(name)), text) << command << " --json " << name;
+    }
+    // A new file gets gyrocal's marker; an earlier result is replaced without --force.
+    fs::remove(path("out.json"));
+    const Outcome first = run(command + " --json " + path("out.json").string());
+    ASSERT_EQ(first.status, 0) << command << ": " << first.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(path("out.json")));
+    EXPECT_EQ(j["gyrocal"]["result"], kind) << command;
+    EXPECT_TRUE(j["gyrocal"]["version"].is_string()) << command;
+    const Outcome again = run(command + " --json " + path("out.json").string());
+    EXPECT_EQ(again.status, 0) << command << ": " << again.err;
+    // Any file with --force.
+    const Outcome forced = run(command + " --force --json " + path("notes.json").string());
+    EXPECT_EQ(forced.status, 0) << command << ": " << forced.err;
+    EXPECT_EQ(nlohmann::json::parse(slurp(path("notes.json")))["gyrocal"]["result"], kind) << command;
+  }
+  // The result of one command is an earlier result for another (results are re-creatable).
+  EXPECT_EQ(run("plan" + cfg + " --json " + path("out.json").string()).status, 0);
+  // The calibration names where it came from (item 8): the record, the configuration and the plan.
+  ASSERT_EQ(run(commands[0].first + " --json " + path("out.json").string()).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(path("out.json")));
+  EXPECT_EQ(j["record"], path("r.csv").string());
+  EXPECT_EQ(j["config"], path("c.toml").string());
+  EXPECT_EQ(j["plan"]["revolutions"], 12);
+  EXPECT_TRUE(others({"c.toml", "r.csv", "out.json", "rigcopy.txt", "other.toml", "notes.json"}).empty());
+}
+
+// Item 10: `inputs` prints no negative zero.
+TEST_F(Cli, InputsPrintsNoNegativeZero) {
+  for (const std::string instant : {"--time-s 0", "--gamma-deg 0", "--gamma-deg 360"}) {
+    const Outcome o = run("inputs --beta-deg 0 " + instant);
+    ASSERT_EQ(o.status, 0) << o.err;
+    EXPECT_EQ(o.out.find(" -0 "), std::string::npos) << instant << "\n" << o.out;
+    EXPECT_NE(o.out.find("gamma"), std::string::npos);
+  }
+}
+
+// Item 10: the sensitivity table fits a terminal: full names, values apart, every harmonic row with its
+// phase.
+TEST_F(Cli, SensitivityTableFitsATerminalAndNamesEveryRow) {
+  write("c.toml", short_test_toml());
+  const Outcome o = run("sensitivity --config " + path("c.toml").string());
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::istringstream lines(o.out);
+  std::string line;
+  std::map<std::string, int> wobble_rows;
+  std::size_t widest = 0;
+  bool in_first_block = false;
+  while (std::getline(lines, line)) {
+    widest = std::max(widest, line.size());
+    if (line.rfind("closed forms, compensation none", 0) == 0) in_first_block = true;
+    if (line.rfind("closed forms, compensation seed", 0) == 0) in_first_block = false;
+    // Rows of one harmonic differ by their phase.
+    if (in_first_block && line.rfind("counter_wobble_x h2", 0) == 0)
+      ++wobble_rows[line.substr(0, line.find("  "))];
+  }
+  EXPECT_LE(widest, 118u) << o.out;
+  EXPECT_NE(o.out.find("dF+(1+Ar^2)dSS"), std::string::npos) << o.out;
+  ASSERT_GE(wobble_rows.size(), 2u) << o.out;
+  for (const auto& [label, n] : wobble_rows) EXPECT_EQ(n, 1) << label;
+  // Numbers never run together: every shift is "name value", separated by ", ".
+  const std::regex glued("[0-9]-[0-9]");
+  EXPECT_FALSE(std::regex_search(o.out, glued)) << o.out;
+}
+
+// Item 10: --compensation seed and the seed paper's study are explained, and told apart from --seed.
+TEST_F(Cli, HelpExplainsTheSeedCompensationAndTheSeedOption) {
+  for (const std::string sub : {"calibrate", "plan", "montecarlo"}) {
+    const Outcome h = run(sub + " --help");
+    EXPECT_EQ(h.status, 0) << sub;
+    EXPECT_NE(h.out.find("seed paper"), std::string::npos) << sub << h.out;
+    EXPECT_NE(h.out.find("nothing to do with --seed"), std::string::npos) << sub << h.out;
+  }
+  const Outcome top = run("--help");
+  EXPECT_NE(top.out.find("seed paper's error study"), std::string::npos) << top.out;
+  const Outcome mc = run("montecarlo --help");
+  EXPECT_NE(mc.out.find("not --compensation seed"), std::string::npos) << mc.out;
+}
+
+// Item 10: long work says how far it is when standard error is not a terminal (a log): a line per step.
+TEST_F(Cli, ProgressIsALinePerStepWhenStandardErrorIsNotATerminal) {
+  write("c.toml", short_test_toml());
+  ::setenv("GYROCAL_PROGRESS_AFTER_S", "0", 1);
+  const Outcome sens = run("sensitivity --config " + path("c.toml").string());
+  const Outcome mc = run("montecarlo --trials 20000 --config " + path("c.toml").string());
+  ::unsetenv("GYROCAL_PROGRESS_AFTER_S");
+  for (const auto& [o, label] : {std::pair{&sens, "sensitivity"}, std::pair{&mc, "Monte Carlo"}}) {
+    ASSERT_EQ(o->status, 0) << o->err;
+    EXPECT_NE(o->err.find(std::string(label) + ": 100 % after"), std::string::npos) << o->err;
+    EXPECT_EQ(o->err.find('\r'), std::string::npos) << "no bar redrawn in a log";
+    EXPECT_GE(std::count(o->err.begin(), o->err.end(), '\n'), 2) << o->err;
+  }
 }
 
 }  // namespace

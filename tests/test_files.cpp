@@ -248,9 +248,9 @@ TEST_F(Files, ASymbolicLinkIsFollowedToItsRegularFileAndStaysALink) {
   EXPECT_TRUE(others({"results", "latest.toml"}).empty());
   EXPECT_TRUE(others({"config.toml"}, path("results")).empty());
 
-  // --json replaces the file a link names (a result is re-creatable), the link stays.
+  // --json replaces the earlier result a link names (a result is re-creatable), the link stays.
   fs::create_symlink("results/in.json", path("in.json"));
-  write("results/in.json", "{}\n");
+  write("results/in.json", "{\"gyrocal\": {\"result\": \"inputs\", \"version\": \"0.1.0\"}}\n");
   const Outcome j = run({"inputs", "--beta-deg", "90", "--time-s", "1", "--json", "in.json"});
   ASSERT_EQ(j.status, 0) << j.err;
   EXPECT_TRUE(fs::is_symlink(path("in.json")));

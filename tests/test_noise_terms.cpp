@@ -321,6 +321,20 @@ TEST_F(NoiseCommand, WritesASelfContainedHtmlReportAndRefusesBadPaths) {
   EXPECT_EQ(test::run_cli("noise " + record.string() + " --html " + other.string() + " --force", dir_).status,
             0);
   EXPECT_EQ(test::slurp(other).rfind("<!DOCTYPE html>", 0), 0u);
+  // --json follows the same rule (docs/interface.md, "Files"): another existing file only with --force, an
+  // earlier result of gyrocal without it; a refused --json leaves no report either.
+  const auto toml = dir_ / "other.toml", html2 = dir_ / "second.html";
+  { std::ofstream(toml) << "[test]\nrevolutions = 3\n"; }
+  bad = test::run_cli("noise " + record.string() + " --json " + toml.string() + " --html " + html2.string(),
+                      dir_);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("not an earlier gyrocal result"), std::string::npos) << bad.err;
+  EXPECT_EQ(test::slurp(toml), "[test]\nrevolutions = 3\n");
+  EXPECT_FALSE(std::filesystem::exists(html2));
+  EXPECT_EQ(test::run_cli("noise " + record.string() + " --json " + json_path.string(), dir_).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(test::slurp(json_path))["gyrocal"]["result"], "noise");
+  EXPECT_EQ(test::run_cli("noise " + record.string() + " --json " + toml.string() + " --force", dir_).status,
+            0);
   // A folder that does not exist: refused, nothing left behind.
   bad = test::run_cli("noise " + record.string() + " --html " + (dir_ / "no" / "r.html").string(), dir_);
   EXPECT_EQ(bad.status, 1);

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -23,6 +24,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/report/noise_report.hpp"
+#include "support/cli_run.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -99,7 +101,8 @@ std::string shell_quoted(const fs::path& p) {
   return shell_quoted(p.string());
 }
 
-const std::vector<std::string> kHeadings = {"<h2>Summary</h2>",
+const std::vector<std::string> kHeadings = {"<h2>Provenance</h2>",
+                                            "<h2>Summary</h2>",
                                             "<h2>Test plan</h2>",
                                             "<h2>Data quality</h2>",
                                             "<h2>Drift coefficients</h2>",
@@ -284,13 +287,16 @@ TEST(Report, DataQualityShowsCountsAndEveryFieldOfTheDwells) {
   EXPECT_NE(html.find("<td class=\"num\">7</td>"), std::string::npos);
   EXPECT_NE(html.find("80.0 %"), std::string::npos);                         // 80000 of 100000 rows used
   EXPECT_NE(html.find("<td>clock</td><td>steady</td>"), std::string::npos);  // a field not known here
-  // The dwells: index and reason first, then the fields this gyrocal does not know, alphabetically.
+  // The dwells: the fields this gyrocal knows in a reader's order (here only index and reason), then those it
+  // does not know, alphabetically.
   EXPECT_NE(
       html.find("<th>index</th><th>reason</th><th>at_<wbr>s</th><th>limit</th><th>rows_<wbr>dropped</th>"),
       std::string::npos);
-  EXPECT_NE(html.find("<td>gap of 0.5 s &lt;inside&gt;</td><td>12.5, 13</td><td>\xE2\x80\x94</td>"
-                      "<td class=\"num\">5000</td>"),
-            std::string::npos);
+  EXPECT_NE(
+      html.find(
+          "<td class=\"sentence\">gap of 0.5 s &lt;inside&gt;</td><td>12.5, 13</td><td>\xE2\x80\x94</td>"
+          "<td class=\"num\">5000</td>"),
+      std::string::npos);
   EXPECT_NE(html.find("<td>sigma: 6</td>"), std::string::npos);
 
   const json bad = {{"data_quality", {{"rows_read", 10}, {"dwells", json::array({1, 2})}}}};
@@ -678,6 +684,169 @@ TEST(ReportBrowser, ChromiumDrawsTheNoiseReport) {
   options.title = "gyrocal noise report";
   write_file(html, gyrocal::render_noise_html_report(noise_sample(), options));
   expect_drawn_in_browser("file://" + html.string(), 1, dir.path());
+}
+
+// --- issue 20: every result of the command line is its own page ----------------------------------------
+
+/// The outputs of calibrate (with its record and configuration), sensitivity and montecarlo on a short test,
+/// and a noise characterisation, each written by the command line as JSON and rendered by `gyrocal report`
+/// into `folder` (the test's working directory keeps them to be looked at).
+struct ResultPages {
+  fs::path folder;
+  std::map<std::string, fs::path> json, html;  // by kind: calibration, sensitivity, montecarlo, noise
+  std::map<std::string, Outcome> report;       // `gyrocal report`'s run per kind
+};
+
+ResultPages make_result_pages(const std::string& name) {
+  ResultPages p;
+  p.folder = fs::absolute(name);
+  fs::remove_all(p.folder);
+  fs::create_directories(p.folder);
+  const fs::path config = p.folder / "short.toml", record = p.folder / "record.csv";
+  write_file(config, gyrocal::test::short_test_toml());
+  const std::string cli = std::string(GYROCAL_CLI), cfg = " --config " + shell_quoted(config);
+  EXPECT_EQ(run(cli + " simulate --out " + shell_quoted(record) + cfg, p.folder).status, 0);
+  const std::map<std::string, std::string> commands = {
+      {"calibration", " calibrate " + shell_quoted(record) + cfg},
+      {"sensitivity", " sensitivity" + cfg},
+      {"montecarlo", " montecarlo --trials 2000" + cfg}};
+  for (const auto& [kind, command] : commands) {
+    p.json[kind] = p.folder / (kind + ".json");
+    const Outcome o = run(cli + command + " --json " + shell_quoted(p.json[kind]), p.folder);
+    EXPECT_EQ(o.status, 0) << command << ": " << o.err;
+  }
+  p.json["noise"] = p.folder / "noise.json";
+  write_file(p.json["noise"], noise_sample().dump(2));
+  for (const auto& [kind, path] : p.json) {
+    p.html[kind] = p.folder / (kind + ".html");
+    p.report[kind] =
+        run(cli + " report " + shell_quoted(path) + " --html " + shell_quoted(p.html[kind]), p.folder);
+  }
+  return p;
+}
+
+std::vector<std::string> headings(const std::string& html) {
+  std::vector<std::string> out;
+  for (const auto& [id, title] : sections_drawn(html)) out.push_back(title);
+  return out;
+}
+
+std::size_t plots_of_kind(const json& plots, const std::string& kind) {
+  return static_cast<std::size_t>(
+      std::count_if(plots.begin(), plots.end(), [&](const json& p) { return p["kind"] == kind; }));
+}
+
+TEST(ReportPages, EachResultOfTheCommandLineRendersAsItsOwnPage) {
+  const ResultPages p = make_result_pages("report_pages");
+  for (const auto& [kind, outcome] : p.report) {
+    ASSERT_EQ(outcome.status, 0) << kind << ": " << outcome.err;
+    // `report` says what it wrote (item 10).
+    EXPECT_NE(outcome.out.find("wrote " + p.html.at(kind).string()), std::string::npos) << outcome.out;
+  }
+  EXPECT_NE(p.report.at("montecarlo").out.find("the Monte Carlo report of"), std::string::npos);
+
+  // Sensitivity: the heat maps, one per compensation, on a page of its own.
+  const std::string sens = read_file(p.html.at("sensitivity"));
+  EXPECT_NE(sens.find("<h1>gyrocal sensitivity report</h1>"), std::string::npos);
+  EXPECT_EQ(headings(sens),
+            (std::vector<std::string>{"Provenance", "The study",
+                                      "Closed forms: shift of every estimate per machine error",
+                                      "Least squares: the estimates each machine error shifts"}));
+  const json sens_plots = plot_descriptions(sens);
+  EXPECT_EQ(plots_of_kind(sens_plots, "heatmap"), 3u);
+  EXPECT_EQ(sens_plots.size(), 3u);
+  // Every row of a heat map is told apart from the others: a harmonic's rows by their phase (item 8).
+  const json sens_json = json::parse(read_file(p.json.at("sensitivity")));
+  for (const auto& plot : sens_plots) {
+    const std::set<std::string> rows(plot["rows"].begin(), plot["rows"].end());
+    EXPECT_EQ(rows.size(), sens_json["rows"].size());
+  }
+  std::size_t wobble_rows = 0;
+  for (const auto& row : sens_plots[0]["rows"])
+    if (row.get<std::string>().rfind("counter_wobble_x h2 @", 0) == 0) ++wobble_rows;
+  EXPECT_GE(wobble_rows, 2u);
+
+  // Monte Carlo: a histogram per estimate and the budget, not a calibration's table.
+  const std::string mc = read_file(p.html.at("montecarlo"));
+  const json mc_json = json::parse(read_file(p.json.at("montecarlo")));
+  EXPECT_NE(mc.find("<h1>gyrocal Monte Carlo report</h1>"), std::string::npos);
+  EXPECT_EQ(mc.find("calibration report"), std::string::npos);
+  EXPECT_EQ(headings(mc),
+            (std::vector<std::string>{"Provenance", "The run", "Distributions and variance budget"}));
+  const json mc_plots = plot_descriptions(mc);
+  EXPECT_EQ(plots_of_kind(mc_plots, "histogram"), mc_json["coefficients"].size());
+  EXPECT_EQ(plots_of_kind(mc_plots, "stacked"), 1u);
+  EXPECT_EQ(mc.find("edges: "), std::string::npos) << "a histogram printed as text";
+
+  // Noise: the Allan deviation page.
+  const std::string noise = read_file(p.html.at("noise"));
+  EXPECT_NE(noise.find("<h1>gyrocal noise report</h1>"), std::string::npos);
+  EXPECT_EQ(plots_of_kind(plot_descriptions(noise), "loglog"), 1u);
+
+  // Calibration: where it came from (item 8): the record, the configuration, gyrocal's version, the plan.
+  const std::string cal = read_file(p.html.at("calibration"));
+  EXPECT_NE(cal.find("<h1>gyrocal calibration report</h1>"), std::string::npos);
+  const auto cal_headings = headings(cal);
+  ASSERT_GE(cal_headings.size(), 2u);
+  EXPECT_EQ(cal_headings[0], "Provenance");
+  EXPECT_NE(std::find(cal_headings.begin(), cal_headings.end(), "Test plan"), cal_headings.end());
+  const std::size_t provenance = cal.find("<section id=\"provenance\">");
+  const std::string prov = cal.substr(provenance, cal.find("</section>", provenance) - provenance);
+  EXPECT_NE(prov.find((p.folder / "record.csv").string()), std::string::npos) << prov;
+  EXPECT_NE(prov.find((p.folder / "short.toml").string()), std::string::npos) << prov;
+  EXPECT_NE(prov.find("gyrocal " + std::string(gyrocal::gyrocal_version())), std::string::npos) << prov;
+  // The dwells' table: labelled columns in a reader's order, the dropped rows one column per reason, no
+  // empty index or reason column, no object printed as text.
+  const std::size_t dq = cal.find("<section id=\"data-quality\">");
+  ASSERT_NE(dq, std::string::npos);
+  const std::string dwells = cal.substr(dq, cal.find("</section>", dq) - dq);
+  for (const char* header :
+       {"<th>dwell</th>", "<th>planned rate, rad/s</th>", "<th>measured rate, rad/s</th>",
+        "<th>dropped: settling</th>", "<th>dropped: outliers</th>", "<th>steady run ended</th>"})
+    EXPECT_NE(dwells.find(header), std::string::npos) << header;
+  EXPECT_LT(dwells.find("<th>planned rate, rad/s</th>"), dwells.find("<th>dropped: settling</th>"));
+  EXPECT_EQ(dwells.find("<th>index</th>"), std::string::npos);
+  EXPECT_EQ(dwells.find("<th>reason</th>"), std::string::npos);
+  EXPECT_EQ(dwells.find("settle: "), std::string::npos) << "the dropped rows printed as an object";
+  EXPECT_EQ(dwells.find("<th>dropped</th>"), std::string::npos);
+
+  // The output of `inputs` has no page: refused with a sentence.
+  const fs::path inputs = p.folder / "inputs.json";
+  ASSERT_EQ(run(std::string(GYROCAL_CLI) + " inputs --beta-deg 90 --time-s 1 --json " + shell_quoted(inputs),
+                p.folder)
+                .status,
+            0);
+  const Outcome refused = run(std::string(GYROCAL_CLI) + " report " + shell_quoted(inputs) + " --html " +
+                                  shell_quoted(p.folder / "inputs.html"),
+                              p.folder);
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("has no report page"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(p.folder / "inputs.html"));
+}
+
+// Each page in a real browser: no error, every plot drawn; a 1400 x 3000 screenshot of each stays in the
+// build tree (tests/report_pages_browser/*.png) to be looked at.
+TEST(ReportBrowser, ChromiumDrawsEveryResultPage) {
+  expect_chromium();
+  if (HasFatalFailure()) return;
+  const ResultPages p = make_result_pages("report_pages_browser");
+  TempDir dir;
+  for (const auto& [kind, html] : p.html) {
+    ASSERT_EQ(p.report.at(kind).status, 0) << kind << ": " << p.report.at(kind).err;
+    const std::string page = read_file(html);
+    const std::size_t plots = count(page, "<canvas id=\"plot-");
+    EXPECT_GT(plots, 0u) << kind;
+    const std::string url = "file://" + html.string();
+    SCOPED_TRACE(kind);
+    expect_drawn_in_browser(url, plots, dir.path());
+    const fs::path png = p.folder / (kind + ".png");
+    const Outcome shot =
+        run(chromium_command(dir.path() / ("profile-shot-" + kind)) +
+                " --window-size=1400,3000 --screenshot=" + shell_quoted(png) + " " + shell_quoted(url),
+            dir.path());
+    EXPECT_EQ(shot.status, 0) << shot.err;
+    EXPECT_GT(read_file(png).size(), 50000u) << png << " looks empty";
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/atomic_file.hpp"
@@ -22,34 +23,58 @@ Scenario load_configuration(const std::string& path);
 /// with the command line's overrides).
 void check_feasible(const Scenario& scenario, const std::string& config_path, const ReduceOptions& options);
 
-/// An output: standard output for "-", else an AtomicOutputFile (a regular file through a temporary and a
-/// rename; a device or FIFO written straight through; anything else refused). An existing regular file is
-/// replaced only when `overwrite`.
-std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, bool overwrite);
+/// What an output option writes; it decides when an existing file may be replaced (replacement_rule).
+enum class OutputKind {
+  kRecord,         ///< simulate --out: a record (possibly a rig's), never re-creatable by gyrocal
+  kConfiguration,  ///< init FILE: a configuration the user may have edited
+  kResult,         ///< --json FILE: a result (gyrocal's marker, report/html_report.hpp)
+  kReport,         ///< --html FILE: a report (kReportMarker)
+};
+
+/// The one rule for every output option (docs/interface.md, "Files"): "-" is standard output; a path that
+/// does not exist is created; an existing regular file is replaced when `force` (--force), and without it
+/// only when it is an earlier output of the same kind written by gyrocal (a result JSON with gyrocal's
+/// marker for --json, a report for --html; a record or a configuration always needs --force). A device or
+/// FIFO is written straight through (AtomicOutputFile). Refuses, naming `option` and the path, a file it
+/// may not replace. Inputs are refused before, by refuse_to_overwrite_input.
+std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, OutputKind kind, bool force,
+                                              std::string_view option);
 
 /// Writes `content` to `path` through open_output and commits it.
-void write_output(const std::string& path, std::string_view content, bool overwrite);
+void write_output(const std::string& path, std::string_view content, OutputKind kind, bool force,
+                  std::string_view option);
+
+/// Writes `result` as the JSON of a `kind` result (kResultKinds: calibration, plan, sensitivity, montecarlo,
+/// noise, inputs) to `path` (--json), with gyrocal's marker added (mark_result), by the rule of open_output.
+void write_result(const std::string& path, nlohmann::json result, std::string_view kind, bool force);
+
+/// --force for the commands whose outputs follow open_output's rule: replace any existing file.
+void add_force_flag(CLI::App* sub, bool& force);
 
 /// Refuse an output path that names one of the inputs (no input is ever overwritten).
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
 
-/// True when `path` is an earlier gyrocal report (it starts with kReportMarker, report/html_report.hpp),
-/// which `report` and `noise --html` replace without --force: a report is derived from its input and cheap to
-/// write again (docs/report.md).
+/// True when `path` is an earlier gyrocal report (it starts with kReportMarker, report/html_report.hpp).
 bool is_earlier_report(const std::string& path);
 
-/// A progress bar on standard error ("label [####    ]  42%"), redrawn when the whole percentage changes.
-/// Commands install it only when standard error is a terminal; it draws nothing during the first second, so
-/// that work shorter than a second shows no bar.
+/// True when `path` is a regular file that holds an earlier gyrocal result: a JSON object with gyrocal's
+/// marker (has_result_marker, report/html_report.hpp).
+bool is_earlier_result(const std::string& path);
+
+/// Progress on standard error. On a terminal, a bar ("label [####    ]  42%") redrawn when the whole
+/// percentage changes; otherwise (a file, a pipe, a log) one line per tenth ("label: 40 % after 3.2 s").
+/// Both only from the first second on, so that work shorter than a second shows none
+/// ($GYROCAL_PROGRESS_AFTER_S sets another delay, 0 = from the start; docs/interface.md).
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label)
-      : label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
+  explicit ProgressBar(std::string label);
   void operator()(double fraction);
 
  private:
   std::string label_;
   std::chrono::steady_clock::time_point start_;
+  std::chrono::duration<double> delay_;
+  bool terminal_;
   int percent_ = -1;
 };
 
@@ -58,6 +83,9 @@ void add_gyro_model_option(CLI::App* sub, std::string& value);
 
 /// The gyro model a command identifies: `option` (--gyro-model) when given, else [calibration] gyro_model.
 GyroModel chosen_gyro_model(const std::string& option, const Scenario& scenario);
+
+/// --compensation's help: what "seed" means (the seed paper's correction, not the random --seed).
+extern const char* const kCompensationHelp;
 
 /// A check for a numeric option: refuses NaN and infinities ("--beta-deg nan"), which CLI11 parses.
 extern const CLI::Validator kFinite;

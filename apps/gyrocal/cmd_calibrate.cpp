@@ -15,6 +15,7 @@ void register_calibrate(CLI::App& app) {
     std::string record, config, json, method = "least-squares", compensation = "full", estimate;
     std::string gyro_model;  // empty: [calibration] gyro_model
     std::string reduction;   // empty: [calibration] reduction
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
@@ -25,7 +26,7 @@ void register_calibrate(CLI::App& app) {
       "([record])");
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
-  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
+  sub->add_option("--compensation", opt->compensation, kCompensationHelp)
       ->check(CLI::IsMember({"none", "seed", "full"}));
   sub->add_option("--reduction", opt->reduction,
                   "harmonic (harmonic fit in gamma with drift) or window (mean around each gamma); default: "
@@ -37,6 +38,7 @@ void register_calibrate(CLI::App& app) {
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
   add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  add_force_flag(sub, opt->force);
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -64,8 +66,12 @@ void register_calibrate(CLI::App& app) {
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
     if (!opt->json.empty()) {
       nlohmann::json j = calibration_to_json(r);
+      // Provenance (docs/interface.md): the record, the configuration (null: the built-in scenario), the
+      // plan.
       j["record"] = opt->record;
-      write_output(opt->json, j.dump(2) + "\n", true);
+      j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
+      j["plan"] = plan_to_json(s.test);
+      write_result(opt->json, std::move(j), "calibration", opt->force);
     }
     if (opt->json != "-") fmt::print("{}", result_table(r));
   });

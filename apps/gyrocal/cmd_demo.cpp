@@ -93,6 +93,8 @@ void register_demo(CLI::App& app) {
                budget.trials, to_string(budget.mode));
 
     const std::string result_path = folder.final_path("result.json").string();
+    j["config"] = nullptr;  // the built-in demo scenario
+    mark_result(j, "calibration");
     write_file_atomically(result_staged, j.dump(2) + "\n", false);
     HtmlReportOptions report;
     report.title = "gyrocal demo: the default scenario";

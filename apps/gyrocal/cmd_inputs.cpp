@@ -8,16 +8,22 @@
 namespace gyrocal::cli {
 namespace {
 
+/// An angle in degrees as printed: a negative zero (gamma at the start of a dwell, -0.0 in radians) shows as
+/// 0, never "-0".
+double shown_deg(double rad) {
+  return rad * kRadToDeg + 0.0;
+}
+
 std::string inputs_table(const InstantInputs& in) {
   const auto& j = in.joints;
   std::string s;
   s += fmt::format("time                 {:.12g} s\n", in.time_s);
-  s += fmt::format("main angle theta     {:.12g} deg   rate {:.9g} rad/s\n", j.main_angle_rad * kRadToDeg,
+  s += fmt::format("main angle theta     {:.12g} deg   rate {:.9g} rad/s\n", shown_deg(j.main_angle_rad),
                    j.main_rate_rad_s);
-  s += fmt::format("counter angle psi_r  {:.12g} deg   rate {:.9g} rad/s\n", j.counter_angle_rad * kRadToDeg,
+  s += fmt::format("counter angle psi_r  {:.12g} deg   rate {:.9g} rad/s\n", shown_deg(j.counter_angle_rad),
                    j.counter_rate_rad_s);
   s += fmt::format("beta                 {:.9g} deg\ngamma                {:.12g} deg\n\n",
-                   j.position_angle_rad * kRadToDeg, j.gamma_rad() * kRadToDeg);
+                   shown_deg(j.position_angle_rad), shown_deg(j.gamma_rad()));
   s += fmt::format("{:<10}{:>22}{:>22}{:>22}\n", "", "exact", "nominal", "exact - nominal");
   s += fmt::format("{:<10}{:>22.12e}{:>22.12e}{:>22.3e}  rad/s\n", "omega_I", in.exact.rate_rad_s.x(),
                    in.nominal.omega_I_rad_s, in.exact.rate_rad_s.x() - in.nominal.omega_I_rad_s);
@@ -38,6 +44,7 @@ void register_inputs(CLI::App& app) {
     std::string config, json;
     double beta_deg = 0.0, time_s = 0.0, gamma_deg = 0.0;
     int revolution = 0;
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("inputs", "Exact and nominal inputs to the gyro at one instant");
@@ -56,6 +63,7 @@ void register_inputs(CLI::App& app) {
                          ->needs(gamma);
   time->excludes(gamma)->excludes(rev);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  add_force_flag(sub, opt->force);
   sub->callback([opt, time, gamma] {
     if (time->count() == 0 && gamma->count() == 0)
       throw CLI::ValidationError("inputs", "give the instant with --time-s T or --gamma-deg G");
@@ -67,7 +75,7 @@ void register_inputs(CLI::App& app) {
                       : inputs_at_gamma(model, rate, beta, opt->gamma_deg * kDegToRad, opt->revolution);
     if (!opt->json.empty()) {
       refuse_to_overwrite_input(opt->json, opt->config);
-      write_output(opt->json, inputs_to_json(in).dump(2) + "\n", true);
+      write_result(opt->json, inputs_to_json(in), "inputs", opt->force);
     }
     if (opt->json != "-") fmt::print("{}", inputs_table(in));
   });

@@ -1,5 +1,4 @@
 // gyrocal montecarlo: uncertainty budget over random machine errors and noise (docs/contract.md).
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -69,6 +68,7 @@ void register_montecarlo(CLI::App& app) {
     std::uint64_t seed = 0;
     bool samples = false;
     int threads = 0;
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -77,7 +77,10 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--trials", opt->trials,
                   "Number of trials: 2 to 1000000000 (1e9), or to 100000 (1e5) with --samples")
       ->required();
-  CLI::Option* seed = sub->add_option("--seed", opt->seed, "Random seed; default: [test] seed");
+  CLI::Option* seed = sub->add_option(
+      "--seed", opt->seed,
+      "Random seed of the trials' draws; default: [test] seed (not --compensation seed, the seed paper's "
+      "correction)");
   sub->add_flag("--samples", opt->samples,
                 "Run the whole time-series pipeline per trial (slow; checks the fast linearised mode)");
   sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
@@ -85,10 +88,12 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation,
-                  "none, seed, full (default) or self (the counter platform's errors estimated; two speeds)")
+                  std::string(kCompensationHelp) +
+                      "; or self (the counter platform's errors estimated from the data; two speeds)")
       ->check(CLI::IsMember({"none", "seed", "full", "self"}));
   add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  add_force_flag(sub, opt->force);
   sub->callback([opt, seed] {
     const long long most = opt->samples ? kMaxSampleTrials : kMaxFastTrials;
     if (opt->trials < 2 || opt->trials > most) {
@@ -114,11 +119,15 @@ void register_montecarlo(CLI::App& app) {
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
     options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
     options.calibration.reduce = scenario.reduce;  // [reduce]: --samples reduces each trial's record with it
-    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("Monte Carlo");
+    options.progress = ProgressBar("Monte Carlo");
     const auto start = std::chrono::steady_clock::now();
     const MonteCarloResult result = monte_carlo(scenario, options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!opt->json.empty()) write_output(opt->json, montecarlo_to_json(result).dump(2) + "\n", true);
+    if (!opt->json.empty()) {
+      nlohmann::json j = montecarlo_to_json(result);
+      j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
+      write_result(opt->json, std::move(j), "montecarlo", opt->force);
+    }
     if (opt->json != "-") fmt::print("{}", montecarlo_table(result, seconds));
   });
 }

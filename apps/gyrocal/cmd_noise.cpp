@@ -27,8 +27,7 @@ void register_noise(CLI::App& app) {
       "--html", opt->html,
       "Write a self-contained HTML report (log-log Allan plot, fitted terms) to FILE ('-' = standard "
       "output)");
-  sub->add_flag("--force", opt->force,
-                "Let --html replace an existing file that is not an earlier gyrocal report");
+  add_force_flag(sub, opt->force);
   sub->add_flag("--toml", opt->toml, "Print the fitted terms as a [gyro.noise] configuration section");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
@@ -42,20 +41,29 @@ void register_noise(CLI::App& app) {
     const Scenario s = load_configuration(opt->config);
     const RecordNoise r = characterise_record_noise(opt->record, {}, s.record);
     const nlohmann::json j = noise_to_json(r);
-    // The report first: a refused --html path (an existing file that is not a report) leaves no --json
-    // output.
+    // Both outputs are opened (and a refused path refused) before either is written: a refused --html
+    // leaves no --json, and a refused --json no report.
+    nlohmann::json marked = j;
+    mark_result(marked, "noise");
+    std::string html;
     if (!opt->html.empty()) {
       HtmlReportOptions options;
       options.title = "gyrocal noise report";
       options.source = opt->record;
       std::vector<std::string> problems;
       options.problems = &problems;
-      const std::string html = render_noise_html_report(j, options);
+      html = render_noise_html_report(j, options);
       if (!problems.empty())
         throw Error(fmt::format("the noise report of {} is incomplete: {}", opt->record, problems.front()));
-      write_output(opt->html, html, opt->force || is_earlier_report(opt->html));
     }
-    if (!opt->json.empty()) write_output(opt->json, j.dump(2) + "\n", true);
+    const std::unique_ptr<AtomicOutputFile> html_file =
+        opt->html.empty() ? nullptr : open_output(opt->html, OutputKind::kReport, opt->force, "--html");
+    const std::unique_ptr<AtomicOutputFile> json_file =
+        opt->json.empty() ? nullptr : open_output(opt->json, OutputKind::kResult, opt->force, "--json");
+    if (html_file) html_file->write(html);
+    if (json_file) json_file->write(marked.dump(2) + "\n");
+    if (html_file) html_file->commit();
+    if (json_file) json_file->commit();
     if (opt->toml) {
       fmt::print("{}", noise_to_toml(r));
     } else if (opt->json != "-" && opt->html != "-") {

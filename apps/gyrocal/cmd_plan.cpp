@@ -13,6 +13,7 @@ void register_plan(CLI::App& app) {
   struct Options {
     std::string config, json, method = "least-squares", compensation = "full", estimate;
     std::string gyro_model;  // empty: [calibration] gyro_model
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -20,7 +21,7 @@ void register_plan(CLI::App& app) {
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
-  sub->add_option("--compensation", opt->compensation, "none, seed or full (default)")
+  sub->add_option("--compensation", opt->compensation, kCompensationHelp)
       ->check(CLI::IsMember({"none", "seed", "full"}));
   sub->add_option(
       "--estimate", opt->estimate,
@@ -28,6 +29,7 @@ void register_plan(CLI::App& app) {
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
   add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");
+  add_force_flag(sub, opt->force);
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
     const Scenario s = load_configuration(opt->config);
@@ -43,8 +45,9 @@ void register_plan(CLI::App& app) {
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {
       nlohmann::json j = calibration_to_json(r);
+      j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
       j["plan"] = plan_to_json(s.test);
-      write_output(opt->json, j.dump(2) + "\n", true);
+      write_result(opt->json, std::move(j), "plan", opt->force);
     }
     if (opt->json == "-") return;
     fmt::print("The configured test: {} positions, {} revolutions per dwell at {} Hz.\n", r.positions.size(),

@@ -37,7 +37,15 @@ void register_report(CLI::App& app) {
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->html, opt->result);
     const nlohmann::json result = read_result(opt->result);
-    if (report_sections_present(result).empty())
+    const std::string kind = result_kind(result);
+    if (kind == "inputs")
+      throw Error(
+          fmt::format("{} is the output of `gyrocal inputs` (one instant's inputs to the gyro), which has no "
+                      "report page; "
+                      "report draws the results of calibrate, plan, sensitivity, montecarlo, noise and demo.",
+                      opt->result));
+    const std::vector<std::string> sections = report_sections_present(result);
+    if (sections.empty())
       throw Error(fmt::format(
           "{} contains none of the sections of a gyrocal result (coefficients, positions, sensitivity, "
           "montecarlo, plan, ...).",
@@ -50,7 +58,11 @@ void register_report(CLI::App& app) {
     for (const auto& p : problems) fmt::print(stderr, "gyrocal: warning: {}: {}\n", opt->result, p);
     // A report is derived from its result and cheap to write again: an earlier report is replaced,
     // any other existing file only with --force (docs/report.md).
-    write_output(opt->html, html, opt->force || is_earlier_report(opt->html));
+    write_output(opt->html, html, OutputKind::kReport, opt->force, "--html");
+    // What was written, on standard error when the report itself went to standard output.
+    fmt::print(opt->html == "-" ? stderr : stdout, "wrote {}: the {} report of {} ({} sections)\n",
+               opt->html == "-" ? "standard output" : opt->html, kind == "montecarlo" ? "Monte Carlo" : kind,
+               opt->result, sections.size());
   });
 }
 

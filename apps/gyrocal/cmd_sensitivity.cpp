@@ -1,8 +1,10 @@
 // gyrocal sensitivity: the seed's error study (docs/physics.md section 10, docs/contract.md).
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -17,7 +19,8 @@ namespace {
 constexpr const char* kCompensationNames[3] = {"none", "seed", "full"};
 
 std::string magnitude(const SensitivityRow& row) {
-  return fmt::format("{:.3g} {}{}", row.value, row.term.unit, row.typical ? " *" : "");
+  // The star after the unit, a blank where there is none, so that the units line up.
+  return fmt::format("{:.3g} {}{}", row.value, row.term.unit, row.typical ? " *" : "  ");
 }
 
 std::string row_label(const SensitivityRow& row) {
@@ -25,9 +28,41 @@ std::string row_label(const SensitivityRow& row) {
   return fmt::format("{} h{} @{:g}", row.term.error, row.term.harmonic, row.term.phase_rad * kRadToDeg);
 }
 
+/// The widest line of the text tables: an 80-column terminal wraps them no more than twice, a 120-column
+/// one not at all.
+constexpr std::size_t kLineWidth = 118;
+
+/// The first column's width: the longest row label, at least "machine error".
+std::size_t label_width(const SensitivityResult& r) {
+  std::size_t width = 14;
+  for (const SensitivityRow& row : r.rows) width = std::max(width, row_label(row).size() + 2);
+  return width;
+}
+
+/// `items` joined by `separator`, after `lead` (of `indent` characters), wrapped onto lines indented by
+/// `indent` so that no line is longer than kLineWidth.
+std::string wrapped(const std::string& lead, std::size_t indent, const std::vector<std::string>& items,
+                    std::string_view separator) {
+  std::string out = lead;
+  std::size_t column = indent;
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    const std::string piece = items[k] + (k + 1 < items.size() ? std::string(separator) : std::string());
+    if (column > indent && column + piece.size() > kLineWidth) {
+      while (!out.empty() && out.back() == ' ') out.pop_back();
+      out += "\n" + std::string(indent, ' ');
+      column = indent;
+    }
+    out += piece;
+    column += piece.size();
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out + "\n";
+}
+
 /// docs/physics.md section 15: least squares' shift of each rate error per machine error and compensation, in
 /// the rate error's unit (ppm, arcsec); a rate error the plan does not identify is named with its reason.
 std::string rate_terms_table(const SensitivityResult& r) {
+  const std::size_t width = label_width(r);
   std::string s = fmt::format(
       "\nleast squares, gyro model drift+rate: shift of the rate errors in their units; * = more than {} "
       "sigma\n",
@@ -39,8 +74,8 @@ std::string rate_terms_table(const SensitivityResult& r) {
       continue;
     }
     const auto sigma = r.least_squares_noise_std.find(name);
-    s += fmt::format("\n{} ({}; sigma {:.3g})\n{:<30}{:>18}", name, kRateTermUnits[k],
-                     sigma != r.least_squares_noise_std.end() ? sigma->second : NAN, "machine error",
+    s += fmt::format("\n{} ({}; sigma {:.3g})\n{:<{}}{:>22}", name, kRateTermUnits[k],
+                     sigma != r.least_squares_noise_std.end() ? sigma->second : NAN, "machine error", width,
                      "magnitude");
     for (const char* c : kCompensationNames) s += fmt::format("{:>12}", c);
     if (r.has_self) s += fmt::format("{:>12}", "self");
@@ -52,7 +87,7 @@ std::string rate_terms_table(const SensitivityResult& r) {
       return fmt::format("{:>12}", fmt::format("{:.3g}{}", it->second, m ? "*" : ""));
     };
     for (const SensitivityRow& row : r.rows) {
-      s += fmt::format("{:<30}{:>18}", row_label(row), magnitude(row));
+      s += fmt::format("{:<{}}{:>22}", row_label(row), width, magnitude(row));
       for (std::size_t c = 0; c < 3; ++c) s += cell(row.least_squares[c], row.least_squares_matters[c]);
       if (r.has_self) s += cell(row.self, row.self_matters);
       s += "\n";
@@ -61,55 +96,63 @@ std::string rate_terms_table(const SensitivityResult& r) {
   return s;
 }
 
-/// Per compensation: the closed forms' shifts in units of their noise std, '.' below the threshold.
+/// Per compensation, per machine error: the closed forms' estimates it shifts by at least the threshold,
+/// each with its shift in units of its noise std ("dI 3.2, dOS -1.1"), the largest first; the full names,
+/// wrapped, never a column of truncated names (docs/interface.md, "Text output").
 std::string sensitivity_table(const SensitivityResult& r) {
+  const std::size_t width = label_width(r), indent = width + 22 + 2;
   std::string s = fmt::format(
-      "Each machine error alone (docs/physics.md section 10): shift = estimate(error) - estimate(no error), "
-      "exact "
-      "(noise-free).\nCells: shift / sigma, sigma = the estimate's predicted noise std; '.' = below {} sigma "
-      "(does not matter). * = typical magnitude (zero in the configuration).\n",
+      "Each machine error alone (docs/physics.md section 10): shift = estimate(error) - estimate(no error),\n"
+      "exact (noise-free). Listed: the estimates shifted by at least {} sigma, as shift / sigma, the "
+      "largest\n"
+      "first (sigma = the estimate's predicted noise std); - = none. * = typical magnitude (zero in the\n"
+      "configuration). @ = a harmonic's phase, deg.\n",
       r.threshold);
-  s += "\nsigma:";
+  std::vector<std::string> sigmas;
   for (const std::string& name : r.closed_form_names)
-    s += fmt::format("  {} {:.2g}", name, r.closed_form_noise_std.at(name));
-  s += "\n";
+    sigmas.push_back(fmt::format("{} {:.2g}", name, r.closed_form_noise_std.at(name)));
+  s += "\n" + wrapped("sigma: ", 7, sigmas, ", ");
+  const auto header = [&](std::string_view title) {
+    return fmt::format("\n{}\n{:<{}}{:>22}  {}\n", title, "machine error", width, "magnitude",
+                       "estimates shifted (shift / sigma)");
+  };
   for (std::size_t c = 0; c < 3; ++c) {
-    s += fmt::format("\nclosed forms, compensation {}\n{:<30}{:>18}", kCompensationNames[c], "machine error",
-                     "magnitude");
-    for (const std::string& name : r.closed_form_names) s += fmt::format("{:>9}", name.substr(0, 8));
-    s += "\n";
+    s += header(fmt::format("closed forms, compensation {}", kCompensationNames[c]));
     for (const SensitivityRow& row : r.rows) {
-      s += fmt::format("{:<30}{:>18}", row_label(row), magnitude(row));
       const auto& matters = row.closed_form_matters[c];
+      std::vector<std::pair<double, std::string>> shifted;
       for (const std::string& name : r.closed_form_names) {
         const auto it = row.closed_form[c].find(name);
-        const bool m = std::find(matters.begin(), matters.end(), name) != matters.end();
+        if (it == row.closed_form[c].end() ||
+            std::find(matters.begin(), matters.end(), name) == matters.end())
+          continue;
         const double sigma = r.closed_form_noise_std.at(name);
-        if (it == row.closed_form[c].end() || !m)
-          s += fmt::format("{:>9}", ".");
-        else if (sigma > 0)
-          s += fmt::format("{:>9.3g}", it->second / sigma);
-        else
-          s += fmt::format("{:>9.2e}", it->second);
+        const double z = sigma > 0 ? it->second / sigma : it->second;
+        shifted.emplace_back(std::fabs(z), sigma > 0 ? fmt::format("{} {:.3g}", name, z)
+                                                     : fmt::format("{} {:.2e} (no sigma)", name, z));
       }
-      s += "\n";
+      std::stable_sort(shifted.begin(), shifted.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::vector<std::string> items;
+      for (auto& item : shifted) items.push_back(std::move(item.second));
+      if (items.empty()) items.emplace_back("-");
+      s += wrapped(fmt::format("{:<{}}{:>22}  ", row_label(row), width, magnitude(row)), indent, items, ", ");
     }
   }
-  s += fmt::format("\nleast squares: estimates shifted by more than {} sigma\n", r.threshold);
+  s += fmt::format("\nleast squares: estimates shifted by more than {} sigma, per compensation\n",
+                   r.threshold);
   for (const SensitivityRow& row : r.rows) {
-    std::string line;
-    for (std::size_t c = 0; c < 3; ++c) {
-      std::string names;
-      for (const std::string& n : row.least_squares_matters[c]) names += (names.empty() ? "" : " ") + n;
-      line += fmt::format("  {}: {:<28}", kCompensationNames[c], names.empty() ? "-" : names);
-    }
-    if (r.has_self) {
-      // The counter platform's perpendicularity and rate mismatch estimated (docs/self_calibration.md).
-      std::string names;
-      for (const std::string& n : row.self_matters) names += (names.empty() ? "" : " ") + n;
-      line += fmt::format("  self: {:<28}", names.empty() ? "-" : names);
-    }
-    s += fmt::format("{:<30}{:>18}{}\n", row_label(row), magnitude(row), line);
+    std::vector<std::string> items;
+    const auto names_of = [](const std::vector<std::string>& names) {
+      std::string out;
+      for (const std::string& n : names) out += (out.empty() ? "" : " ") + n;
+      return out.empty() ? std::string("-") : out;
+    };
+    for (std::size_t c = 0; c < 3; ++c)
+      items.push_back(fmt::format("{}: {}", kCompensationNames[c], names_of(row.least_squares_matters[c])));
+    // The counter platform's perpendicularity and rate mismatch estimated (docs/self_calibration.md).
+    if (r.has_self) items.push_back(fmt::format("self: {}", names_of(row.self_matters)));
+    s += wrapped(fmt::format("{:<{}}{:>22}  ", row_label(row), width, magnitude(row)), indent, items, "; ");
   }
   if (r.gyro_model == GyroModel::kDriftRate) s += rate_terms_table(r);
   return s;
@@ -123,13 +166,17 @@ void register_sensitivity(CLI::App& app) {
     std::string gyro_model;  // empty: [calibration] gyro_model
     double threshold = 0.1;
     int threads = 0;
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "sensitivity",
-      "The seed's study: the shift of every estimate per machine error, with each compensation");
+      "The seed paper's error study (Wang & Meng 2017, the paper this method comes from; docs/physics.md "
+      "section 10): the exact shift of every estimate per machine error alone, with each compensation "
+      "(none, seed = the paper's correction, full)");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
+  add_force_flag(sub, opt->force);
   sub->add_option("--threshold", opt->threshold,
                   "An estimate is affected when its shift exceeds this many noise std; default 0.1")
       ->check(kFinite & CLI::PositiveNumber);
@@ -144,9 +191,13 @@ void register_sensitivity(CLI::App& app) {
     options.threshold = opt->threshold;
     options.threads = opt->threads;
     options.calibration.reduce = scenario.reduce;  // [reduce]: the reduction the study's calibrations use
-    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("sensitivity");
+    options.progress = ProgressBar("sensitivity");
     const SensitivityResult result = sensitivity_study(scenario, options);
-    if (!opt->json.empty()) write_output(opt->json, sensitivity_to_json(result).dump(2) + "\n", true);
+    if (!opt->json.empty()) {
+      nlohmann::json j = sensitivity_to_json(result);
+      j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
+      write_result(opt->json, std::move(j), "sensitivity", opt->force);
+    }
     if (opt->json != "-") fmt::print("{}", sensitivity_table(result));
   });
 }

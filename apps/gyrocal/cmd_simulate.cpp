@@ -1,6 +1,5 @@
 // gyrocal simulate: simulate a whole test into a record (docs/contract.md).
 #include <sys/statvfs.h>
-#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -62,7 +61,10 @@ void register_simulate(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("simulate", "Simulate a whole test into a record");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--out", opt->out, "The record to write (CSV; '-' = standard output)")->required();
-  CLI::Option* seed = sub->add_option("--seed", opt->seed, "Random seed of the noise; default: [test] seed");
+  CLI::Option* seed = sub->add_option(
+      "--seed", opt->seed,
+      "Random seed of the noise; default: [test] seed (not --compensation seed, the seed paper's "
+      "correction)");
   sub->add_flag("--force", opt->force, "Overwrite RECORD if it exists");
   sub->callback([opt, seed] {
     refuse_to_overwrite_input(opt->out, opt->config);
@@ -71,12 +73,13 @@ void register_simulate(CLI::App& app) {
     check_feasible(scenario, opt->config, scenario.reduce);
     SimulationOptions options;
     if (seed->count()) options.seed = opt->seed;
-    if (::isatty(STDERR_FILENO)) options.progress = ProgressBar("simulating");
+    options.progress = ProgressBar("simulating");
 
     const std::uint64_t samples =
         sample_count(make_timeline(scenario.test, scenario.model()), scenario.test.sample_rate_hz);
 
-    const std::unique_ptr<AtomicOutputFile> file = open_output(opt->out, opt->force);
+    const std::unique_ptr<AtomicOutputFile> file =
+        open_output(opt->out, OutputKind::kRecord, opt->force, "--out");
     if (!file->writes_through()) refuse_what_cannot_fit(*file, samples);
     const SimulationSummary summary = simulate_record(scenario, options, file->stream());
     const std::uint64_t bytes = file->bytes();

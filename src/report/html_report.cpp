@@ -3,6 +3,8 @@
 #include "gyrocal/report/html_report.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -70,13 +72,66 @@ nlohmann::json parse_result_json(std::string_view text, const std::string& sourc
   }
 }
 
+void mark_result(nlohmann::json& result, std::string_view kind) {
+  result[std::string(kResultMarkerKey)] = {{"result", kind}, {"version", GYROCAL_VERSION}};
+}
+
+bool has_result_marker(const nlohmann::json& result) {
+  if (!result.is_object()) return false;
+  const auto m = result.find(kResultMarkerKey);
+  if (m == result.end() || !m->is_object()) return false;
+  const auto kind = m->find("result");
+  return kind != m->end() && kind->is_string() &&
+         std::find(std::begin(kResultKinds), std::end(kResultKinds), kind->get<std::string>()) !=
+             std::end(kResultKinds);
+}
+
+std::string result_kind(const nlohmann::json& result) {
+  if (has_result_marker(result)) return result[std::string(kResultMarkerKey)]["result"].get<std::string>();
+  if (!result.is_object()) return "calibration";
+  // A result without the marker (written before it, or by Python): told by its shape.
+  if (result.contains("allan")) return "noise";
+  if (result.contains("rows") && !result.contains("coefficients")) return "sensitivity";
+  if (result.contains("budget") || result.contains("trials")) return "montecarlo";
+  if (result.contains("specific_force_g") && result.contains("nominal")) return "inputs";
+  return "calibration";
+}
+
+namespace {
+
+struct PageKind {
+  std::string_view kind, title;
+  std::span<const report::Section> (*sections)();
+};
+
+/// The page of each kind of result: its own table of sections and title. `inputs` has none.
+const PageKind kPages[] = {
+    {"calibration", "gyrocal calibration report", report::result_sections},
+    {"plan", "gyrocal plan report: the predicted calibration", report::result_sections},
+    {"sensitivity", "gyrocal sensitivity report", report::sensitivity_sections},
+    {"montecarlo", "gyrocal Monte Carlo report", report::montecarlo_sections},
+    {"noise", "gyrocal noise report", report::noise_sections},
+};
+
+const PageKind* page_of(const nlohmann::json& result) {
+  const std::string kind = result_kind(result);
+  for (const PageKind& p : kPages)
+    if (p.kind == kind) return &p;
+  return nullptr;
+}
+
+}  // namespace
+
 std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options) {
   if (!result.is_object())
     throw Error(fmt::format("a result must be a JSON object, not a JSON {}", result.type_name()));
+  const PageKind* kind = page_of(result);
+  if (kind == nullptr)
+    throw Error(fmt::format("the output of `gyrocal {}` has no report page", result_kind(result)));
   report::Page page(options.problems);
-  report::render_sections(report::result_sections(), result, page);
+  report::render_sections(kind->sections(), result, page);
   report::PageHeader header;
-  header.title = options.title;
+  header.title = options.title.empty() ? std::string(kind->title) : options.title;
   header.source = options.source;
   header.created = options.created;
   return page.html(header);
@@ -84,7 +139,9 @@ std::string render_html_report(const nlohmann::json& result, const HtmlReportOpt
 
 std::vector<std::string> report_sections_present(const nlohmann::json& result) {
   if (!result.is_object()) return {};
-  return report::sections_applying(report::result_sections(), result);
+  const PageKind* kind = page_of(result);
+  if (kind == nullptr) return {};
+  return report::sections_applying(kind->sections(), result);
 }
 
 std::string_view embedded_plot_library() {

@@ -232,15 +232,21 @@ Cell num_cell(std::string text, std::string cls, std::string title) {
 
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<Cell>>& rows,
                   std::string_view cls) {
-  std::string s = fmt::format("<div class=\"table-wrap\"><table class=\"{}\">\n<thead><tr>", cls);
+  std::string s = fmt::format("<div class=\"table-wrap\"><table class=\"{}\">\n", cls);
+  // A table of label and value (every heading empty) has no heading row.
+  const bool headed =
+      std::any_of(header.begin(), header.end(), [](const std::string& h) { return !h.empty(); });
+  if (headed) s += "<thead><tr>";
   for (const auto& h : header) {
+    if (!headed) break;
     // Let long source names such as counter_perpendicularity break after an underscore.
     std::string cell = esc(h);
     for (std::size_t at = cell.find('_'); at != std::string::npos; at = cell.find('_', at + 6))
       cell.replace(at, 1, "_<wbr>");
     s += "<th>" + cell + "</th>";
   }
-  s += "</tr></thead>\n<tbody>\n";
+  if (headed) s += "</tr></thead>\n";
+  s += "<tbody>\n";
   for (const auto& row : rows) {
     s += "<tr>";
     for (const auto& c : row) {

@@ -13,6 +13,7 @@
 #include "gyrocal/core/noise_terms.hpp"
 #include "html_writing.hpp"
 #include "page.hpp"
+#include "sections.hpp"
 
 namespace gyrocal {
 namespace report {
@@ -217,6 +218,11 @@ const Section kNoiseSections[] = {
 };
 
 }  // namespace
+
+std::span<const Section> noise_sections() {
+  return kNoiseSections;
+}
+
 }  // namespace report
 
 std::string render_noise_html_report(const nlohmann::json& noise, const HtmlReportOptions& options) {
@@ -225,7 +231,7 @@ std::string render_noise_html_report(const nlohmann::json& noise, const HtmlRepo
   report::Page page(options.problems);
   report::render_sections(report::kNoiseSections, noise, page);
   report::PageHeader header;
-  header.title = options.title;
+  header.title = options.title.empty() ? "gyrocal noise report" : options.title;
   header.source = options.source;
   header.source_label = "record";
   header.created = options.created;

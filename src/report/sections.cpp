@@ -12,6 +12,7 @@
 
 #include "charts.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/report/html_report.hpp"
 #include "html_writing.hpp"
 
 namespace gyrocal::report {
@@ -22,6 +23,32 @@ std::string unit_of(const json& result, const std::string& name) {
   const json* entry = c ? find(*c, name) : nullptr;
   const json* unit = entry ? find(*entry, "unit") : nullptr;
   return unit && unit->is_string() ? unit->get<std::string>() : "";
+}
+
+/// A sensitivity row's label: the error, with its harmonic and phase for a harmonic
+/// ("counter_wobble_x h2 @90°"): the phase tells apart the rows of one harmonic.
+std::string sensitivity_row_label(const json& row, std::string_view where) {
+  const std::string error = string_or(row, "error", kDash);
+  const auto harmonic = number(row, "harmonic", where);
+  if (!harmonic || *harmonic == 0) return error;
+  std::string label = fmt::format("{} h{}", error, num(harmonic));
+  if (const auto phase = number(row, "phase_deg", where)) label += fmt::format(" @{}\xC2\xB0", num(phase, 4));
+  return label;
+}
+
+/// A sensitivity row's magnitude with its unit, "(typical)" where the configuration had zero and the study
+/// used a typical magnitude (`typical`).
+std::string sensitivity_magnitude(const json& row, std::string_view where) {
+  const json* typical = find(row, "typical");
+  return fmt::format("{} {}{}", num(number(row, "value", where)), string_or(row, "unit"),
+                     typical && typical->is_boolean() && typical->get<bool>() ? " (typical)" : "");
+}
+
+/// The unit of an estimate: the study's own `units` {name: unit}, else the result's coefficients'.
+std::string estimate_unit(const json& s, const json& result, const std::string& name) {
+  if (const json* units = find(s, "units"); units && units->is_object())
+    if (std::string u = string_or(*units, name); !u.empty()) return u;
+  return unit_of(result, name);
 }
 
 std::optional<double> truth_of(const json& result, const std::string& name) {
@@ -390,7 +417,6 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   const json& rows_j = s["rows"];
   const json* sigma_j = find(s, "least_squares_noise_std");
   if (sigma_j) expect(*sigma_j, json::value_t::object, "sensitivity.least_squares_noise_std");
-  const json* units_j = find(s, "units");
   std::vector<std::string> names, compensations;
   for (const char* name : kRateErrorNames)
     for (const auto& row : rows_j)
@@ -416,8 +442,7 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   if (names.empty()) return;
   std::vector<std::string> header = {"machine error", "magnitude"};
   for (const auto& name : names) {
-    std::string unit = units_j && units_j->is_object() ? string_or(*units_j, name) : "";
-    if (unit.empty()) unit = unit_of(result, name);
+    const std::string unit = estimate_unit(s, result, name);
     const auto sigma = sigma_j ? number(*sigma_j, name, "sensitivity.least_squares_noise_std") : std::nullopt;
     for (const auto& comp : ordered_comp)
       header.push_back(fmt::format("{} [{}], {}{}", name, unit, comp,
@@ -427,9 +452,7 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const json& row = rows_j[k];
     const std::string where = fmt::format("sensitivity.rows[{}].least_squares", k);
-    std::vector<Cell> cells = {
-        text_cell(row_labels[k]),
-        num_cell(fmt::format("{} {}", num(number(row, "value", where)), string_or(row, "unit")))};
+    std::vector<Cell> cells = {text_cell(row_labels[k]), num_cell(sensitivity_magnitude(row, where))};
     const json* ls = find(row, "least_squares");
     for (const auto& name : names) {
       // Zero where no sigma is given: then no cell is shaded.
@@ -447,8 +470,9 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   out += table(header, rows, "wrap");
 }
 
-void sensitivity(const json& result, Page& page, std::string& out) {
-  const json& s = member(result, "sensitivity", "the result");
+/// The heat maps of a sensitivity study `s` (sensitivity_to_json); `result` is the whole result it is part
+/// of (or `s` itself), for the estimates' units.
+void sensitivity_study(const json& s, const json& result, Page& page, std::string& out) {
   const json& rows_j = member(s, "rows", "sensitivity");
   expect(rows_j, json::value_t::array, "sensitivity.rows");
   const json* noise_j = find(s, "noise_std");
@@ -478,12 +502,8 @@ void sensitivity(const json& result, Page& page, std::string& out) {
   const std::vector<std::string> names = ordered_names(names_set);
 
   std::vector<std::string> row_labels;
-  for (std::size_t k = 0; k < rows_j.size(); ++k) {
-    const std::string where = fmt::format("sensitivity.rows[{}]", k);
-    const std::string error = string_or(rows_j[k], "error", kDash);
-    const auto harmonic = number(rows_j[k], "harmonic", where);
-    row_labels.push_back(harmonic && *harmonic != 0 ? fmt::format("{} h{}", error, num(harmonic)) : error);
-  }
+  for (std::size_t k = 0; k < rows_j.size(); ++k)
+    row_labels.push_back(sensitivity_row_label(rows_j[k], fmt::format("sensitivity.rows[{}]", k)));
 
   // The scale: shift/sigma when noise_std gives the sigma of every estimate, else the shift itself.
   // Shared by all compensations so that their maps compare at a glance; logarithmic because shifts
@@ -538,8 +558,7 @@ void sensitivity(const json& result, Page& page, std::string& out) {
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const std::string where = fmt::format("sensitivity.rows[{}]", k);
     significant_rows[k].push_back(text_cell(row_labels[k]));
-    significant_rows[k].push_back(
-        num_cell(fmt::format("{} {}", num(number(rows_j[k], "value", where)), string_or(rows_j[k], "unit"))));
+    significant_rows[k].push_back(num_cell(sensitivity_magnitude(rows_j[k], where)));
   }
   for (const auto& comp : ordered_comp) {
     json colours = json::array(), tips = json::array();
@@ -552,8 +571,8 @@ void sensitivity(const json& result, Page& page, std::string& out) {
       for (const auto& name : names) {
         const json* v = m ? find(*m, name) : nullptr;
         const std::optional<double> given = v ? number(*v, where + "." + name) : std::nullopt;
-        const std::string unit = unit_of(result, name);
-        const std::string magnitude = fmt::format("{} = {} {}", string_or(row, "error", kDash),
+        const std::string unit = estimate_unit(s, result, name);
+        const std::string magnitude = fmt::format("{} = {} {}", row_labels[k],
                                                   num(number(row, "value", where)), string_or(row, "unit"));
         if (!given) {
           crow.push_back("#d9d9d9");
@@ -601,10 +620,16 @@ void sensitivity(const json& result, Page& page, std::string& out) {
   sensitivity_rate_errors(result, s, row_labels, out);
 }
 
-void montecarlo(const json& result, Page& page, std::string& out) {
-  const json& m = member(result, "montecarlo", "the result");
+void sensitivity(const json& result, Page& page, std::string& out) {
+  sensitivity_study(member(result, "sensitivity", "the result"), result, page, out);
+}
+
+/// The distributions and budget of a Monte Carlo run `m` (montecarlo_to_json); `result` is the whole result
+/// it is part of (or `m` itself), for the estimates' units.
+void montecarlo_run(const json& m, const json& result, Page& page, std::string& out) {
   expect(m, json::value_t::object, "montecarlo");
-  if (const auto trials = number(m, "trials", "montecarlo"))
+  // A run on its own page says its trials in its settings (montecarlo_settings).
+  if (const auto trials = number(m, "trials", "montecarlo"); trials && &m != &result)
     out += fmt::format("<p>{} trials.</p>\n", esc(num(trials, 12)));
   if (const json* c = find(m, "coefficients")) {
     expect(*c, json::value_t::object, "montecarlo.coefficients");
@@ -649,8 +674,8 @@ void montecarlo(const json& result, Page& page, std::string& out) {
       grid += page.plot(chart.to_json(), 220, "histogram of " + name + " over the Monte Carlo trials",
                         "plot cell");
     }
-    out += table({"estimate", "mean", "standard deviation", "predicted std",
-                  "z std (error / stated \xCF\x83)", "unit"},
+    out += table({"estimate", "mean error (estimate \xE2\x88\x92 truth)", "standard deviation of the error",
+                  "predicted std", "z std (error / stated \xCF\x83)", "unit"},
                  rows, "compact");
     out += not_identifiable_notes(find(m, "not_identifiable"), "montecarlo.not_identifiable");
     if (!grid.empty()) out += "<h3>Distributions</h3>\n<div class=\"grid\">\n" + grid + "</div>\n";
@@ -703,6 +728,108 @@ void montecarlo(const json& result, Page& page, std::string& out) {
   }
 }
 
+void montecarlo(const json& result, Page& page, std::string& out) {
+  montecarlo_run(member(result, "montecarlo", "the result"), result, page, out);
+}
+
+/// The dwells' table of data_quality.dwells (calibration_to_json): one row per dwell in time order, its
+/// columns in the order a reader follows a dwell (what was planned, what was measured, what was dropped and
+/// why it ended), the `dropped` object spread into one column per reason; any field a later gyrocal adds
+/// follows under its own name.
+void dwell_table(const json& dwells, std::string& out) {
+  expect(dwells, json::value_t::array, "data_quality.dwells");
+  out += "<h3>Dwells</h3>\n";
+  if (dwells.empty()) {
+    out += "<p>No dwell in the record was used.</p>\n";
+    return;
+  }
+  struct Column {
+    std::string_view key, header;
+  };
+  static constexpr Column kBefore[] = {{"index", "index"},
+                                       {"static", "kind"},
+                                       {"rate_rad_s", "planned rate, rad/s"},
+                                       {"measured_rate_rad_s", "measured rate, rad/s"},
+                                       {"beta_deg", "\xCE\xB2, deg"},
+                                       {"gamma_deg", "\xCE\xB3 (static), deg"},
+                                       {"start_s", "start, s"},
+                                       {"end_s", "end, s"},
+                                       {"rows", "rows"},
+                                       {"rows_used", "rows used"}};
+  static constexpr Column kDropped[] = {{"settle", "settling"},
+                                        {"beyond_planned", "beyond the plan"},
+                                        {"encoder_glitches", "encoder glitches"},
+                                        {"before_leaving", "before leaving"},
+                                        {"outliers", "outliers"}};
+  static constexpr Column kAfter[] = {{"gaps", "gaps"}, {"ended", "steady run ended"}, {"reason", "reason"}};
+  // The columns any dwell has: the known ones in the order above, then the others alphabetically.
+  const auto any_has = [&](std::string_view key) {
+    return std::any_of(dwells.begin(), dwells.end(),
+                       [&](const json& d) { return d.is_object() && find(d, key) != nullptr; });
+  };
+  std::set<std::string> known, dropped_keys;
+  for (const auto& c : kBefore) known.emplace(c.key);
+  for (const auto& c : kAfter) known.emplace(c.key);
+  known.emplace("dropped");
+  std::set<std::string> others;
+  for (std::size_t k = 0; k < dwells.size(); ++k) {
+    expect(dwells[k], json::value_t::object, fmt::format("data_quality.dwells[{}]", k));
+    for (const auto& [key, v] : dwells[k].items())
+      if (!known.count(key)) others.insert(key);
+    if (const json* d = find(dwells[k], "dropped")) {
+      expect(*d, json::value_t::object, fmt::format("data_quality.dwells[{}].dropped", k));
+      for (const auto& [key, v] : d->items()) dropped_keys.insert(key);
+    }
+  }
+  std::vector<std::string> header;
+  const bool numbered = !any_has("index");
+  if (numbered) header.emplace_back("dwell");
+  for (const auto& c : kBefore)
+    if (any_has(c.key)) header.emplace_back(c.header);
+  std::vector<std::string> dropped_order;
+  for (const auto& c : kDropped)
+    if (dropped_keys.erase(std::string(c.key))) {
+      dropped_order.emplace_back(c.key);
+      header.push_back("dropped: " + std::string(c.header));
+    }
+  for (const auto& key : dropped_keys) {
+    dropped_order.push_back(key);
+    header.push_back("dropped: " + key);
+  }
+  for (const auto& c : kAfter)
+    if (any_has(c.key)) header.emplace_back(c.header);
+  header.insert(header.end(), others.begin(), others.end());
+
+  std::vector<std::vector<Cell>> rows;
+  for (std::size_t k = 0; k < dwells.size(); ++k) {
+    const json& d = dwells[k];
+    std::vector<Cell> row;
+    if (numbered) row.push_back(num_cell(std::to_string(k + 1)));
+    for (const auto& c : kBefore) {
+      if (!any_has(c.key)) continue;
+      const json* v = find(d, c.key);
+      if (c.key == "static" && v && v->is_boolean())
+        row.push_back(text_cell(v->get<bool>() ? "static" : "spinning"));
+      else
+        row.push_back(value_cell(v));
+    }
+    const json* dropped = find(d, "dropped");
+    for (const auto& key : dropped_order) row.push_back(value_cell(dropped ? find(*dropped, key) : nullptr));
+    for (const auto& c : kAfter)
+      if (any_has(c.key)) {
+        row.push_back(value_cell(find(d, c.key)));
+        // A sentence: wide enough to read in a few lines.
+        if (!row.back().numeric) row.back().cls = "sentence";
+      }
+    for (const auto& key : others) row.push_back(value_cell(find(d, key)));
+    rows.push_back(std::move(row));
+  }
+  out +=
+      "<p class=\"note\">Each dwell the calibration used, in time order: the steady run the record held, the "
+      "rows that entered the estimate and the rows dropped from it, by reason.</p>\n";
+  out += table(header, rows, "wrap dense");
+}
+
 void data_quality(const json& result, Page&, std::string& out) {
   const json& q = member(result, "data_quality", "the result");
   expect(q, json::value_t::object, "data_quality");
@@ -713,24 +840,28 @@ void data_quality(const json& result, Page&, std::string& out) {
       {text_cell("samples rejected as outliers"), num_cell(num(number(q, "outliers", "data_quality"), 15))},
       {text_cell("breaks in the time series inside dwells"),
        num_cell(num(number(q, "gaps", "data_quality"), 15))}};
+  if (find(q, "encoder_glitch_rows"))
+    rows.push_back({text_cell("rows dropped inside dwells: their encoders left the line"),
+                    num_cell(num(number(q, "encoder_glitch_rows", "data_quality"), 15))});
   if (read && used && *read > 0)
     rows.push_back(
         {text_cell("share of the rows used"), num_cell(fmt::format("{:.1f} %", 100.0 * *used / *read))});
   // Fields a later gyrocal may add: shown as they are.
   for (const auto& [key, v] : q.items()) {
-    if (key == "rows_read" || key == "rows_used" || key == "outliers" || key == "gaps" || key == "dwells")
+    if (key == "rows_read" || key == "rows_used" || key == "outliers" || key == "gaps" || key == "dwells" ||
+        key == "rejected" || key == "encoder_glitch_rows")
       continue;
     rows.push_back({text_cell(key), v.is_number() ? num_cell(value_text(v)) : text_cell(value_text(v))});
   }
   out += table({"", "count"}, rows, "compact");
-  if (const json* dwells = find(q, "dwells")) {
-    expect(*dwells, json::value_t::array, "data_quality.dwells");
-    out += "<h3>Dwells</h3>\n";
-    if (dwells->empty()) {
-      out += "<p>No dwell lost data.</p>\n";
-    } else {
-      out += "<p class=\"note\">What was dropped from each dwell, and why.</p>\n";
-      out += generic_table(*dwells, {"index", "reason"}, "data_quality.dwells");
+  if (const json* dwells = find(q, "dwells")) dwell_table(*dwells, out);
+  if (const json* rejected = find(q, "rejected")) {
+    expect(*rejected, json::value_t::array, "data_quality.rejected");
+    if (!rejected->empty()) {
+      out +=
+          "<h3>Steady runs that gave no dwell</h3>\n<p class=\"note\">Parts of the record where the machine "
+          "held a steady rate that no planned dwell could use, and why.</p>\n";
+      out += generic_table(*rejected, {"start_s", "end_s", "reason"}, "data_quality.rejected");
     }
   }
 }
@@ -831,8 +962,177 @@ bool has(const json& result, std::string_view key) {
   return find(result, key) != nullptr;
 }
 
+/// Where the result came from: the record, the configuration, the gyrocal that wrote it (its marker,
+/// docs/interface.md) and what it is. The plan has its own section.
+void provenance(const json& result, Page&, std::string& out) {
+  std::vector<std::vector<Cell>> rows;
+  const auto code_cell = [](std::string_view text) {
+    return Cell{"<code>" + esc(text) + "</code>", false, "", ""};
+  };
+  if (const json* r = find(result, "record"))
+    rows.push_back({text_cell("record"), code_cell(scalar_text(*r))});
+  if (const json* c = find(result, "config"))
+    rows.push_back({text_cell("configuration"), c->is_null()
+                                                    ? text_cell("the built-in default scenario (no --config)")
+                                                    : code_cell(scalar_text(*c))});
+  if (const json* m = find(result, kResultMarkerKey)) {
+    expect(*m, json::value_t::object, kResultMarkerKey);
+    rows.push_back({text_cell("written by"), text_cell("gyrocal " + string_or(*m, "version", kDash))});
+    rows.push_back({text_cell("result"), text_cell(string_or(*m, "result", kDash))});
+  }
+  if (const json* g = find(result, "gyro_model"))
+    rows.push_back({text_cell("gyro model"), text_cell(scalar_text(*g))});
+  out += table({"", ""}, rows, "compact");
+  if (!has(result, "plan") && has(result, "positions"))
+    out += "<p class=\"note\">The result does not hold its test plan.</p>\n";
+}
+
+bool has_provenance(const json& r) {
+  return has(r, "record") || has(r, "config") || has(r, kResultMarkerKey);
+}
+
+// --- the page of a sensitivity study (`gyrocal sensitivity --json`) ---------------------------------
+
+/// The study's settings and the noise standard uncertainty of every estimate, the scale of the heat maps.
+void sensitivity_settings(const json& s, Page&, std::string& out) {
+  std::vector<std::vector<Cell>> rows;
+  if (const json* rows_j = find(s, "rows"); rows_j && rows_j->is_array())
+    rows.push_back({text_cell("machine errors studied (a harmonic is a row per phase)"),
+                    num_cell(std::to_string(rows_j->size()))});
+  if (has(s, "threshold"))
+    rows.push_back({text_cell("an estimate is affected from a shift of (noise \xCF\x83)"),
+                    num_cell(num(number(s, "threshold", "the study")))});
+  if (const json* g = find(s, "gyro_model"))
+    rows.push_back({text_cell("gyro model of least squares"), text_cell(scalar_text(*g))});
+  out += table({"", ""}, rows, "compact");
+  out +=
+      "<p class=\"note\">The seed paper's study (Wang &amp; Meng 2017; docs/physics.md section 10): each "
+      "machine "
+      "error of the configuration alone, at its configured magnitude (or a typical one where the "
+      "configuration has zero), shifts each estimate of a noise-free calibration by the exact amount shown, "
+      "with each compensation: none, <em>seed</em> (the paper's correction: the counter platform's "
+      "perpendicularity, wobble tilt and rate mismatch only) and <em>full</em> (every configured "
+      "error).</p>\n";
+  const json* closed = find(s, "noise_std");
+  const json* ls = find(s, "least_squares_noise_std");
+  if (closed) expect(*closed, json::value_t::object, "noise_std");
+  if (ls) expect(*ls, json::value_t::object, "least_squares_noise_std");
+  std::set<std::string> names;
+  for (const json* m : {closed, ls})
+    if (m)
+      for (const auto& [name, v] : m->items()) names.insert(name);
+  if (names.empty()) return;
+  std::vector<std::vector<Cell>> sigma_rows;
+  for (const auto& name : ordered_names(names))
+    sigma_rows.push_back({text_cell(name),
+                          num_cell(num(closed ? number(*closed, name, "noise_std") : std::nullopt, 3)),
+                          num_cell(num(ls ? number(*ls, name, "least_squares_noise_std") : std::nullopt, 3)),
+                          text_cell(estimate_unit(s, s, name))});
+  out += "<h3>Noise standard uncertainty of each estimate</h3>\n";
+  out += table({"estimate", "closed form \xCF\x83", "least squares \xCF\x83", "unit"}, sigma_rows, "compact");
+}
+
+/// Least squares' estimates shifted by more than the threshold, per machine error and compensation.
+void sensitivity_least_squares(const json& s, Page&, std::string& out) {
+  const json& rows_j = member(s, "rows", "the study");
+  expect(rows_j, json::value_t::array, "rows");
+  std::vector<std::string> compensations;
+  for (const auto& row : rows_j)
+    if (const json* m = find(row, "least_squares_matters"); m && m->is_object())
+      for (const auto& [comp, v] : m->items())
+        if (std::find(compensations.begin(), compensations.end(), comp) == compensations.end())
+          compensations.push_back(comp);
+  std::vector<std::string> ordered_comp;
+  for (const char* c : {"none", "seed", "full", "self"})
+    if (std::find(compensations.begin(), compensations.end(), c) != compensations.end())
+      ordered_comp.push_back(c);
+  std::vector<std::vector<Cell>> rows;
+  for (std::size_t k = 0; k < rows_j.size(); ++k) {
+    const json& row = rows_j[k];
+    const std::string where = fmt::format("rows[{}]", k);
+    std::vector<Cell> cells = {text_cell(sensitivity_row_label(row, where)),
+                               num_cell(sensitivity_magnitude(row, where))};
+    const json* m = find(row, "least_squares_matters");
+    for (const auto& comp : ordered_comp) {
+      const json* names = m ? find(*m, comp) : nullptr;
+      std::string text = names ? value_text(*names) : std::string();
+      cells.push_back(text_cell(text.empty() ? kDash : text));
+    }
+    rows.push_back(std::move(cells));
+  }
+  std::vector<std::string> header = {"machine error", "magnitude"};
+  for (const auto& comp : ordered_comp) header.push_back("compensation " + comp);
+  out += fmt::format(
+      "<p class=\"note\">The estimates of a least-squares calibration that each machine error alone shifts "
+      "by "
+      "more than {} noise standard uncertainties ({} = none).</p>\n",
+      esc(num(number(s, "threshold", "the study"))), kDash);
+  out += table(header, rows, "wrap");
+}
+
+void sensitivity_maps(const json& s, Page& page, std::string& out) {
+  sensitivity_study(s, s, page, out);
+}
+
+bool has_least_squares_matters(const json& s) {
+  const json* rows = find(s, "rows");
+  return rows && rows->is_array() && std::any_of(rows->begin(), rows->end(), [](const json& r) {
+           return find(r, "least_squares_matters");
+         });
+}
+
+const Section kSensitivitySections[] = {
+    {"provenance", "provenance", "Provenance", provenance, has_provenance},
+    {"study", "study", "The study", sensitivity_settings,
+     [](const json& s) { return has(s, "threshold") || has(s, "noise_std"); }},
+    {"sensitivity", "sensitivity", "Closed forms: shift of every estimate per machine error",
+     sensitivity_maps, [](const json& s) { return has(s, "rows"); }},
+    {"least_squares", "least-squares", "Least squares: the estimates each machine error shifts",
+     sensitivity_least_squares, has_least_squares_matters},
+};
+
+// --- the page of a Monte Carlo run (`gyrocal montecarlo --json`) -------------------------------------
+
+void montecarlo_settings(const json& m, Page&, std::string& out) {
+  std::vector<std::vector<Cell>> rows;
+  const auto item = [&](std::string_view key, std::string_view label) {
+    if (const json* j = find(m, key); j && !j->is_null())
+      rows.push_back({text_cell(label),
+                      j->is_number() ? num_cell(num(number(*j, key), 15)) : text_cell(scalar_text(*j))});
+  };
+  item("trials", "trials");
+  item("mode", "mode (fast: linearised; samples: each trial simulated and reduced)");
+  item("seed", "random seed");
+  item("method", "method");
+  item("compensation", "compensation");
+  item("gyro_model", "gyro model");
+  out += table({"", ""}, rows, "compact");
+  out +=
+      "<p class=\"note\">Each trial draws the machine errors of <code>[uncertainty]</code> about their "
+      "configured values and the noise, and calibrates with the configured values: the spread of the error "
+      "(estimate \xE2\x88\x92 truth) is the uncertainty the machine's imperfect knowledge adds.</p>\n";
+  if (const json* sources = find(m, "sources")) {
+    expect(*sources, json::value_t::array, "sources");
+    out += "<h3>Error sources</h3>\n";
+    out += generic_table(*sources, {"name", "std", "unit"}, "sources");
+  }
+}
+
+void montecarlo_body(const json& m, Page& page, std::string& out) {
+  montecarlo_run(m, m, page, out);
+}
+
+const Section kMonteCarloSections[] = {
+    {"provenance", "provenance", "Provenance", provenance, has_provenance},
+    {"run", "run", "The run", montecarlo_settings,
+     [](const json& m) { return has(m, "trials") || has(m, "sources"); }},
+    {"montecarlo", "montecarlo", "Distributions and variance budget", montecarlo_body,
+     [](const json& m) { return has(m, "coefficients") || has(m, "budget"); }},
+};
+
 /// The table of the sections of a result's report: it drives both the page and its navigation.
 const Section kResultSections[] = {
+    {"provenance", "provenance", "Provenance", provenance, has_provenance},
     {"summary", "summary", "Summary", summary,
      [](const json& r) {
        return has(r, "method") || has(r, "compensation") || has(r, "g_level") || has(r, "warnings");
@@ -862,6 +1162,14 @@ const Section kResultSections[] = {
 
 std::span<const Section> result_sections() {
   return kResultSections;
+}
+
+std::span<const Section> sensitivity_sections() {
+  return kSensitivitySections;
+}
+
+std::span<const Section> montecarlo_sections() {
+  return kMonteCarloSections;
 }
 
 }  // namespace gyrocal::report

@@ -11,8 +11,9 @@
 namespace gyrocal {
 
 struct HtmlReportOptions {
-  /// Shown as the page title and the first heading.
-  std::string title = "gyrocal calibration report";
+  /// Shown as the page title and the first heading; empty = the kind's own ("gyrocal calibration report",
+  /// "gyrocal sensitivity report", ...: result_kind).
+  std::string title;
   /// Where the result came from (usually its file name), shown in the header; empty = not shown.
   std::string source;
   /// Date and time shown in the header; empty = now, UTC, ISO 8601.
@@ -27,15 +28,40 @@ struct HtmlReportOptions {
 /// number beyond the range of a double, and for arrays and objects nested more than 64 levels deep.
 nlohmann::json parse_result_json(std::string_view text, const std::string& source_name);
 
-/// Renders the HTML report of `result` (a JSON object with any of the sections of docs/report.md:
-/// method/compensation/g_level/warnings, plan, data_quality, coefficients with truth, machine_errors,
-/// combinations, alternatives, comparison, positions, sensitivity, montecarlo). Sections that are absent are
-/// left out; the navigation lists exactly the sections drawn. Every string from `result` is escaped.
+/// The key of gyrocal's own marker in every result JSON that gyrocal writes (docs/interface.md, "Files"):
+/// `"gyrocal": {"result": KIND, "version": "X.Y.Z"}`. It tells `report` which page to draw and lets `--json`
+/// replace an earlier result of gyrocal without --force.
+inline constexpr std::string_view kResultMarkerKey = "gyrocal";
+
+/// The kinds of result gyrocal writes, as the marker names them.
+inline constexpr std::string_view kResultKinds[] = {"calibration", "plan",  "sensitivity",
+                                                    "montecarlo",  "noise", "inputs"};
+
+/// Adds gyrocal's marker to `result` (a JSON object): `"gyrocal": {"result": kind, "version": this
+/// gyrocal's}`.
+void mark_result(nlohmann::json& result, std::string_view kind);
+
+/// True when `result` is a JSON object carrying gyrocal's marker with one of kResultKinds.
+bool has_result_marker(const nlohmann::json& result);
+
+/// The kind of a result: its marker's, else (a result written before the marker, or by Python) from its
+/// shape: `allan` = noise, `rows` without `coefficients` = sensitivity, `budget` or `trials` = montecarlo,
+/// `specific_force_g` = inputs, anything else a calibration (a calibration, a plan or the demo's
+/// result.json).
+std::string result_kind(const nlohmann::json& result);
+
+/// Renders the HTML report of `result`, the page of its kind (result_kind): a calibration or plan result (a
+/// JSON object with any of the sections of docs/report.md: method/compensation/g_level/warnings, plan,
+/// data_quality, coefficients with truth, machine_errors, combinations, alternatives, comparison, positions,
+/// sensitivity, montecarlo), a sensitivity study (heat maps), a Monte Carlo run (histograms and budget) or a
+/// noise characterisation (render_noise_html_report). Sections that are absent are left out; the
+/// navigation lists exactly the sections drawn. Every string from `result` is escaped.
 /// Throws gyrocal::Error if `result` is not a JSON object.
 std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options = {});
 
 /// The names of the report's sections that `result` has (summary, plan, data_quality, coefficients,
-/// machine_errors, ...), in report order (empty if none: `gyrocal report` then refuses the file).
+/// machine_errors, ...; those of its kind's page), in report order (empty if none: `gyrocal report` then
+/// refuses the file).
 std::vector<std::string> report_sections_present(const nlohmann::json& result);
 
 /// The first bytes of every report (of a result or of a noise characterisation): an existing file that
