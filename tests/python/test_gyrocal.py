@@ -308,7 +308,7 @@ def test_noise_of_a_record_of_the_output_alone_equals_the_full_records(tmp_path)
     write_record_csv(alone, {"time_s": time_s, "gyro_deg_h": rate})
     from_full, from_alone = gyrocal.noise(str(full)), gyrocal.noise(str(alone))
     assert from_alone["allan"] == from_full["allan"]
-    assert from_alone == json.loads(run_cli("noise", alone, "--json", "-").stdout)
+    assert from_alone == cli_result(run_cli("noise", alone, "--json", "-").stdout)
 
 
 # --- errors -----------------------------------------------------------------------------------------------------
