@@ -22,6 +22,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
@@ -40,28 +41,25 @@ using Column = py::array_t<double, py::array::c_style | py::array::forcecast>;
 /// The JSON as the Python objects json.loads gives for the command line's text, so that a dict from the
 /// module equals the command line's JSON parsed by Python (NaN written as null, as the command line writes
 /// it).
-py::object json_to_python(const nlohmann::json& j) {
+py::object json_to_python(const nlohmann::ordered_json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
 }
 
-/// The options `gyrocal calibrate` builds: the scenario's [reduce] and [calibration] reduction, the method
-/// overridden by `reduction` unless it is empty (None in Python).
-CalibrationOptions calibration_options(const Scenario& scenario, const std::string& method,
-                                       const std::string& compensation, const std::string& reduction,
-                                       const std::vector<std::string>& estimate) {
-  CalibrationOptions options;
-  options.estimate = parse_machine_error_names(estimate, "estimate");
-  options.method = parse_method(method);
-  options.compensation = parse_compensation(compensation);
-  options.reduce = scenario.reduce;
-  if (reduction == "harmonic") {
-    options.reduce.method = ReduceOptions::Method::kHarmonicFit;
-  } else if (reduction == "window") {
-    options.reduce.method = ReduceOptions::Method::kWindowMean;
-  } else if (!reduction.empty()) {
-    throw Error("unknown reduction '" + reduction + "': use harmonic or window.");
-  }
-  return options;
+/// The options `gyrocal calibrate` builds, by the same library function (identify/scenario_options.hpp):
+/// each choice left empty (None in Python) takes the scenario's [calibration] gyro_model, estimate and
+/// reduction; [reduce] applies always.
+CalibrationOptions python_calibration_options(const Scenario& scenario, const std::string& method,
+                                              const std::string& compensation, const std::string& reduction,
+                                              const std::optional<std::vector<std::string>>& estimate,
+                                              const std::string& gyro_model) {
+  CalibrationChoices choices;
+  choices.method = method;
+  choices.compensation = compensation;
+  choices.estimate = estimate;
+  choices.estimate_source = "estimate";
+  choices.gyro_model = gyro_model;
+  choices.reduction = reduction;
+  return calibration_options(scenario, choices);
 }
 
 /// Checks that a dict's columns make a record the reader would accept: one dimension, the same length, finite
@@ -89,6 +87,15 @@ void check_columns(const std::vector<const Column*>& columns, const std::vector<
 }
 
 py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double beta_deg) {
+  // As `gyrocal inputs`, which refuses a number that is not finite (--beta-deg nan, --time-s inf).
+  if (!std::isfinite(beta_deg))
+    throw Error(fmt::format("beta_deg must be a finite number, not {}.", beta_deg));
+  if (time_s.ndim() != 1)
+    throw Error(
+        fmt::format("time_s has {} dimensions; give a number or a one-dimensional array.", time_s.ndim()));
+  for (py::ssize_t i = 0; i < time_s.size(); ++i)
+    if (!std::isfinite(time_s.data()[i]))
+      throw Error(fmt::format("time_s[{}] must be a finite number, not {}.", i, time_s.data()[i]));
   const CentrifugeModel model = scenario.model();
   // As `gyrocal inputs --time-s`: a spinning dwell at the configured rate, beta in radians from degrees.
   const double rate = scenario.centrifuge.rate_rad_s, beta = beta_deg * kDegToRad;
@@ -134,9 +141,11 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
 
 py::object calibrate_path_py(const std::string& path, const Scenario& scenario, const std::string& method,
                              const std::string& compensation, const std::string& reduction,
-                             const std::vector<std::string>& estimate) {
-  const CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
-  nlohmann::json j;
+                             const std::optional<std::vector<std::string>>& estimate,
+                             const std::string& gyro_model) {
+  const CalibrationOptions options =
+      python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
+  nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;
     j = calibration_to_json(
@@ -149,12 +158,14 @@ py::object calibrate_path_py(const std::string& path, const Scenario& scenario, 
 py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, const Column& counter_deg,
                                const Column& position_deg, const Column& gyro_deg_h, const Scenario& scenario,
                                const std::string& method, const std::string& compensation,
-                               const std::string& reduction, const std::vector<std::string>& estimate,
-                               const std::string& name) {
-  const CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
+                               const std::string& reduction,
+                               const std::optional<std::vector<std::string>>& estimate,
+                               const std::string& gyro_model, const std::string& name) {
+  const CalibrationOptions options =
+      python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
   check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
-  nlohmann::json j;
+  nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;
     // What calibrate_record does, with the rows from the arrays instead of a RecordReader.

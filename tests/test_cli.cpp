@@ -76,6 +76,7 @@ TEST_F(Cli, InputsJsonMatchesTheIndependentPoseForARandomConfiguration) {
     s.site.latitude_rad = 60 * kDegToRad * u(rng);
     s.centrifuge.radius_m = 1.5 + u(rng);
     s.centrifuge.rate_rad_s = 8 * u(rng);
+    s.test.rates_rad_s = {s.centrifuge.rate_rad_s};  // one rate, one place (docs/interface.md)
     s.centrifuge.heading_rad = 3 * u(rng);
     s.centrifuge.initial_main_angle_rad = 3 * u(rng);
     s.errors.base_tilt_x_rad = 30 * kArcsecToRad * u(rng);

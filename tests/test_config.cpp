@@ -1,5 +1,6 @@
 // The configuration file: round trips, units, defaults, and every kind of bad value refused with its key
 // and line (docs/contract.md, "Configuration (TOML)").
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -14,9 +15,14 @@
 
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
+#include "support/cli_run.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
@@ -149,6 +155,7 @@ void expect_same(const Scenario& a, const Scenario& b) {
   expect_same(a.test.beta_rad, b.test.beta_rad, "test.beta");
   expect_same(a.test.gamma_rad, b.test.gamma_rad, "test.gamma");
   expect_same(a.test.rates_rad_s, b.test.rates_rad_s, "test.rates");
+  expect_same(a.test.static_hold_s, b.test.static_hold_s, "test.static_hold_s");
   EXPECT_EQ(a.test.seed, b.test.seed);
   expect_same(a.uncertainty, b.uncertainty, "uncertainty.");
   expect_same(a.reduce, b.reduce);
@@ -194,8 +201,10 @@ Scenario changed_scenario() {
   s.test.settle_s = 0.5;
   s.test.beta_rad = {45.0 * kDegToRad, 135.0 * kDegToRad};
   s.test.gamma_rad = {10.0 * kDegToRad, 20.0 * kDegToRad, 30.0 * kDegToRad};
-  s.test.rates_rad_s = {0.0, 5.0, -9.9};
+  // The centrifuge's rate (-12.5) is one of the test's, not its first: written beside them.
+  s.test.rates_rad_s = {0.0, 5.0, -12.5};
   s.test.seed = 123456789012345ULL;
+  s.test.static_hold_s = 42.5;
   CentrifugeErrors& u = s.uncertainty;
   u.base_tilt_x_rad = 0.5 * kArcsecToRad;
   u.counter_perpendicularity_x_rad = 0.3 * kArcsecToRad;
@@ -232,6 +241,8 @@ TEST(Config, RandomValuesRoundTripBitForBit) {
     s.site.latitude_rad = 90.0 * unit(rng) * kDegToRad;
     s.site.gravity_m_s2 = std::abs(random_value()) + 1e-3;
     s.centrifuge.rate_rad_s = random_value();
+    s.test.rates_rad_s = {s.centrifuge.rate_rad_s};  // one rate, one place (written once, in [test])
+    s.test.static_hold_s = std::abs(random_value());
     s.centrifuge.heading_rad = random_value() * kDegToRad;
     s.errors.counter_perpendicularity_x_rad = random_value() * kArcsecToRad;
     s.errors.lever_arm_m = Eigen::Vector3d(random_value(), random_value(), random_value());
@@ -325,8 +336,8 @@ TEST(Config, TestRatesDefaultToTheCentrifugeRate) {
   const Scenario alone = parse_scenario("[centrifuge]\nrate_rad_s = 5.5\n", "rate.toml");
   EXPECT_EQ(alone.test.rates_rad_s, std::vector<double>{5.5});
   const Scenario both =
-      parse_scenario("[centrifuge]\nrate_rad_s = 5.5\n[test]\nrates_rad_s = [0, 3.0]\n", "rate.toml");
-  EXPECT_EQ(both.centrifuge.rate_rad_s, 5.5);
+      parse_scenario("[centrifuge]\nrate_rad_s = 3.0\n[test]\nrates_rad_s = [0, 3.0]\n", "rate.toml");
+  EXPECT_EQ(both.centrifuge.rate_rad_s, 3.0);
   EXPECT_EQ(both.test.rates_rad_s, (std::vector<double>{0.0, 3.0}));
 }
 
@@ -571,6 +582,189 @@ TEST(ConfigReduce, WrongTypesAndUnknownKeysAreRefused) {
   expect_refused("[calibration]\nreduction = \"mean\"\n", 2, "calibration.reduction",
                  "\"harmonic\" or \"window\"");
   expect_refused("reduce = 3\n", 1, "reduce", "must be a table");
+}
+
+// ---- one rate, one place: [centrifuge] rate_rad_s and [test] rates_rad_s (issue 20, item 7) ---------------
+
+/// The 1-based line of text on which `what` begins.
+int line_of(const std::string& text, const std::string& what) {
+  const std::size_t at = text.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+TEST(ConfigRates, ACentrifugeRateThatIsNotATestRateIsRefusedNamingBothKeys) {
+  // The issue's case: the file `init` writes, its [centrifuge] rate_rad_s set to 5.0 while [test] still says
+  // rates_rad_s = [9.9]. The test would run at 9.9 rad/s: one of the two keys would be ignored.
+  std::string text = scenario_to_toml(default_scenario());
+  const std::string commented = "# rate_rad_s = 9.9";
+  const std::size_t at = text.find(commented);
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, commented.size(), "rate_rad_s = 5.0");
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find("bad.toml, line " + std::to_string(line_of(text, "rate_rad_s = 5.0")) +
+                         ": centrifuge.rate_rad_s = 5 is not one of test.rates_rad_s = [9.9] (line " +
+                         std::to_string(line_of(text, "rates_rad_s = [9.9]")) + ")"),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  // The same by hand, the test's rates first.
+  expect_refused("[test]\nrates_rad_s = [0, 3.0]\n[centrifuge]\nrate_rad_s = 5.5\n", 4,
+                 "centrifuge.rate_rad_s = 5.5 is not one of test.rates_rad_s = [0, 3] (line 2)",
+                 "give the rates in test.rates_rad_s alone");
+}
+
+TEST(ConfigRates, EitherKeyAloneOrBothAgreeingIsRead) {
+  // [test] rates_rad_s alone: the centrifuge's rate (`inputs`' rate) follows its first non-zero rate.
+  const Scenario rates = parse_scenario("[test]\nrates_rad_s = [0, 3.0, 7.0]\n", "rates.toml");
+  EXPECT_EQ(rates.centrifuge.rate_rad_s, 3.0);
+  EXPECT_EQ(rates.test.rates_rad_s, (std::vector<double>{0.0, 3.0, 7.0}));
+  // A static test keeps the default scenario's rate (it sizes the holds without static_hold_s).
+  const Scenario stopped = parse_scenario("[test]\nrates_rad_s = [0]\n", "stopped.toml");
+  EXPECT_EQ(stopped.centrifuge.rate_rad_s, default_scenario().centrifuge.rate_rad_s);
+  // Both, the centrifuge's rate one of the test's (not the first: `inputs` at the second rate).
+  const Scenario both =
+      parse_scenario("[centrifuge]\nrate_rad_s = 7.0\n[test]\nrates_rad_s = [0, 3.0, 7.0]\n", "both.toml");
+  EXPECT_EQ(both.centrifuge.rate_rad_s, 7.0);
+  // A static test with the centrifuge's rate: any rate (the one its holds are sized by).
+  const Scenario hold =
+      parse_scenario("[centrifuge]\nrate_rad_s = 5.5\n[test]\nrates_rad_s = [0]\n", "h.toml");
+  EXPECT_EQ(hold.centrifuge.rate_rad_s, 5.5);
+  EXPECT_EQ(hold.test.rates_rad_s, std::vector<double>{0.0});
+}
+
+TEST(ConfigRates, InitWritesTheRateOnceSoEditingTheTestRatesMovesBoth) {
+  const std::string init = scenario_to_toml(default_scenario());
+  // rate_rad_s is there, commented out: the only rate the reader sees is [test] rates_rad_s.
+  EXPECT_NE(init.find("\n# rate_rad_s = 9.9 "), std::string::npos) << init;
+  EXPECT_EQ(init.find("\nrate_rad_s ="), std::string::npos) << init;
+  std::string edited = init;
+  const std::string rates = "rates_rad_s = [9.9]";
+  edited.replace(edited.find(rates), rates.size(), "rates_rad_s = [0.0, 5.0]");
+  const Scenario s = parse_scenario(edited, "edited.toml");
+  EXPECT_EQ(s.centrifuge.rate_rad_s, 5.0);
+  EXPECT_EQ(s.test.rates_rad_s, (std::vector<double>{0.0, 5.0}));
+}
+
+TEST(ConfigRates, AScenarioWhoseRatesDisagreeIsNotWritten) {
+  Scenario s = default_scenario();
+  s.centrifuge.rate_rad_s = 5.0;  // the test still at 9.9: a file holding both would be refused
+  try {
+    (void)scenario_to_toml(s);
+    ADD_FAILURE() << "written";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("rate_rad_s 5 is not one of its [test] rates_rad_s [9.9]"), std::string::npos)
+        << message;
+  }
+}
+
+// ---- a static hold's own duration: [test] static_hold_s (issue 20, item 7) ------------------------------
+
+/// The durations of the timeline's measurements of `kind`, s.
+std::vector<double> durations(const Timeline& t, SegmentKind kind) {
+  std::vector<double> out;
+  for (const MeasurementInterval& m : t.measurements)
+    if (m.kind == kind) out.push_back(m.end_s - m.start_s);
+  return out;
+}
+
+TEST(ConfigStaticHold, AStaticHoldLastsStaticHoldS) {
+  const Scenario s =
+      parse_scenario("[test]\nrates_rad_s = [0, 9.9]\nrevolutions = 20\nstatic_hold_s = 7.5\n", "hold.toml");
+  EXPECT_EQ(s.test.static_hold_s, 7.5);
+  const Timeline t = make_timeline(s.test, s.model());
+  const std::vector<double> holds = durations(t, SegmentKind::kHold);
+  ASSERT_EQ(holds.size(), 16u);  // 4 betas x 4 gammas at rate 0
+  for (const double h : holds) EXPECT_NEAR(h, 7.5, 1e-9);
+  // The spinning dwells keep their whole revolutions: 20 periods of 9.9 rad/s.
+  for (const double d : durations(t, SegmentKind::kDwell))
+    EXPECT_NEAR(d, 20 * 2 * std::numbers::pi / 9.9, 1e-9);
+  // The issue's 5.3 h static record: one key, not revolutions = 30000.
+  const Scenario day = parse_scenario(
+      "[test]\nrates_rad_s = [0]\nbeta_deg = [0]\ngamma_deg = [0]\nstatic_hold_s = 19080\n", "day.toml");
+  const std::vector<double> day_holds = durations(make_timeline(day.test, day.model()), SegmentKind::kHold);
+  ASSERT_EQ(day_holds.size(), 1u);
+  EXPECT_NEAR(day_holds[0], 5.3 * 3600, 1e-6);
+  // The test's size counts the holds at their own length: 16 holds of (7.5 s + 2 s settle) and 4 dwells of
+  // (20 periods + 2 s), at 200 Hz.
+  EXPECT_NEAR(planned_test_samples(s.test, s.centrifuge.rate_rad_s),
+              (16 * (7.5 + 2.0) + 4 * (20 * 2 * std::numbers::pi / 9.9 + 2.0)) * 200.0, 1e-6);
+  expect_refused("[test]\nstatic_hold_s = -1.0\n", 2, "test.static_hold_s", ">= 0");
+}
+
+TEST(ConfigStaticHold, WithoutTheKeyAHoldLastsTheRevolutionsOfTheFirstSpinningRateAsBefore) {
+  const Scenario s = parse_scenario("[test]\nrates_rad_s = [0, 4.0, 9.9]\nrevolutions = 30\n", "old.toml");
+  EXPECT_EQ(s.test.static_hold_s, 0.0);
+  const Timeline t = make_timeline(s.test, s.model());
+  for (const double h : durations(t, SegmentKind::kHold))
+    EXPECT_NEAR(h, 30 * 2 * std::numbers::pi / 4.0, 1e-9);
+  // init writes the key with its default, which reads back as the old rule.
+  EXPECT_NE(scenario_to_toml(default_scenario()).find("\nstatic_hold_s = 0.0 "), std::string::npos);
+}
+
+TEST(ConfigStaticHold, AStaticTestWithoutAnyRateIsSimulatedAndReducedWithItsOwnHolds) {
+  // No rate anywhere (the centrifuge's is 0 too): before static_hold_s such a test could not be planned.
+  const Scenario s = parse_scenario(
+      "[centrifuge]\nrate_rad_s = 0.0\n[test]\nrates_rad_s = [0]\nbeta_deg = [0, 90]\nstatic_hold_s = 4.0\n"
+      "settle_s = 1.0\n",
+      "static.toml");
+  const Reduction r = testing::simulate_and_reduce(s, 1);
+  ASSERT_EQ(r.dwells.size(), 8u);  // 2 betas x 4 gammas
+  for (const Dwell& d : r.dwells) {
+    EXPECT_TRUE(d.is_static);
+    EXPECT_NEAR(d.planned_duration_s, 4.0, 1e-9);
+    // 4 s at 200 Hz, less the samples the reducer's guards drop at the ends.
+    EXPECT_GT(d.samples, 700u);
+    EXPECT_LE(d.samples, 801u);
+  }
+}
+
+// ---- README's static record for `noise` (issue 20, item 7) ------------------------------------------------
+
+TEST(ConfigStaticHold, ReadmeSimulatesTheStaticRecordThatNoiseReads) {
+  // The commands of README.md's block after the marker "static-record", run as written (build/gyrocal is this
+  // build's command line), so that the README cannot drift from what works.
+  const std::string readme =
+      test::slurp(std::filesystem::path(GYROCAL_TEST_DATA_DIR) / ".." / ".." / "README.md");
+  const std::size_t marker = readme.find("<!-- static-record");
+  ASSERT_NE(marker, std::string::npos);
+  const std::size_t begin = readme.find("```sh\n", marker);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = readme.find("\n```", begin + 6);
+  ASSERT_NE(end, std::string::npos);
+  const std::string block = readme.substr(begin + 6, end + 1 - (begin + 6));
+  const std::filesystem::path dir = test::fresh_test_folder("gyrocal-readme");
+  std::filesystem::create_directories(dir / "build");
+  std::filesystem::create_symlink(GYROCAL_CLI, dir / "build" / "gyrocal");
+  { std::ofstream(dir / "block.sh") << block; }
+  const std::string command = "cd '" + dir.string() + "' && sh -e block.sh >out.txt 2>err.txt";
+  ASSERT_EQ(std::system(command.c_str()), 0) << block << test::slurp(dir / "err.txt");
+  // The record: the main axis stopped, one hour at 100 Hz.
+  std::ifstream record(dir / "static.csv");
+  std::string line;
+  std::size_t rows = 0;
+  double last_time = 0.0;
+  while (std::getline(record, line)) {
+    if (line.empty() || line[0] == '#' || line.starts_with("time_s")) continue;
+    std::istringstream fields(line);
+    std::string time, main;
+    std::getline(fields, time, ',');
+    std::getline(fields, main, ',');
+    last_time = std::stod(time);
+    EXPECT_NEAR(std::stod(main), 0.0, 1e-6) << line;
+    if (HasFailure()) break;
+    ++rows;
+  }
+  EXPECT_NEAR(last_time, 3600.0, 0.02);
+  EXPECT_NEAR(static_cast<double>(rows), 3600.0 * 100, 2.0);
+  // noise read it and found the configured angle random walk, 0.002 deg/sqrt(h) (an hour at 100 Hz measures
+  // it to about 0.2 %).
+  const nlohmann::json noise = nlohmann::json::parse(test::slurp(dir / "noise.json"));
+  ASSERT_TRUE(noise.contains("terms")) << noise.dump();
+  EXPECT_NEAR(noise["terms"]["angle_random_walk_deg_rt_h"]["value"].get<double>(), 0.002, 0.02 * 0.002)
+      << noise.dump();
+  std::filesystem::remove_all(dir);
 }
 
 // ---- files ----------------------------------------------------------------------------------------------

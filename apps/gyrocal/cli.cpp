@@ -89,7 +89,7 @@ void write_output(const std::string& path, std::string_view content, OutputKind 
   file->commit();
 }
 
-void write_result(const std::string& path, nlohmann::json result, std::string_view kind, bool force) {
+void write_result(const std::string& path, nlohmann::ordered_json result, std::string_view kind, bool force) {
   mark_result(result, kind);
   write_output(path, result.dump(2) + "\n", OutputKind::kResult, force, "--json");
 }

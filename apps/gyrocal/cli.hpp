@@ -46,7 +46,7 @@ void write_output(const std::string& path, std::string_view content, OutputKind 
 
 /// Writes `result` as the JSON of a `kind` result (kResultKinds: calibration, plan, sensitivity, montecarlo,
 /// noise, inputs) to `path` (--json), with gyrocal's marker added (mark_result), by the rule of open_output.
-void write_result(const std::string& path, nlohmann::json result, std::string_view kind, bool force);
+void write_result(const std::string& path, nlohmann::ordered_json result, std::string_view kind, bool force);
 
 /// --force for the commands whose outputs follow open_output's rule: replace any existing file.
 void add_force_flag(CLI::App* sub, bool& force);

@@ -4,6 +4,7 @@
 #include "cli.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/record_check.hpp"
+#include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
@@ -43,18 +44,14 @@ void register_calibrate(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
     const Scenario s = load_configuration(opt->config);
-    CalibrationOptions options;
-    options.method = parse_method(opt->method);
-    options.compensation = parse_compensation(opt->compensation);
-    options.estimate = opt->estimate.empty()
-                           ? parse_machine_error_names(s.estimate, "[calibration] estimate")
-                           : parse_machine_error_names(split_names(opt->estimate), "--estimate");
-    options.gyro_model = chosen_gyro_model(opt->gyro_model, s);
-    // [reduce] and [calibration] reduction (docs/contract.md), the method overridden by --reduction.
-    options.reduce = s.reduce;
-    if (!opt->reduction.empty())
-      options.reduce.method = opt->reduction == "window" ? ReduceOptions::Method::kWindowMean
-                                                         : ReduceOptions::Method::kHarmonicFit;
+    // The options as the library builds them for every caller (identify/scenario_options.hpp).
+    CalibrationChoices choices;
+    choices.method = opt->method;
+    choices.compensation = opt->compensation;
+    if (!opt->estimate.empty()) choices.estimate = split_names(opt->estimate);
+    choices.gyro_model = opt->gyro_model;
+    choices.reduction = opt->reduction;
+    const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
     require_angle_columns(s.record, opt->record);
     // The record's metadata against the configuration, before the record is read (docs/interface.md).
@@ -65,7 +62,7 @@ void register_calibrate(CLI::App& app) {
     CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options, s.record);
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
     if (!opt->json.empty()) {
-      nlohmann::json j = calibration_to_json(r);
+      nlohmann::ordered_json j = calibration_to_json(r);
       // Provenance (docs/interface.md): the record, the configuration (null: the built-in scenario), the
       // plan.
       j["record"] = opt->record;

@@ -73,7 +73,7 @@ void register_demo(CLI::App& app) {
     fmt::print("{}\n", main.BriefReport());
     for (const std::string& w : main.warnings) fmt::print("- {}\n", w);
 
-    nlohmann::json j = calibration_to_json(main);
+    nlohmann::ordered_json j = calibration_to_json(main);
     j["record"] = record;
     j["truth"] = coefficients_to_json(s.gyro);
     j["plan"] = plan_to_json(s.test);

@@ -3,6 +3,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
@@ -33,18 +34,18 @@ void register_plan(CLI::App& app) {
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
     const Scenario s = load_configuration(opt->config);
-    CalibrationOptions options;
-    options.method = parse_method(opt->method);
-    options.compensation = parse_compensation(opt->compensation);
-    options.estimate = opt->estimate.empty()
-                           ? parse_machine_error_names(s.estimate, "[calibration] estimate")
-                           : parse_machine_error_names(split_names(opt->estimate), "--estimate");
-    options.gyro_model = chosen_gyro_model(opt->gyro_model, s);
-    options.reduce = s.reduce;  // [reduce] and [calibration] reduction: the reduction the prediction models
+    // The options as the library builds them for every caller (identify/scenario_options.hpp); the
+    // prediction models [reduce] and [calibration] reduction.
+    CalibrationChoices choices;
+    choices.method = opt->method;
+    choices.compensation = opt->compensation;
+    if (!opt->estimate.empty()) choices.estimate = split_names(opt->estimate);
+    choices.gyro_model = opt->gyro_model;
+    const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {
-      nlohmann::json j = calibration_to_json(r);
+      nlohmann::ordered_json j = calibration_to_json(r);
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
       j["plan"] = plan_to_json(s.test);
       write_result(opt->json, std::move(j), "plan", opt->force);

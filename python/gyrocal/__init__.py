@@ -4,12 +4,13 @@
     sc = gyrocal.Scenario.load("scenario.toml")        # gyrocal.Scenario() is the default scenario
     w, f = gyrocal.exact_inputs(sc, time_s=np.linspace(0, 10, 1000), beta_deg=90.0)  # (n, 3): rad/s, g
     rec = gyrocal.simulate(sc, seed=1)                 # dict of numpy arrays named as the record's columns
-    res = gyrocal.calibrate(rec, sc, method="least-squares", compensation="full", estimate=[])
+    res = gyrocal.calibrate(rec, sc, method="least-squares", compensation="full")
     nz = gyrocal.noise("static.csv", sc)               # noise's JSON as a dict
 
 Every error of gyrocal raises ValueError with the command line's sentence.
 """
 
+import operator
 import os
 
 import numpy as np
@@ -41,35 +42,57 @@ def _column(rec, name):
 def exact_inputs(scenario, time_s, beta_deg):
     """Exact inputs to the gyro at the instants time_s (s) of a dwell at the scenario's rate and beta_deg,
     as `gyrocal inputs --time-s T --beta-deg B`: (omega, specific_force), each an (n, 3) float64 array of
-    the I, O, S components, rad/s and g. time_s is any array (flattened) or a number."""
-    t = np.ascontiguousarray(time_s, dtype=np.float64).reshape(-1)
+    the I, O, S components, rad/s and g. time_s is a number or a one-dimensional array; an array of more
+    dimensions, or a value that is not finite (as beta_deg), raises ValueError as the command line refuses
+    it."""
+    t = np.ascontiguousarray(time_s, dtype=np.float64)
+    if t.ndim == 0:
+        t = t.reshape(1)
     return _gyrocal._exact_inputs(scenario, t, float(beta_deg))
+
+
+#: The largest seed: the simulation's seed is an unsigned 64-bit integer, as --seed.
+_MAX_SEED = 2**64 - 1
 
 
 def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
-    record's columns (RECORD_COLUMNS). seed=None takes the scenario's [test] seed, as without --seed."""
-    return _gyrocal._simulate(scenario, None if seed is None else int(seed))
+    record's columns (RECORD_COLUMNS). seed=None takes the scenario's [test] seed, as without --seed; any other
+    seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
+    if seed is not None:
+        try:
+            value = operator.index(seed)
+        except TypeError:
+            raise ValueError(f"seed must be an integer from 0 to {_MAX_SEED}, not {seed!r}.") from None
+        if not 0 <= value <= _MAX_SEED:
+            raise ValueError(f"seed must be an integer from 0 to {_MAX_SEED}, not {value}.")
+        seed = value
+    return _gyrocal._simulate(scenario, seed)
 
 
-def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=(), reduction=None):
+def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=None, reduction=None,
+              gyro_model=None):
     """`gyrocal calibrate --json` as a dict. rec is a record's path (read through the scenario's [record]
     layout when its configuration has one, as `gyrocal calibrate --config`) or a mapping of arrays (a dict such
     as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
     method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
-    "window" (None: the scenario's [calibration] reduction, else "harmonic"; the scenario's [reduce] options
-    apply either way). estimate: machine errors estimated with the coefficients (self-calibration, as --estimate:
-    NAME, NAME_I/_O/_S, NAME:N; docs/self_calibration.md), a list of names or one name."""
-    if estimate is None:
-        estimate = ()
+    "window"; gyro_model: "drift" or "drift+rate"; estimate: machine errors estimated with the coefficients
+    (self-calibration, as --estimate: NAME, NAME_I/_O/_S, NAME:N; docs/self_calibration.md), a list of names or
+    one name ([] estimates none). Each of reduction, gyro_model and estimate left None takes the scenario's
+    [calibration] value, as the command line does without the option; the scenario's [reduce] options apply
+    always. The options are built by the command line's own function, so the result is its result. The
+    coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors)."""
     if isinstance(estimate, str):
         estimate = [estimate]
-    estimate = [str(name) for name in estimate]
+    if estimate is not None:
+        estimate = [str(name) for name in estimate]
     reduction = "" if reduction is None else str(reduction)
+    gyro_model = "" if gyro_model is None else str(gyro_model)
+    options = (method, compensation, reduction, estimate, gyro_model)
     if _is_path(rec):
-        return _gyrocal._calibrate_path(os.fspath(rec), scenario, method, compensation, reduction, estimate)
+        return _gyrocal._calibrate_path(os.fspath(rec), scenario, *options)
     columns = [_column(rec, name) for name in RECORD_COLUMNS]
-    return _gyrocal._calibrate_arrays(*columns, scenario, method, compensation, reduction, estimate, _ARRAYS_NAME)
+    return _gyrocal._calibrate_arrays(*columns, scenario, *options, _ARRAYS_NAME)
 
 
 def noise(rec, scenario=None):

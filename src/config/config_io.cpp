@@ -519,7 +519,46 @@ void read_test(const Reader& reader, Section& section, TestSpec& test) {
   if (const toml::node* node = section.find("seed")) {
     test.seed = static_cast<std::uint64_t>(reader.integer(*node, section.path("seed"), 0, INT64_MAX));
   }
+  section.number("static_hold_s", 1.0, kNonNegative, test.static_hold_s);
   section.reject_unknown();
+}
+
+/// The values of a list of numbers as the file would write them: "[a, b]".
+std::string list_text(const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + shortest(values[i]);
+  return text + "]";
+}
+
+/// The test's first non-zero rate, which [centrifuge] rate_rad_s follows when the file gives only [test]
+/// rates_rad_s; nullopt for a static test.
+std::optional<double> first_spinning_rate(const std::vector<double>& rates) {
+  for (const double r : rates)
+    if (r != 0.0) return r;
+  return std::nullopt;
+}
+
+/// One rate, one place (config_io.hpp): [centrifuge] rate_rad_s and [test] rates_rad_s, once both sections
+/// are read into s. `rate` and `rates` are the two keys' nodes, nullptr when the file does not give them.
+/// With only rates_rad_s the centrifuge's rate follows its first non-zero rate; with both, a centrifuge rate
+/// that is not one of the test's rates is refused, naming both keys (a test of rate 0 alone takes any: the
+/// centrifuge's rate is then `inputs`' rate and sizes the holds without static_hold_s).
+void reconcile_rates(const Reader& reader, const toml::node* rate, const toml::node* rates, Scenario& s) {
+  if (rates == nullptr) return;  // the test runs at the centrifuge's rate, set before [test] was read
+  const std::optional<double> spinning = first_spinning_rate(s.test.rates_rad_s);
+  if (rate == nullptr) {
+    if (spinning) s.centrifuge.rate_rad_s = *spinning;
+    return;
+  }
+  const std::vector<double>& list = s.test.rates_rad_s;
+  if (!spinning || std::find(list.begin(), list.end(), s.centrifuge.rate_rad_s) != list.end()) return;
+  reader.fail(rate->source(),
+              "centrifuge.rate_rad_s = " + shortest(s.centrifuge.rate_rad_s) +
+                  " is not one of test.rates_rad_s = " + list_text(list) + " (line " +
+                  std::to_string(rates->source().begin.line) +
+                  "), the rates the test runs at, so one of the two keys would be ignored; give the rates in "
+                  "test.rates_rad_s alone (centrifuge.rate_rad_s then follows its first non-zero rate), or a "
+                  "centrifuge.rate_rad_s that is one of them");
 }
 
 /// The string keys of [record] that name a column (docs/contract.md, "Records").
@@ -680,9 +719,10 @@ class TomlWriter {
   }
   /// "key = value  # note"; a note of several lines (separated by \n) continues on comment lines aligned
   /// with its first.
-  void key(std::string_view key, const std::string& value, std::string_view note) {
+  void key(std::string_view key, const std::string& value, std::string_view note,
+           bool commented_out = false) {
     constexpr std::size_t kCommentColumn = 44;
-    std::string line = std::string(key) + " = " + value;
+    std::string line = (commented_out ? "# " : "") + std::string(key) + " = " + value;
     line.resize(std::max(line.size() + 2, kCommentColumn), ' ');
     const std::size_t first_end = std::min(note.find('\n'), note.size());
     out_ << line << "# " << note.substr(0, first_end) << "\n";
@@ -798,10 +838,14 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
         "the numbers' decimal mark, \".\" or \",\" (then delimiter \";\")");
 }
 
+/// The keys, each with its value and comment; the key `commented_out` (if any) as a comment line, which the
+/// reader does not see.
 template <class S, std::size_t N>
-void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source) {
+void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source,
+                   std::string_view commented_out = {}) {
   for (const NumberKey<S>& k : keys) {
-    writer.key(k.key, toml_number(in_file_unit(source.*k.member, k.to_si)), k.comment);
+    writer.key(k.key, toml_number(in_file_unit(source.*k.member, k.to_si)), k.comment,
+               k.key == commented_out);
   }
 }
 
@@ -920,7 +964,8 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   Section site(reader, top.table("site"), "site");
   read_numbers(site, kSiteKeys, s.site);
 
-  Section centrifuge(reader, top.table("centrifuge"), "centrifuge");
+  const toml::table* centrifuge_table = top.table("centrifuge");
+  Section centrifuge(reader, centrifuge_table, "centrifuge");
   const toml::table* errors_table = centrifuge.table("errors");
   read_numbers(centrifuge, kCentrifugeKeys, s.centrifuge);
   Section errors(reader, errors_table, "centrifuge.errors");
@@ -944,8 +989,11 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
 
   // Without rates of its own, the test runs at the configured centrifuge rate (see config_io.hpp).
   s.test.rates_rad_s = {s.centrifuge.rate_rad_s};
-  Section test(reader, top.table("test"), "test");
+  const toml::table* test_table = top.table("test");
+  Section test(reader, test_table, "test");
   read_test(reader, test, s.test);
+  reconcile_rates(reader, centrifuge_table ? centrifuge_table->get("rate_rad_s") : nullptr,
+                  test_table ? test_table->get("rates_rad_s") : nullptr, s);
 
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
   read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
@@ -1064,8 +1112,22 @@ std::string scenario_to_toml(const Scenario& s) {
   w.section("site", "");
   write_numbers(w, kSiteKeys, s.site);
 
-  w.section("centrifuge", "");
-  write_numbers(w, kCentrifugeKeys, s.centrifuge);
+  // One rate, one place: when the centrifuge's rate is the one the reader derives from [test] rates_rad_s
+  // (its first non-zero rate), the key is written commented out, so that editing the test's rates moves both.
+  const std::optional<double> spinning = first_spinning_rate(s.test.rates_rad_s);
+  const std::vector<double>& rates = s.test.rates_rad_s;
+  if (spinning && std::find(rates.begin(), rates.end(), s.centrifuge.rate_rad_s) == rates.end()) {
+    throw Error("Cannot write the scenario: its centrifuge rate_rad_s " + shortest(s.centrifuge.rate_rad_s) +
+                " is not one of its [test] rates_rad_s " + list_text(rates) +
+                ", and a configuration that gives both is refused when they disagree.");
+  }
+  const bool rate_follows_test = spinning && same_bits(*spinning, s.centrifuge.rate_rad_s);
+  w.section("centrifuge", rate_follows_test
+                              ? "rate_rad_s follows [test] rates_rad_s (its first non-zero rate): "
+                                "set the test's rates there.\nGiven here, it must be one of them "
+                                "(it is the rate of `gyrocal inputs`)."
+                              : "");
+  write_numbers(w, kCentrifugeKeys, s.centrifuge, rate_follows_test ? "rate_rad_s" : "");
 
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
   write_errors(w, s.errors);
@@ -1097,10 +1159,13 @@ std::string scenario_to_toml(const Scenario& s) {
   w.key("beta_deg", number_array(t.beta_rad, kDegToRad), "position-platform angles, deg");
   w.key("gamma_deg", number_array(t.gamma_rad, kDegToRad), "arm angles read out at each beta, deg");
   w.key("rates_rad_s", number_array(t.rates_rad_s, 1.0),
-        "main rates, rad/s; absent = [centrifuge rate_rad_s]");
+        "main rates, rad/s; absent = [centrifuge] rate_rad_s");
   w.key("counter_rate_offsets_rad_s", number_array(t.counter_rate_offsets_rad_s, 1.0),
         "rate platform: per rate, one set per offset, counter at -rate + offset, rad/s");
   w.key("seed", std::to_string(t.seed), "random seed of the simulation, integer >= 0");
+  w.key("static_hold_s", toml_number(t.static_hold_s),
+        "each static hold (rate 0), s; 0 = revolutions x the period of the first\nnon-zero rate (else of "
+        "[centrifuge] rate_rad_s)");
 
   w.section(
       "uncertainty",

@@ -110,13 +110,15 @@ class Builder {
       : test_(test), limits_(limits) {
     timeline_.psi0_rad = model.geometry().heading_rad;
     timeline_.counter_rate_mismatch_rad_s = model.errors().counter_rate_mismatch_rad_s;
-    const auto first_spinning =
-        std::find_if(test.rates_rad_s.begin(), test.rates_rad_s.end(), [](double r) { return r != 0.0; });
-    timeline_.reference_rate_rad_s =
-        first_spinning != test.rates_rad_s.end() ? *first_spinning : model.geometry().rate_rad_s;
-    check(std::isfinite(timeline_.reference_rate_rad_s) && timeline_.reference_rate_rad_s != 0.0,
-          "a test with only rate 0 needs a non-zero [centrifuge] rate_rad_s to set the hold time");
-    timeline_.hold_s = revolutions_s(timeline_.reference_rate_rad_s);
+    timeline_.reference_rate_rad_s = reference_rate_rad_s(test, model.geometry().rate_rad_s);
+    check(std::isfinite(test.static_hold_s) && test.static_hold_s >= 0.0,
+          "[test] static_hold_s must be a finite number >= 0");
+    check(
+        test.static_hold_s > 0.0 ||
+            (std::isfinite(timeline_.reference_rate_rad_s) && timeline_.reference_rate_rad_s != 0.0),
+        "a test with only rate 0 needs [test] static_hold_s or a non-zero [centrifuge] rate_rad_s to set the "
+        "hold time");
+    timeline_.hold_s = static_hold_duration_s(test, timeline_.reference_rate_rad_s);
 
     // The test starts in its first position: spinning, or stopped and indexed to the first gamma.
     rate_ = test.rates_rad_s.front();

@@ -13,13 +13,8 @@ int min_samples_per_revolution(const ReduceOptions& options) {
   return 2 * (2 * options.harmonic_order + 1);
 }
 
-double planned_test_samples(const TestSpec& test, double reference_rate_rad_s) {
-  double reference = reference_rate_rad_s;
-  for (double r : test.rates_rad_s)
-    if (r != 0.0) {
-      reference = r;
-      break;
-    }
+double planned_test_samples(const TestSpec& test, double centrifuge_rate_rad_s) {
+  const double hold_s = static_hold_duration_s(test, reference_rate_rad_s(test, centrifuge_rate_rad_s));
   const double revolutions_s = static_cast<double>(test.revolutions) * 2.0 * kPi;
   const double betas = static_cast<double>(test.beta_rad.size());
   const double gammas = static_cast<double>(test.gamma_rad.size());
@@ -30,7 +25,7 @@ double planned_test_samples(const TestSpec& test, double reference_rate_rad_s) {
       if (r != 0.0 || o != 0.0)
         seconds += betas * (revolutions_s / std::abs(r - o) + test.settle_s);
       else
-        seconds += betas * gammas * (revolutions_s / std::abs(reference) + test.settle_s);
+        seconds += betas * gammas * (hold_s + test.settle_s);
     }
   return seconds * test.sample_rate_hz;
 }

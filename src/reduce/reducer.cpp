@@ -307,7 +307,7 @@ struct Reducer::State {
   RecordSummary summary;
   std::optional<RecordLayout> layout;
 
-  double hold_duration() const { return plan.revolutions * 2.0 * kPi / std::abs(reference_rate); }
+  double hold_duration() const { return static_hold_duration_s(plan, reference_rate); }
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
   bool is_gap(double dt) const { return dt > options.gap_intervals * dt_planned; }
 
@@ -939,15 +939,12 @@ Reducer::Reducer(const PlannedTest& plan, const ReduceOptions& options, std::str
   state_->plan = plan.spec;
   state_->options = options;
   state_->source = std::move(source_name);
-  state_->reference_rate = plan.reference_rate_rad_s;
   state_->dt_planned = 1.0 / plan.spec.sample_rate_hz;
-  for (double r : plan.spec.rates_rad_s)
-    if (r != 0.0) {
-      state_->reference_rate = r;
-      break;
-    }
-  if (state_->reference_rate == 0.0)
-    throw Error("the plan has no non-zero rate and no reference rate to size the static holds.");
+  state_->reference_rate = reference_rate_rad_s(plan.spec, plan.reference_rate_rad_s);
+  if (state_->reference_rate == 0.0 && !(plan.spec.static_hold_s > 0.0))
+    throw Error(
+        "the plan has no non-zero rate, no [test] static_hold_s and no reference rate to size the static "
+        "holds.");
   check_test_feasible(plan.spec, options, state_->reference_rate);
 }
 

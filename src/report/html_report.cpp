@@ -76,6 +76,10 @@ void mark_result(nlohmann::json& result, std::string_view kind) {
   result[std::string(kResultMarkerKey)] = {{"result", kind}, {"version", GYROCAL_VERSION}};
 }
 
+void mark_result(nlohmann::ordered_json& result, std::string_view kind) {
+  result[std::string(kResultMarkerKey)] = {{"result", kind}, {"version", GYROCAL_VERSION}};
+}
+
 bool has_result_marker(const nlohmann::json& result) {
   if (!result.is_object()) return false;
   const auto m = result.find(kResultMarkerKey);

@@ -7,13 +7,13 @@
 namespace gyrocal {
 namespace {
 
-nlohmann::json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+nlohmann::ordered_json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
 
 /// {name, value, std, unit} and, for a combination, the coefficients on dF..dOS it was estimated with.
-nlohmann::json named_estimate_to_json(const NamedEstimate& c) {
-  nlohmann::json j = {
+nlohmann::ordered_json named_estimate_to_json(const NamedEstimate& c) {
+  nlohmann::ordered_json j = {
       {"name", c.name}, {"value", number_or_null(c.value)}, {"std", number_or_null(c.std)}, {"unit", c.unit}};
   if (!c.coefficients.empty()) j["coefficients"] = c.coefficients;
   return j;
@@ -21,14 +21,14 @@ nlohmann::json named_estimate_to_json(const NamedEstimate& c) {
 
 }  // namespace
 
-nlohmann::json calibration_to_json(const CalibrationResult& r) {
-  nlohmann::json j;
-  nlohmann::json coefficients = nlohmann::json::object();
+nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
+  nlohmann::ordered_json j;
+  nlohmann::ordered_json coefficients = nlohmann::ordered_json::object();
   for (std::size_t k = 0; k < kNumCoefficients; ++k) {
     const CoefficientEstimate& c = r.coefficients[k];
     coefficients[std::string(kCoefficientNames[k])] = {
-        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::json(nullptr)},
-        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::json(nullptr)},
+        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
+        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
         {"unit", kCoefficientUnits[k]},
         {"identifiable", c.identifiable}};
   }
@@ -37,29 +37,29 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
     for (std::size_t k = 0; k < kNumRateTerms; ++k) {
       const CoefficientEstimate& c = r.rate_terms[k];
       coefficients[std::string(kRateTermNames[k])] = {
-          {"value", c.identifiable ? number_or_null(c.value) : nlohmann::json(nullptr)},
-          {"std", c.identifiable ? number_or_null(c.std) : nlohmann::json(nullptr)},
+          {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
+          {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
           {"unit", kRateTermUnits[k]},
           {"identifiable", c.identifiable}};
       if (!c.identifiable && !c.reason.empty())
         coefficients[std::string(kRateTermNames[k])]["reason"] = c.reason;
     }
   j["coefficients"] = coefficients;
-  j["combinations"] = nlohmann::json::array();
+  j["combinations"] = nlohmann::ordered_json::array();
   for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
-  j["alternatives"] = nlohmann::json::array();
+  j["alternatives"] = nlohmann::ordered_json::array();
   for (const NamedEstimate& c : r.alternatives) j["alternatives"].push_back(named_estimate_to_json(c));
-  j["positions"] = nlohmann::json::array();
+  j["positions"] = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const ReducedPosition& p = r.positions[i];
-    nlohmann::json e = {{"index", p.index},
-                        {"beta_deg", p.beta_rad * kRadToDeg},
-                        {"gamma_deg", p.gamma_rad * kRadToDeg},
-                        {"rate_rad_s", p.rate_rad_s},
-                        {"mean_deg_h", p.mean_deg_h},
-                        {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
-                        {"samples", p.samples},
-                        {"outliers", p.outliers}};
+    nlohmann::ordered_json e = {{"index", p.index},
+                                {"beta_deg", p.beta_rad * kRadToDeg},
+                                {"gamma_deg", p.gamma_rad * kRadToDeg},
+                                {"rate_rad_s", p.rate_rad_s},
+                                {"mean_deg_h", p.mean_deg_h},
+                                {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
+                                {"samples", p.samples},
+                                {"outliers", p.outliers}};
     if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
     if (i < r.residuals_deg_h.size()) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
     j["positions"].push_back(e);
@@ -83,24 +83,25 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
                          {"gaps", r.data_quality.gaps},
                          {"encoder_glitch_rows", r.data_quality.encoder_glitch_rows}};
   if (r.data_quality.rows_read > 0) {
-    nlohmann::json dwells = nlohmann::json::array(), rejected = nlohmann::json::array();
+    nlohmann::ordered_json dwells = nlohmann::ordered_json::array(),
+                           rejected = nlohmann::ordered_json::array();
     for (const DataQuality::Dwell& d : r.data_quality.dwells) {
-      nlohmann::json j_d = {{"static", d.is_static},
-                            {"rate_rad_s", d.rate_rad_s},
-                            {"measured_rate_rad_s", d.measured_rate_rad_s},
-                            {"beta_deg", d.beta_deg},
-                            {"start_s", d.start_s},
-                            {"end_s", d.end_s},
-                            {"rows", d.rows},
-                            {"rows_used", d.rows_used},
-                            {"dropped",
-                             {{"settle", d.settle_rows},
-                              {"beyond_planned", d.beyond_planned_rows},
-                              {"encoder_glitches", d.encoder_glitch_rows},
-                              {"before_leaving", d.before_leaving_rows},
-                              {"outliers", d.outliers}}},
-                            {"gaps", d.gaps},
-                            {"ended", d.ended}};
+      nlohmann::ordered_json j_d = {{"static", d.is_static},
+                                    {"rate_rad_s", d.rate_rad_s},
+                                    {"measured_rate_rad_s", d.measured_rate_rad_s},
+                                    {"beta_deg", d.beta_deg},
+                                    {"start_s", d.start_s},
+                                    {"end_s", d.end_s},
+                                    {"rows", d.rows},
+                                    {"rows_used", d.rows_used},
+                                    {"dropped",
+                                     {{"settle", d.settle_rows},
+                                      {"beyond_planned", d.beyond_planned_rows},
+                                      {"encoder_glitches", d.encoder_glitch_rows},
+                                      {"before_leaving", d.before_leaving_rows},
+                                      {"outliers", d.outliers}}},
+                                    {"gaps", d.gaps},
+                                    {"ended", d.ended}};
       if (d.is_static) j_d["gamma_deg"] = d.gamma_deg;
       dwells.push_back(std::move(j_d));
     }
@@ -112,18 +113,19 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
   j["unidentifiable"] = r.unidentifiable;
   // The self-calibration's estimated machine errors (docs/contract.md, machine_errors).
   if (!r.machine_errors.empty()) {
-    j["machine_errors"] = nlohmann::json::array();
+    j["machine_errors"] = nlohmann::ordered_json::array();
     for (const MachineErrorEstimate& e : r.machine_errors) {
-      nlohmann::json m = {{"error", e.error},
-                          {"harmonic", e.harmonic},
-                          {"value", e.identifiable ? number_or_null(e.value) : nlohmann::json(nullptr)},
-                          {"std", e.identifiable ? number_or_null(e.std) : nlohmann::json(nullptr)},
-                          {"unit", e.unit},
-                          {"configured", e.configured},
-                          {"identifiable", e.identifiable}};
+      nlohmann::ordered_json m = {
+          {"error", e.error},
+          {"harmonic", e.harmonic},
+          {"value", e.identifiable ? number_or_null(e.value) : nlohmann::ordered_json(nullptr)},
+          {"std", e.identifiable ? number_or_null(e.std) : nlohmann::ordered_json(nullptr)},
+          {"unit", e.unit},
+          {"configured", e.configured},
+          {"identifiable", e.identifiable}};
       if (!e.part.empty()) m["part"] = e.part;
       if (!e.identifiable) m["reason"] = e.reason;
-      nlohmann::json correlations = nlohmann::json::object();
+      nlohmann::ordered_json correlations = nlohmann::ordered_json::object();
       for (const auto& [name, r_value] : e.correlations)
         if (std::isfinite(r_value)) correlations[name] = r_value;
       m["correlations"] = correlations;
@@ -134,8 +136,8 @@ nlohmann::json calibration_to_json(const CalibrationResult& r) {
   return j;
 }
 
-nlohmann::json coefficients_to_json(const DriftCoefficients& c) {
-  nlohmann::json j = nlohmann::json::object();
+nlohmann::ordered_json coefficients_to_json(const DriftCoefficients& c) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
   for (std::size_t k = 0; k < kNumCoefficients; ++k) j[std::string(kCoefficientNames[k])] = c.values[k];
   return j;
 }

@@ -124,16 +124,30 @@ def test_exact_inputs_equal_cli_bit_for_bit(config, small):
             assert same_bits(force[i], expected["specific_force_g"]), (t, beta)
 
 
-def test_exact_inputs_take_a_number_or_any_array():
+def test_exact_inputs_take_a_number_or_a_one_dimensional_array():
     sc = gyrocal.Scenario()
     w1, f1 = gyrocal.exact_inputs(sc, time_s=2.5, beta_deg=90.0)
-    w2, f2 = gyrocal.exact_inputs(sc, time_s=[[0.0, 2.5]], beta_deg=90)
+    w2, f2 = gyrocal.exact_inputs(sc, time_s=[0.0, 2.5], beta_deg=90)
     assert w1.shape == (1, 3) and w2.shape == (2, 3)
     assert same_bits(w1[0], w2[1]) and same_bits(f1[0], f2[1])
     # Physics, roughly (physics.md section 4): the counter-rotating platform cancels the main rate of 9.9 rad/s,
     # so the gyro sees about the Earth's rate; the specific force is gravity plus the centripetal omega^2 R (1 m).
     assert 5e-5 < np.linalg.norm(w1[0]) < 1e-3
     assert np.linalg.norm(f1[0]) == pytest.approx(math.hypot(1.0, 9.9**2 * 1.0 / 9.80665), rel=1e-2)
+
+
+def test_exact_inputs_refuse_what_the_command_line_refuses():
+    # issue 20, item 9: a beta or a time that is not finite, as `gyrocal inputs` refuses it, and a 2-D time array,
+    # whose rows would otherwise be flattened silently into one list of instants.
+    sc = gyrocal.Scenario()
+    assert run_cli("inputs", "--beta-deg", "nan", "--time-s", "1", check=False).returncode != 0
+    with pytest.raises(ValueError, match="beta_deg must be a finite number, not nan"):
+        gyrocal.exact_inputs(sc, time_s=1.0, beta_deg=float("nan"))
+    assert run_cli("inputs", "--beta-deg", "0", "--time-s", "inf", check=False).returncode != 0
+    with pytest.raises(ValueError, match=r"time_s\[1\] must be a finite number, not inf"):
+        gyrocal.exact_inputs(sc, time_s=[0.0, np.inf], beta_deg=0.0)
+    with pytest.raises(ValueError, match="time_s has 2 dimensions"):
+        gyrocal.exact_inputs(sc, time_s=[[0.0, 2.5]], beta_deg=0.0)
 
 
 # --- simulate ---------------------------------------------------------------------------------------------------
@@ -161,6 +175,16 @@ def test_simulate_default_seed_is_the_scenarios(small, tmp_path):
     assert same_bits(rec["gyro_deg_h"], expected["gyro_deg_h"])
     # Another seed gives another noise (so the test above does compare the seed).
     assert not same_bits(gyrocal.simulate(sc, seed=4)["gyro_deg_h"], expected["gyro_deg_h"])
+
+
+def test_simulate_refuses_a_seed_that_is_not_a_non_negative_integer(small):
+    # issue 20, item 9: a ValueError as for every other bad argument (pybind11 raised TypeError for -1).
+    _, sc = small
+    for seed in (-1, 2**64, 1.5, "3"):
+        with pytest.raises(ValueError, match="seed must be an integer from 0 to 18446744073709551615"):
+            gyrocal.simulate(sc, seed=seed)
+    # The largest seed and a NumPy integer are seeds.
+    assert len(gyrocal.simulate(sc, seed=2**64 - 1)["time_s"]) == len(gyrocal.simulate(sc, seed=np.uint64(5))["time_s"])
 
 
 # --- calibrate --------------------------------------------------------------------------------------------------
@@ -213,6 +237,49 @@ def test_calibrate_takes_the_scenarios_reduction_and_reduce_options(tmp_path):
     plain.write_text(SMALL_TEST)
     with_default_window = gyrocal.calibrate(str(record), gyrocal.Scenario.load(str(plain)), reduction="window")
     assert gyrocal.calibrate(str(record), sc)["coefficients"] != with_default_window["coefficients"]
+
+
+def test_calibrate_takes_the_scenarios_gyro_model_and_estimate(tmp_path):
+    # issue 20, item 9: [calibration] gyro_model and estimate apply in Python as on the command line (the options
+    # are built by one library function): drift+rate gives the 13 coefficients, the estimate its machine error.
+    config = tmp_path / "rate.toml"
+    config.write_text(SMALL_TEST + '[calibration]\ngyro_model = "drift+rate"\nestimate = ["counter_perpendicularity_x"]\n')
+    sc = gyrocal.Scenario.load(str(config))
+    record = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--out", record)
+    result = tmp_path / "result.json"
+    run_cli("calibrate", record, "--config", config, "--json", result)
+    expected = json.loads(result.read_text())
+    assert len(expected["coefficients"]) == 13 and len(expected["machine_errors"]) == 1
+    got = gyrocal.calibrate(str(record), sc)
+    assert got == expected
+    assert len(got["coefficients"]) == 13
+    assert [e["error"] for e in got["machine_errors"]] == ["counter_perpendicularity_x"]
+    # The call's own choices override the scenario's, as --gyro-model and --estimate do.
+    run_cli("calibrate", record, "--config", config, "--gyro-model", "drift", "--estimate", "counter_rate_mismatch",
+            "--json", result)
+    overridden = gyrocal.calibrate(str(record), sc, gyro_model="drift", estimate=["counter_rate_mismatch"])
+    assert overridden == json.loads(result.read_text())
+    assert len(overridden["coefficients"]) == 10
+    # An empty list estimates nothing (the command line has no way to say so but leaving out [calibration]).
+    assert "machine_errors" not in gyrocal.calibrate(str(record), sc, estimate=[])
+    with pytest.raises(ValueError, match="unknown gyro model 'rate'"):
+        gyrocal.calibrate(str(record), sc, gyro_model="rate")
+
+
+def test_coefficients_come_in_the_contract_order(small, tmp_path):
+    # docs/contract.md orders the coefficients dF dI dO dS dII dOO dSS dIO dIS dOS; the command line's JSON and the
+    # module's dict keep that order (json.loads keeps the text's order), not the alphabet's.
+    config, sc = small
+    contract = ["dF", "dI", "dO", "dS", "dII", "dOO", "dSS", "dIO", "dIS", "dOS"]
+    record = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--out", record)
+    cli = run_cli("calibrate", record, "--config", config, "--json", "-")
+    assert list(json.loads(cli.stdout)["coefficients"]) == contract
+    assert list(gyrocal.calibrate(str(record), sc)["coefficients"]) == contract
+    rate = gyrocal.calibrate(str(record), sc, gyro_model="drift+rate")
+    assert list(rate["coefficients"]) == contract + [
+        "scale_factor_error_ppm", "input_axis_misalignment_O_arcsec", "input_axis_misalignment_S_arcsec"]
 
 
 def test_calibrate_takes_a_mapping_with_more_columns(small):

@@ -4,9 +4,14 @@
 // scenario holds SI values (docs/physics.md section 1). Every key is optional and defaults to
 // default_scenario().
 //
-// Relation of [centrifuge] rate_rad_s and [test] rates_rad_s: rate_rad_s is the main rate of a single
-// instant (`gyrocal inputs`), rates_rad_s the rates of the test. When [test] has no rates_rad_s, the test
-// runs at the configured centrifuge rate alone: rates_rad_s = [rate_rad_s].
+// Relation of [centrifuge] rate_rad_s and [test] rates_rad_s (one rate, one place; docs/interface.md):
+// rate_rad_s is the main rate of a single instant (`gyrocal inputs`), rates_rad_s the rates of the test.
+// When [test] has no rates_rad_s, the test runs at the configured centrifuge rate alone: rates_rad_s =
+// [rate_rad_s]. When [centrifuge] has no rate_rad_s, it follows the test's first non-zero rate (the default
+// scenario's rate for a test of rate 0 alone). A file that gives both, with a centrifuge rate that is not one
+// of the test's rates is refused naming both keys (a test of rate 0 alone accepts any centrifuge
+// rate: it sizes the static holds when [test] static_hold_s is 0). The writer writes rate_rad_s commented out
+// when it is the test's first non-zero rate, so that a file from `init` holds the rate in one place.
 //
 // [uncertainty] has the keys of [centrifuge.errors] with their units; each value is the standard
 // uncertainty of that error (all zero by default). In a harmonic term, amplitude is the standard
@@ -40,7 +45,8 @@ Scenario load_scenario(const std::filesystem::path& path);
 /// and unit. Numbers are written in their shortest exact form, so that parse_scenario gives back s bit for
 /// bit whenever s's angles are reachable from the file's units (any scenario that parse_scenario returned,
 /// default_scenario() included; an arbitrary SI angle may come back within one unit in the last place).
-/// Throws Error if test.seed exceeds the largest TOML integer (2^63 - 1).
+/// Throws Error if test.seed exceeds the largest TOML integer (2^63 - 1), or if centrifuge.rate_rad_s is not
+/// one of a spinning test's rates_rad_s (a file holding both would be refused when read).
 std::string scenario_to_toml(const Scenario& s);
 
 /// A number as a TOML float that reads back bit for bit: the shortest form, with ".0" added where it would

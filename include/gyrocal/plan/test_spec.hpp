@@ -1,5 +1,6 @@
 #pragma once
 // The test as configured (configuration section [test]): which positions, rates, and how long.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -18,6 +19,25 @@ struct TestSpec {
   /// the counter platform turning at -rate + offset relative to the arm, rad/s. {0} = the plain test.
   std::vector<double> counter_rate_offsets_rad_s = {0.0};
   std::uint64_t seed = 1;  ///< random seed of the simulation
+  /// Each static hold's duration (rate 0), s (>= 0). 0 = revolutions whole periods of the reference rate
+  /// (static_hold_duration_s), the rule before this key existed, so that a configuration without it keeps
+  /// its holds.
+  double static_hold_s = 0.0;
 };
+
+/// The rate that sizes a static hold when static_hold_s is 0: the test's first non-zero rate, else
+/// `centrifuge_rate_rad_s` (the configuration's [centrifuge] rate_rad_s), rad/s.
+inline double reference_rate_rad_s(const TestSpec& test, double centrifuge_rate_rad_s) {
+  for (const double r : test.rates_rad_s)
+    if (r != 0.0) return r;
+  return centrifuge_rate_rad_s;
+}
+
+/// Each static hold's duration, s: static_hold_s when it is > 0, else revolutions * 2 pi / |reference rate|
+/// (infinite for a reference rate of 0, which the planner and the reducer refuse).
+inline double static_hold_duration_s(const TestSpec& test, double reference_rate_rad_s) {
+  if (test.static_hold_s > 0.0) return test.static_hold_s;
+  return test.revolutions * (2.0 * kPi) / std::abs(reference_rate_rad_s);
+}
 
 }  // namespace gyrocal

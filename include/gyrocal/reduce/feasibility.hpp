@@ -18,8 +18,9 @@ inline constexpr double kMaxTestSamples = 1e10;
 int min_samples_per_revolution(const ReduceOptions& options);
 
 /// The number of samples of the test's measured part (dwells, holds, settle intervals; moves not counted).
-/// reference_rate_rad_s sizes a static hold when the plan has no non-zero rate.
-double planned_test_samples(const TestSpec& test, double reference_rate_rad_s);
+/// A static hold lasts static_hold_duration_s (plan/test_spec.hpp); centrifuge_rate_rad_s sizes it when the
+/// test has neither [test] static_hold_s nor a non-zero rate.
+double planned_test_samples(const TestSpec& test, double centrifuge_rate_rad_s);
 
 /// Throws gyrocal::Error naming the [test] key at fault when a record of `test` cannot be reduced with
 /// `options`: too few samples per revolution at a rate (with the sample rate it needs), a non-zero rate

@@ -40,6 +40,8 @@ inline constexpr std::string_view kResultKinds[] = {"calibration", "plan",  "sen
 /// Adds gyrocal's marker to `result` (a JSON object): `"gyrocal": {"result": kind, "version": this
 /// gyrocal's}`.
 void mark_result(nlohmann::json& result, std::string_view kind);
+/// The same for a result whose keys keep their written order (calibration_to_json's).
+void mark_result(nlohmann::ordered_json& result, std::string_view kind);
 
 /// True when `result` is a JSON object carrying gyrocal's marker with one of kResultKinds.
 bool has_result_marker(const nlohmann::json& result);
