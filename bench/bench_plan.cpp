@@ -19,3 +19,5 @@ BENCHMARK(BM_Plan)->Arg(200)->Arg(20000)->Arg(2000000)->Unit(benchmark::kMillise
 
 }  // namespace
 }  // namespace gyrocal
+
+BENCHMARK_MAIN();
