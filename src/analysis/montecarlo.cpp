@@ -85,14 +85,19 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoeff
   return out;
 }
 
-/// Noise-free reduced outputs (deg/h) of scenario s's test, in plan order.
-Eigen::VectorXd noise_free_outputs(const Scenario& s, const ReduceOptions& ro) {
-  Reduction r = planned_reduction(s);
-  set_noise_free_outputs(r, reduce_model_channels(r, s.model(), ro), s.gyro, s.gyro_rate);
-  Eigen::VectorXd w(static_cast<Eigen::Index>(r.positions.size()));
-  for (std::size_t i = 0; i < r.positions.size(); ++i)
-    w[static_cast<Eigen::Index>(i)] = r.positions[i].mean_deg_h;
-  return w;
+/// True when the dwells of a and b lie on the same encoder lines at the same samples: a calibration then
+/// evaluates the same model channels on both.
+bool same_encoder_lines(const Reduction& a, const Reduction& b) {
+  if (a.dwells.size() != b.dwells.size()) return false;
+  for (std::size_t i = 0; i < a.dwells.size(); ++i) {
+    const Dwell &x = a.dwells[i], &y = b.dwells[i];
+    if (x.first_time_s != y.first_time_s || x.samples != y.samples ||
+        x.sample_interval_s != y.sample_interval_s || x.main.at_first_rad != y.main.at_first_rad ||
+        x.main.rate_rad_s != y.main.rate_rad_s || x.counter.at_first_rad != y.counter.at_first_rad ||
+        x.counter.rate_rad_s != y.counter.rate_rad_s)
+      return false;
+  }
+  return true;
 }
 
 /// Mean, M2 (sum of squared deviations), min, max of a chunk of trials, per estimate.
@@ -184,17 +189,41 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
       map(i, k) = e[static_cast<std::size_t>(i)] - m.bias[static_cast<std::size_t>(i)];
   }
 
-  // Each source's effect on W at one standard uncertainty: (W(e0 + u) - W(e0 - u)) / 2, the drawn machine
-  // reduced on its own plan (its encoders), exact to second order.
+  // Each source's effect on the estimates at one standard uncertainty, (E(e0 + u) - E(e0 - u)) / 2, exact to
+  // second order: the drawn machine reduced on its own planned encoder lines, as a record of it would be.
+  // Where the drawn machine's encoder lines are the configured one's, the calibration sees the same channels
+  // and the effect is the affine map of the outputs' change. Where they differ (counter_rate_mismatch turns
+  // the platform's heading, which its encoder measures), a record's calibration evaluates the configured
+  // model on the drawn lines: the channels follow the heading, and the effect is that whole calibration's
+  // (docs/montecarlo.md, "The sources through the encoders").
   const auto ns = static_cast<Eigen::Index>(m.sources.size());
-  Eigen::MatrixXd ju(np, ns);
+  Eigen::MatrixXd effect(ne, ns);
   parallel_for(static_cast<std::size_t>(ns), options.threads, [&](std::size_t s) {
-    Scenario plus = scenario, minus = scenario;
-    m.sources[s].term.add_to(plus.errors, m.sources[s].std_si);
-    m.sources[s].term.add_to(minus.errors, -m.sources[s].std_si);
-    const Eigen::VectorXd wp = noise_free_outputs(plus, ro), wm = noise_free_outputs(minus, ro);
-    if (wp.size() != np || wm.size() != np) throw Error("Monte Carlo: a drawn machine changes the plan.");
-    ju.col(static_cast<Eigen::Index>(s)) = 0.5 * (wp - wm);
+    Eigen::VectorXd side[2];
+    for (int k = 0; k < 2; ++k) {
+      Scenario drawn = scenario;
+      m.sources[s].term.add_to(drawn.errors, (k == 0 ? 1.0 : -1.0) * m.sources[s].std_si);
+      Reduction r = planned_reduction(drawn);
+      if (static_cast<Eigen::Index>(r.positions.size()) != np)
+        throw Error("Monte Carlo: a drawn machine changes the plan.");
+      set_noise_free_outputs(r, reduce_model_channels(r, drawn.model(), ro), scenario.gyro,
+                             scenario.gyro_rate);
+      if (same_encoder_lines(r, r0)) {
+        Eigen::VectorXd dw(np);
+        for (Eigen::Index i = 0; i < np; ++i)
+          dw[i] = r.positions[static_cast<std::size_t>(i)].mean_deg_h -
+                  r0.positions[static_cast<std::size_t>(i)].mean_deg_h;
+        side[k] = map * dw;
+      } else {
+        set_predicted_std_errors(r, scenario.noise, scenario.test.sample_rate_hz, ro);
+        const std::vector<double> e =
+            estimate_errors(identify(r, reduce_model_channels(r, model0, ro), model0, m.calibration),
+                            scenario.gyro, scenario.gyro_rate, m.names, nullptr, nullptr);
+        side[k] = Eigen::Map<const Eigen::VectorXd>(e.data(), ne) -
+                  Eigen::Map<const Eigen::VectorXd>(m.bias.data(), ne);
+      }
+    }
+    effect.col(static_cast<Eigen::Index>(s)) = 0.5 * (side[0] - side[1]);
   });
 
   // The gyro's noise through the reduction as a factor L of its covariance, n = L xi: white noise, bias
@@ -217,7 +246,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     }
   }
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> g(ne, ns + np);
-  g.leftCols(ns) = map * ju;
+  g.leftCols(ns) = effect;
   g.rightCols(np) = map * chol;
   m.gain.assign(g.data(), g.data() + g.size());
   return m;

@@ -11,6 +11,7 @@
 #include <Eigen/Cholesky>
 #include <limits>
 
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
@@ -251,6 +252,18 @@ Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& r, const Red
   const double walk_step = rate_random_walk_step_std_deg_h(noise.rate_random_walk_deg_h_rt_h, sample_rate_hz);
   const double s2 = walk_step * walk_step;
   if (b2 == 0.0 && s2 == 0.0) return cov;
+  // The coloured noise's covariance is not in closed form: it walks the samples and holds each dwell's
+  // operator (gammas x samples). Beyond kMaxColouredNoiseSamples it would take minutes and gigabytes, so it
+  // is refused, never left out in silence (docs/performance.md, "plan in closed form").
+  double total = 0.0;
+  for (const Dwell& d : r.dwells) total += static_cast<double>(d.samples);
+  if (total > kMaxColouredNoiseSamples)
+    throw Error(fmt::format(
+        "the bias instability and rate random walk are predicted by walking every sample of the dwells, and "
+        "this test has {:.3g} of them, more than the {:.3g} that fit in memory: lower [test] revolutions (or "
+        "sample_rate_hz), or set [gyro.noise] bias_instability_deg_h and rate_random_walk_deg_h_rt_h to 0 "
+        "for the white noise's prediction alone.",
+        total, kMaxColouredNoiseSamples));
   const std::size_t nd = r.dwells.size();
   std::vector<std::optional<Eigen::MatrixXd>> ops(nd);
   for (std::size_t d = 0; d < nd; ++d) {

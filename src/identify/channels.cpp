@@ -4,6 +4,7 @@
 
 #include "gyrocal/core/parallel.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/planned_channels.hpp"
 #include "gyrocal/model/nominal.hpp"
 
 namespace gyrocal {
@@ -40,7 +41,6 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     // The reducer's operator, the heading's sweep at a counter rate offset included (docs/physics.md 15).
     const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false, sweep);
-    double v[kColumns];
     // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always: for the harmonic
     // fit and a static hold's mean, which see the channels' smooth shape; a window holds a few samples only,
     // so window means take every sample.
@@ -68,7 +68,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
                                d.counter.rate_rad_s * d.sample_interval_s, per_revolution);
       }
     }
-    const auto add_sample = [&](double t, double main_rad, double counter_rad) {
+    const auto evaluate = [&](double main_rad, double counter_rad, double* v) {
       // The joints on the dwell's constant-rate lines fitted to the encoders (the measured rates); beta as
       // planned (reduce/reducer.cpp: an encoder's mean at rest is biased by up to half a count).
       JointState j;
@@ -91,7 +91,16 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
         v[kFirstRegressor + k] = re[k];
         v[kFirstRegressor + kNumCoefficients + k] = rn[k];
       }
-      acc.add(t, -j.counter_angle_rad, v);
+    };
+    // A planned dwell (no stretches: evenly spaced samples on the lines) summed on every sample or for a
+    // prediction: in closed form, at a cost independent of its length (identify/planned_channels.hpp).
+    if (d.stretches.empty() && (options.model_samples_per_revolution == 0 || max_samples_per_dwell > 0) &&
+        planned_dwell_channels(d, options, kColumns, evaluate, per_dwell[di]))
+      return;
+    double row[kColumns];
+    const auto add_sample = [&](double t, double main_rad, double counter_rad) {
+      evaluate(main_rad, counter_rad, row);
+      acc.add(t, -counter_rad, row);
     };
     if (d.stretches.empty()) {
       const auto at = [&](std::size_t i) {

@@ -4,12 +4,14 @@
 // configured errors. The result is the distribution of each estimate's error and the share of each source
 // in its variance.
 //
-// Two modes. Fast: the reduced outputs are linear in the drawn errors and the noise, W = W0 + J*delta + n,
-// with J from central differences of the exact noise-free engine (analysis/predict.hpp) and n the white
-// noise through the reduction operator (with its correlation between the gammas of one dwell); the
-// identification is an affine map of W (precomputed from identify itself), so a trial is one small
-// matrix-vector product. Samples: the whole time-series pipeline per trial (simulate with the drawn errors,
-// reduce, channels of the configured model, identify), to check the fast mode.
+// Two modes. Fast: the estimates are linear in the drawn errors and the noise, E = E0 + G*delta + M*n:
+// each source's column a central difference of the noise-free calibration of the drawn machine reduced on its
+// own planned encoder lines, with the configured model's channels on those lines (as a record's calibration
+// evaluates them: docs/montecarlo.md, "The sources through the encoders"); n the noise through the reduction
+// operator (with its correlation between the gammas of one dwell) and M the identification's affine map of
+// the outputs (precomputed from identify itself), so a trial is one small matrix-vector product. Samples:
+// the whole time-series pipeline per trial (simulate with the drawn errors, reduce, channels of the
+// configured model, identify), to check the fast mode.
 //
 // Trial k draws from RandomSource(seed, k) alone, and statistics are combined in trial order, so the same
 // seed gives the same result whatever the number of threads.
@@ -78,7 +80,8 @@ struct MonteCarloModel {
   std::size_t columns() const { return sources.size() + static_cast<std::size_t>(positions); }
 };
 
-/// Linearise the scenario (about 2 evaluations of the exact model over the plan per source, in parallel).
+/// Linearise the scenario (about 2 evaluations of the exact model over the plan per source, in parallel; 4
+/// and 2 calibrations for a source that moves the encoder lines).
 /// Throws Error for options the calibration refuses.
 MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOptions& options);
 

@@ -36,12 +36,16 @@ Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& dwell, const ReduceOpt
 Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                               double sample_std_deg_h);
 
+/// The most samples (over all dwells) whose coloured-noise covariance is predicted: it walks them, holding a
+/// gammas x samples operator per dwell (~14 bytes a sample, 0.5 GB here).
+inline constexpr double kMaxColouredNoiseSamples = 33554432.0;  // 2^25
+
 /// Covariance (deg/h)^2 of the reduced positions under the bias instability and the rate random walk of
 /// `noise`, across dwells as well as within them (docs/noise.md, "Coloured noise in the prediction"): the
 /// reduction operator of each dwell applied to the samples' covariance as the simulator makes the noise
 /// (a sum of Gauss-Markov processes; a random walk from the record's start). Dwells whose operator is not
 /// formed (a spinning dwell reduced by the window mean) are left out, and *complete (if given) is set to
-/// false.
+/// false. Throws Error beyond kMaxColouredNoiseSamples samples in the dwells (with coloured noise only).
 Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                                    const GyroNoise& noise, double sample_rate_hz,
                                                    bool* complete = nullptr);

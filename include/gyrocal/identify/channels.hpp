@@ -52,7 +52,10 @@ inline constexpr std::size_t kMaxModelSamplesPerDwell = 32768;
 
 /// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
 /// the model evaluations of a spinning dwell (above); 0 (a calibration) evaluates ReduceOptions::
-/// model_samples_per_revolution per revolution, however many revolutions.
+/// model_samples_per_revolution per revolution, however many revolutions. A dwell without stretches (a
+/// planned one) reduced by the harmonic fit or a static mean, with every sample asked for
+/// (model_samples_per_revolution 0) or a bound, is summed in closed form instead, at a cost independent of
+/// its length (identify/planned_channels.hpp; equal to the every-sample sum to ~1e-11).
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                     const ReduceOptions& options,
                                                     std::size_t max_samples_per_dwell = 0);
