@@ -1,15 +1,18 @@
 #!/usr/bin/python3
-"""gyrocal's record reader beside pandas.read_csv on the same record, same machine, same run (issue 8, "Speed
-and memory"; docs/performance.md).
+"""gyrocal's record reader and `gyrocal calibrate` beside pandas.read_csv on the same record, same machine, same
+run (issue 8, "Speed and memory"; issue 17, item 1; docs/performance.md).
 
-    bench/bench_read_vs_pandas.py BUILD_DIR [--rows 2000000] [--rounds 5] [--keep DIR]
+    bench/bench_read_vs_pandas.py BUILD_DIR [--rows 2000000] [--rounds 5] [--keep DIR] [--no-calibrate]
 
 Writes a simulated record of about ROWS rows once (`gyrocal simulate`), and the same samples as a rig would
 write them: ';' between fields, time stamps in integer ms, the three angles as encoder counts (2^24 a
 revolution, the main axis wrapped), the output in mV at 2.5 mV per deg/h, read through a [record] mapping.
 Then, in ROUNDS interleaved rounds: the gyrocal reader on the native record (bench_read_file, the reader
-alone), pandas.read_csv on the native record, and the gyrocal reader on the foreign record. Prints the medians,
-the ratio pandas / gyrocal (target >= 3) and foreign / native (target <= 1.5), and the reader's peak memory.
+alone), pandas.read_csv on the native record, the gyrocal reader on the foreign record, `gyrocal calibrate` of
+the native record end to end (default reduction and compensation; the wall time of the process, start to
+exit) and the same on one core (`taskset -c 0`: its threads share one CPU). Prints the medians, the ratios
+pandas / gyrocal reader (target >= 3), pandas / calibrate (target >= 3), foreign / native (target <= 1.5), and
+the peak memory of the reader and of calibrate (target < 64 MB).
 """
 import argparse
 import math
@@ -46,6 +49,27 @@ def gyrocal_read(bench, record, config=None):
     return {k: float(v) for k, v in re.findall(r"(\w+)=([-0-9.e+]+)", out)}
 
 
+def timed_process(args):
+    """Runs args; returns (wall seconds, peak resident memory in MB) of that process alone. The memory is
+    /usr/bin/time's: the peak of a child forked from this Python (pandas loaded) would count the Python's pages
+    too."""
+    start = time.perf_counter()
+    done = subprocess.run(["/usr/bin/time", "-f", "maxrss_kb=%M"] + args, stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        raise RuntimeError(f"{args[0]} failed: {done.stderr}")
+    return seconds, float(re.findall(r"maxrss_kb=(\d+)", done.stderr)[-1]) / 1024.0
+
+
+def calibrate(gyrocal, record, scenario, folder, one_core=False):
+    result = os.path.join(folder, "result.json")
+    if os.path.exists(result):
+        os.remove(result)
+    args = [gyrocal, "calibrate", record, "--config", scenario, "--json", result]
+    return timed_process((["taskset", "-c", "0"] if one_core else []) + args)
+
+
 def pandas_read(record):
     start = time.perf_counter()
     frame = pd.read_csv(record, comment="#")
@@ -72,6 +96,7 @@ def main():
     parser.add_argument("--rows", type=float, default=2e6)
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--keep", help="folder for the records (default: a temporary one, removed)")
+    parser.add_argument("--no-calibrate", action="store_true", help="time the readers only")
     args = parser.parse_args()
     gyrocal = os.path.join(args.build, "gyrocal")
     bench = os.path.join(args.build, "bench", "bench_read_file")
@@ -93,7 +118,7 @@ def main():
             write_foreign(native, foreign)
         with open(config, "w") as f:
             f.write(FOREIGN_TOML)
-        native_s, pandas_s, foreign_s, peak = [], [], [], 0.0
+        native_s, pandas_s, foreign_s, calibrate_s, one_core_s, peak, calibrate_peak = [], [], [], [], [], 0.0, 0.0
         for _ in range(args.rounds):
             n = gyrocal_read(bench, native)
             native_s.append(n["seconds"])
@@ -102,18 +127,36 @@ def main():
             foreign_s.append(f["seconds"])
             peak = max(peak, n["peak_rss_mb"], f["peak_rss_mb"])
             assert n["rows"] == f["rows"], (n, f)
+            if not args.no_calibrate:
+                seconds, mb = calibrate(gyrocal, native, scenario, folder)
+                calibrate_s.append(seconds)
+                calibrate_peak = max(calibrate_peak, mb)
+                seconds, mb = calibrate(gyrocal, native, scenario, folder, one_core=True)
+                one_core_s.append(seconds)
+                calibrate_peak = max(calibrate_peak, mb)
         mb = os.path.getsize(native) / 1e6
         med = statistics.median
         print(f"record: {int(n['rows'])} rows, native {mb:.1f} MB, foreign {os.path.getsize(foreign) / 1e6:.1f} MB;"
               f" {args.rounds} rounds, medians (min-max)")
-        for name, values in (("gyrocal reader, native", native_s), ("pandas.read_csv, native", pandas_s),
-                             ("gyrocal reader, foreign (mapped)", foreign_s)):
+        rows = [("gyrocal reader, native", native_s), ("pandas.read_csv, native", pandas_s),
+                ("gyrocal reader, foreign (mapped)", foreign_s)]
+        if calibrate_s:
+            rows += [("gyrocal calibrate, native", calibrate_s), ("gyrocal calibrate, one core", one_core_s)]
+        for name, values in rows:
             print(f"  {name:34s} {med(values):7.3f} s  ({min(values):.3f}-{max(values):.3f})")
         ratios = [p / g for p, g in zip(pandas_s, native_s)]
         print(f"pandas / gyrocal native: {med(pandas_s) / med(native_s):.2f}x (per round {min(ratios):.2f}-"
               f"{max(ratios):.2f}; target >= 3)")
         print(f"foreign / native: {med(foreign_s) / med(native_s):.2f}x (target <= 1.5)")
         print(f"gyrocal reader peak memory: {peak:.1f} MB")
+        if calibrate_s:
+            for name, values in (("calibrate", calibrate_s), ("calibrate on one core", one_core_s)):
+                ratios = [p / c for p, c in zip(pandas_s, values)]
+                print(f"pandas / gyrocal {name}: {med(pandas_s) / med(values):.2f}x (per round {min(ratios):.2f}-"
+                      f"{max(ratios):.2f}; target >= 3)")
+            print(f"gyrocal calibrate peak memory: {calibrate_peak:.1f} MB (target < 64)")
+            print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())} "
+                  f"on {os.cpu_count()} cores")
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 
 namespace gyrocal {
@@ -137,6 +138,21 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   pending_.push_back({t, gamma, values[0], after_break});
 }
 
+void DwellAccumulator::add_sums(double first_time_s, double last_time_s, std::size_t samples,
+                                const Eigen::MatrixXd& normal, const Eigen::MatrixXd& rhs) {
+  if (samples_ != 0 || with_std_err_ || samples == 0)
+    throw Error("DwellAccumulator::add_sums: only once, on an empty accumulator without standard errors");
+  t_first_ = first_time_s;
+  t_last_ = last_time_s;
+  samples_ = samples;
+  if (auto* fit = std::get_if<HarmonicFit>(&reduction_))
+    fit->add_sums(samples, normal, rhs);
+  else if (auto* mean = std::get_if<StaticMean>(&reduction_))
+    mean->add_sums(samples, rhs);
+  else
+    throw Error("DwellAccumulator::add_sums: a window mean takes its samples one by one");
+}
+
 void DwellAccumulator::break_revolution() {
   if (samples_ > 0) break_next_ = true;
 }
@@ -182,9 +198,14 @@ void DwellAccumulator::test_block() {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(p);
   std::vector<double> residual(n);
   double scale = 0.0;
+  // The last iteration's normal equations, when they were formed with the final set of outliers: the
+  // dwell's sums then need only the outliers' terms added (below), not every sample's again.
+  Eigen::MatrixXd normal;
+  Eigen::VectorXd rhs;
+  bool settled = false;
   for (int iteration = 0; iteration < 20; ++iteration) {
-    Eigen::MatrixXd normal = ref_normal_;
-    Eigen::VectorXd rhs = ref_rhs_;
+    normal = ref_normal_;
+    rhs = ref_rhs_;
     for (std::size_t i = 0; i < n; ++i) {
       if (out[i]) continue;
       const double* b = basis_of(i);
@@ -214,18 +235,30 @@ void DwellAccumulator::test_block() {
       changed = changed || o != out[i];
       out[i] = o;
     }
-    if (!changed) break;
+    if (!changed) {
+      settled = true;
+      break;
+    }
   }
-  if (!x.allFinite()) x.setZero();
+  if (!x.allFinite()) {
+    x.setZero();
+    settled = false;
+  }
   last_scale_ = scale;
+  if (settled) {
+    ref_normal_ = std::move(normal);
+    ref_rhs_ = std::move(rhs);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const Pending& s = pending_[i];
     const double v = out[i] ? fit_at(i, x) : s.value;
     if (out[i]) ++outliers_;
-    const double* b = basis_of(i);
-    for (int j = 0; j < p; ++j) {
-      for (int k = j; k < p; ++k) ref_normal_(k, j) += b[k] * b[j];
-      ref_rhs_[j] += b[j] * v;
+    if (!settled || out[i]) {
+      const double* b = basis_of(i);
+      for (int j = 0; j < p; ++j) {
+        for (int k = j; k < p; ++k) ref_normal_(k, j) += b[k] * b[j];
+        ref_rhs_[j] += b[j] * v;
+      }
     }
     accumulate(s.t, s.gamma, &v, s.after_break);
   }

@@ -118,6 +118,11 @@ void StaticMean::add(double /*t_scaled*/, double /*gamma_rad*/, const double* va
   ++batch_n_;
 }
 
+void StaticMean::add_sums(std::size_t samples, const Eigen::MatrixXd& rhs) {
+  samples_ += samples;
+  sum_ += rhs.row(0).transpose();
+}
+
 void StaticMean::close_period(RevolutionSums& scatter) {
   // A batch's mean enters at time 0: the scatter of a hold is about the batches' mean (fits_drift: never).
   if (batch_n_ > 0)
@@ -195,6 +200,12 @@ void HarmonicFit::add(double t_scaled, double gamma_rad, const double* values) {
   for (int i = 0; i < nr; ++i) rev_rhs[i] += b[i] * values[0];
   ++rev_samples_;
   rev_time_sum_ += t_scaled;
+}
+
+void HarmonicFit::add_sums(std::size_t samples, const Eigen::MatrixXd& normal, const Eigen::MatrixXd& rhs) {
+  samples_ += samples;
+  normal_.triangularView<Eigen::Lower>() += normal;
+  rhs_ += rhs;
 }
 
 void HarmonicFit::close_period(RevolutionSums& scatter) {

@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <deque>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <optional>
+#include <span>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -16,6 +21,21 @@
 
 namespace gyrocal {
 namespace {
+
+/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
+/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
+/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
+/// a / 360, and a quotient that a / 360's rounding put on the wrong side of a half turn is corrected. Only
+/// exactly +-180 may come out with the other sign than remainder's.
+double wrap_deg_quick(double a) {
+  if (std::abs(a) <= 180.0) return a;
+  double r = a - 360.0 * std::nearbyint(a / 360.0);
+  if (r > 180.0)
+    r -= 360.0;
+  else if (r < -180.0)
+    r += 360.0;
+  return r;
+}
 
 /// Straight-line fit of y against t, streaming, on deviations from a planned line (well conditioned).
 struct LineSums {
@@ -250,7 +270,7 @@ PlanMatch match_to_plan(const TestSpec& plan, const ReduceOptions& options, doub
   const auto nearest = [](const std::vector<double>& planned_rad, double deg, double& best_deg) {
     double best = std::numeric_limits<double>::infinity();
     for (double p : planned_rad) {
-      const double d = std::abs(wrap_deg(deg - p * kRadToDeg));
+      const double d = std::abs(wrap_deg_quick(deg - p * kRadToDeg));
       if (d < best) best = d, best_deg = p;
     }
     return best;
@@ -320,8 +340,8 @@ struct Reducer::State {
       if (is_gap(r.t - p.t)) {
         window.clear();
       } else {
-        r.theta = p.theta + wrap_deg(raw.theta - raw_theta_prev);
-        r.psi = p.psi + wrap_deg(raw.psi - raw_psi_prev);
+        r.theta = p.theta + wrap_deg_quick(raw.theta - raw_theta_prev);
+        r.psi = p.psi + wrap_deg_quick(raw.psi - raw_psi_prev);
       }
     }
     raw_theta_prev = raw.theta;
@@ -343,19 +363,19 @@ struct Reducer::State {
     for (auto it = first; it != window.end(); ++it) betas.push_back(it->beta);
     const double beta = median_of(betas);
     for (double b : betas)
-      if (std::abs(wrap_deg(b - beta)) > options.beta_tolerance_deg) return;
+      if (std::abs(wrap_deg_quick(b - beta)) > options.beta_tolerance_deg) return;
     if (offset_ramp(th.rate * kDegToRad, ps.rate * kDegToRad)) return;
     // Steady: the run begins at the earliest row before the window that still lies on its lines as closely as
     // the window's own rows do (twice their largest residual, and beta within their spread): the end of a
     // ramp or a move is not taken in.
     double beta_spread = 0.0;
-    for (double b : betas) beta_spread = std::max(beta_spread, std::abs(wrap_deg(b - beta)));
+    for (double b : betas) beta_spread = std::max(beta_spread, std::abs(wrap_deg_quick(b - beta)));
     const double th_tol = std::max(2.0 * th.max_residual, 1e-9),
                  ps_tol = std::max(2.0 * ps.max_residual, 1e-9);
     while (first != window.begin()) {
       const Row& q = *std::prev(first);
       if (std::abs(q.theta - th(q.t)) > th_tol || std::abs(q.psi - ps(q.t)) > ps_tol ||
-          std::abs(wrap_deg(q.beta - beta)) > beta_spread + 1e-9)
+          std::abs(wrap_deg_quick(q.beta - beta)) > beta_spread + 1e-9)
         break;
       --first;
     }
@@ -368,7 +388,7 @@ struct Reducer::State {
     std::vector<Row> rows_of_run(first, window.end());
     window.clear();
     // follow() unwraps against the run's lines: the rows' readings as the record gave them.
-    for (Row& q : rows_of_run) q.theta = wrap_deg(q.theta), q.psi = wrap_deg(q.psi);
+    for (Row& q : rows_of_run) q.theta = wrap_deg_quick(q.theta), q.psi = wrap_deg_quick(q.psi);
     for (const Row& q : rows_of_run) take(q);
   }
 
@@ -444,7 +464,7 @@ struct Reducer::State {
     r.rate_theta = th.rate;
     r.rate_psi = ps.rate;
     r.beta_deg = beta;
-    r.gamma_deg = wrap_deg(-ps(first.t));
+    r.gamma_deg = wrap_deg_quick(-ps(first.t));
     r.theta_line = th;
     r.psi_line = ps;
     r.block_t0 = first.t;
@@ -498,14 +518,15 @@ struct Reducer::State {
                  ps_pred = r.psi_prev + r.psi_line.rate * step;
     Row u = raw;
     u.t = t;
-    u.theta = th_pred + wrap_deg(raw.theta - th_pred);
-    u.psi = ps_pred + wrap_deg(raw.psi - ps_pred);
-    const double db = wrap_deg(raw.beta - r.beta_deg);
+    u.theta = th_pred + wrap_deg_quick(raw.theta - th_pred);
+    u.psi = ps_pred + wrap_deg_quick(raw.psi - ps_pred);
+    const double db = wrap_deg_quick(raw.beta - r.beta_deg);
     Deviations dev;
     dev.beta = std::abs(db);
     if (!gap) dev.angle = std::max(std::abs(u.theta - th_pred), std::abs(u.psi - ps_pred));
     if (r.decided && r.matched && r.match.is_static)
-      dev.hold = std::max(std::abs(wrap_deg(u.theta - r.hold_theta)), std::abs(wrap_deg(u.psi - r.hold_psi)));
+      dev.hold = std::max(std::abs(wrap_deg_quick(u.theta - r.hold_theta)),
+                          std::abs(wrap_deg_quick(u.psi - r.hold_psi)));
     std::string off;
     if (std::abs(db) > options.beta_tolerance_deg)
       off = fmt::format("beta moves by {:.3g} deg at t = {:.3f} s", db, raw.t);
@@ -519,7 +540,7 @@ struct Reducer::State {
     else if (dev.hold > options.beta_tolerance_deg) {
       // A static hold: a move that starts slowly stays within angle_tolerance_deg of each last reading;
       // the hold's angles are held, like beta, within beta_tolerance_deg (docs/calibration.md).
-      const double dth = wrap_deg(u.theta - r.hold_theta), dps = wrap_deg(u.psi - r.hold_psi);
+      const double dth = wrap_deg_quick(u.theta - r.hold_theta), dps = wrap_deg_quick(u.psi - r.hold_psi);
       off = std::abs(dth) > options.beta_tolerance_deg
                 ? fmt::format("the main axis moves by {:.3g} deg at t = {:.3f} s", dth, raw.t)
                 : fmt::format("the counter platform moves by {:.3g} deg at t = {:.3f} s", dps, raw.t);
@@ -617,7 +638,7 @@ struct Reducer::State {
       r.theta_line = line(r.block_theta, rt, r.block_theta0);
       r.psi_line = line(r.block_psi, rp, r.block_psi0);
       r.psi_line_valid = true;
-      if (!r.decided) r.gamma_deg = wrap_deg(-r.psi_line(t));
+      if (!r.decided) r.gamma_deg = wrap_deg_quick(-r.psi_line(t));
       r.block_theta = r.block_psi = LineSums{};
       if (decide_now) decide(r, t);
     }
@@ -687,7 +708,7 @@ struct Reducer::State {
     // The arm angle of the fit's basis from the line of the last window (smooth: a reading quantised to 0.1
     // deg would put its rounding into every basis function), continued from the reading to within half a
     // turn; after a gap, until a window has closed, the reading itself.
-    const double psi = r.psi_line_valid ? u.psi + wrap_deg(r.psi_line(u.t) - u.psi) : u.psi;
+    const double psi = r.psi_line_valid ? u.psi + wrap_deg_quick(r.psi_line(u.t) - u.psi) : u.psi;
     r.acc->add(u.t, -psi * kDegToRad, &u.y);
   }
 
@@ -910,14 +931,14 @@ struct Reducer::State {
     for (const RejectedRun& x : rejected) {
       const bool is_static = p.rate_rad_s == 0.0 && p.counter_rate_offset_rad_s == 0.0;
       if (x.is_static != is_static) continue;
-      const double db = std::abs(wrap_deg(x.beta_deg - p.beta_rad * kRadToDeg));
+      const double db = std::abs(wrap_deg_quick(x.beta_deg - p.beta_rad * kRadToDeg));
       // A rate table at main rate 0 (docs/physics.md section 15): the main axis' rate against the stopped
       // tolerance.
       const double dr = is_static ? 0.0
                         : p.rate_rad_s == 0.0
                             ? (std::abs(x.main_rate_rad_s) < options.static_rate_tolerance_rad_s ? 0.0 : 1.0)
                             : std::abs(x.main_rate_rad_s - p.rate_rad_s) / std::abs(p.rate_rad_s);
-      const double dg = is_static ? std::abs(wrap_deg(x.gamma_deg - p.gamma_rad * kRadToDeg)) : 0.0;
+      const double dg = is_static ? std::abs(wrap_deg_quick(x.gamma_deg - p.gamma_rad * kRadToDeg)) : 0.0;
       if (db > 5.0 || dr > 0.05 || dg > 5.0) continue;
       const int rank = (db <= options.beta_tolerance_deg ? 2 : 0) + (dr <= options.rate_tolerance ? 1 : 0);
       if (!best || rank > best_rank ||
@@ -1089,12 +1110,106 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   return rp;
 }
 
+namespace {
+
+/// Rows read ahead by the reader's thread: kReadAheadBatches batches of kReadAheadRows rows (3.4 MB).
+constexpr std::size_t kReadAheadRows = 8192;
+constexpr std::size_t kReadAheadBatches = 4;
+
+/// The reader on a thread of its own, a few batches of rows ahead of the caller's thread (docs/
+/// performance.md): parsing and reducing overlap. Rows arrive in the record's order; an error of the reader
+/// (gyrocal::Error naming the file and line) is rethrown by next() where its row would have been.
+class ReadAhead {
+ public:
+  explicit ReadAhead(RecordReader& reader) : reader_(reader), batches_(kReadAheadBatches) {
+    for (auto& b : batches_) b.rows.resize(kReadAheadRows);
+    thread_ = std::thread([this] { produce(); });
+  }
+  ~ReadAhead() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+  ReadAhead(const ReadAhead&) = delete;
+  ReadAhead& operator=(const ReadAhead&) = delete;
+
+  /// The next batch of rows (empty at the end of the record); valid until the next call.
+  std::span<const RecordSample> next() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (holding_) {  // the caller is done with the batch it held: its slot is free again
+      holding_ = false;
+      // The rows read before an error went first; the error comes where the next row would have been.
+      if (batches_[head_].error) std::rethrow_exception(batches_[head_].error);
+      head_ = (head_ + 1) % batches_.size();
+      --filled_;
+      changed_.notify_all();
+    }
+    changed_.wait(lock, [&] { return filled_ > 0; });
+    Batch& b = batches_[head_];
+    if (b.error && b.count == 0) std::rethrow_exception(b.error);
+    holding_ = true;
+    return {b.rows.data(), b.count};
+  }
+
+ private:
+  struct Batch {
+    std::vector<RecordSample> rows;
+    std::size_t count = 0;
+    std::exception_ptr error;
+  };
+  void produce() {
+    std::size_t tail = 0;
+    bool ended = false;
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return stop_ || filled_ < batches_.size(); });
+        if (stop_) return;
+      }
+      Batch& b = batches_[tail];
+      b.count = 0;
+      try {
+        while (!ended && b.count < b.rows.size()) {
+          if (reader_.next(b.rows[b.count]))
+            ++b.count;
+          else
+            ended = true;
+        }
+      } catch (...) {
+        b.error = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++filled_;
+      }
+      changed_.notify_all();
+      // The end of the record is an empty batch (or an error): the consumer stops there.
+      if (b.count == 0 || b.error) return;
+      tail = (tail + 1) % batches_.size();
+    }
+  }
+
+  RecordReader& reader_;
+  std::vector<Batch> batches_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::size_t head_ = 0, filled_ = 0;
+  bool holding_ = false, stop_ = false;
+};
+
+}  // namespace
+
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s) {
   Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
   reducer.set_record_layout(reader.layout());
-  RecordSample s;
-  while (reader.next(s)) reducer.push(s);
+  ReadAhead ahead(reader);
+  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next())
+    for (const RecordSample& s : rows) reducer.push(s);
   return reducer.finish();
 }
 

@@ -50,14 +50,40 @@ struct PositionChannels {
 /// length; docs/calibration.md states the error.
 inline constexpr std::size_t kMaxModelSamplesPerDwell = 32768;
 
+/// How the channels of a dwell are reduced when every sample is asked for (ReduceOptions::
+/// model_samples_per_revolution = 0).
+enum class ChannelRoute {
+  /// The channels as a Fourier series in the two joint angles, summed over the samples in closed form, when
+  /// the series' check holds (docs/calibration.md, "The model's side of each position"); otherwise every
+  /// sample. The default.
+  kExact,
+  kEverySample,  ///< the model evaluated at every sample (the reference the closed forms are tested against)
+};
+
+/// What was done for one dwell (reduce_model_channels' `routes`).
+struct DwellChannelsRoute {
+  bool fourier = false;  ///< the closed forms were used
+  int harmonics = 0;     ///< H of the Fourier series tried last (0: not tried)
+  /// Per channel column (omega exact, nominal, seed, 10 exact and 10 nominal regressors, omega_O, omega_S):
+  /// the sum of |C_nm| over the outer quarter of the band (max(|n|, |m|) > 3H/4), and
+  /// over all of it, in the column's unit.
+  std::vector<double> outer_tail, scale;
+  /// Per gamma of the dwell: the reduction operator's white-noise gain sum_i w_i^2 (DwellAccumulator::
+  /// white_noise_gain); sqrt(samples x gain) bounds the operator's L1 norm sum_i |w_i|.
+  std::vector<double> operator_gain;
+};
+
 /// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
-/// the model evaluations of a spinning dwell (above); 0 (a calibration) evaluates ReduceOptions::
-/// model_samples_per_revolution per revolution, however many revolutions. A dwell without stretches (a
-/// planned one) reduced by the harmonic fit or a static mean, with every sample asked for
-/// (model_samples_per_revolution 0) or a bound, is summed in closed form instead, at a cost independent of
-/// its length (identify/planned_channels.hpp; equal to the every-sample sum to ~1e-11).
+/// the model evaluations of a spinning dwell (above) where a stride is configured; 0 (a calibration)
+/// evaluates ReduceOptions::model_samples_per_revolution per revolution, however many revolutions. A dwell
+/// without stretches (a planned one) reduced by the harmonic fit or a static mean, with every sample asked
+/// for (model_samples_per_revolution 0) or a bound, is summed in closed form at a cost independent of its
+/// length (identify/planned_channels.hpp; equal to the every-sample sum to ~1e-11). A record's dwell, with
+/// every sample asked for, goes by `route` (above); `routes`, when given, receives per dwell what was done.
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                     const ReduceOptions& options,
-                                                    std::size_t max_samples_per_dwell = 0);
+                                                    std::size_t max_samples_per_dwell = 0,
+                                                    ChannelRoute route = ChannelRoute::kExact,
+                                                    std::vector<DwellChannelsRoute>* routes = nullptr);
 
 }  // namespace gyrocal

@@ -139,6 +139,18 @@ class DwellAccumulator {
   /// ReduceOptions::outlier_threshold > 0) samples wait in a block of whole revolutions (at least
   /// outlier_block_samples) until the block is tested; finish() tests the last one.
   void add(double time_s, double gamma_rad, const double* values);
+  /// A whole dwell's samples at once, given by their sums (identify/channels.hpp: the model's channels summed
+  /// in closed form): `samples` samples from first_time_s to last_time_s (s); for a harmonic fit `normal` and
+  /// `rhs` as HarmonicFit::add_sums takes them (the basis' time is scaled as add() scales it), for a static
+  /// hold rhs's one row holds the columns' sums (`normal` unused). Only on an accumulator without standard
+  /// errors that has no sample yet; a window mean cannot (it throws).
+  void add_sums(double first_time_s, double last_time_s, std::size_t samples, const Eigen::MatrixXd& normal,
+                const Eigen::MatrixXd& rhs);
+  /// The time scaled as the reduction's basis takes it: (t - first) / planned_duration - 0.5, with `first`
+  /// the dwell's first sample's time.
+  static double scaled_time(double time_s, double first_time_s, double planned_duration_s) {
+    return (time_s - first_time_s) / planned_duration_s - 0.5;
+  }
 
   /// The reduced values of column `column`, evaluated at the dwell's mid-time. The first call ends the
   /// accumulation (it tests the block still waiting and closes the last revolution).

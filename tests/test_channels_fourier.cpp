@@ -1,0 +1,158 @@
+// The model's channels summed in closed form from their Fourier series in the two joint angles
+// (identify/channels.hpp, ChannelRoute::kExact) against the same channels evaluated at every sample
+// (ChannelRoute::kEverySample): on machines with large errors, each reduced channel is within the bound the
+// series states (docs/calibration.md, "The model's side of each position"), and where the series' check
+// fails the channels are taken at every sample.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace gyrocal {
+namespace {
+
+/// The default test at 200 Hz over two speeds (127 and 180 samples a revolution), noise-free.
+Scenario two_speed_test(int revolutions) {
+  Scenario s = default_scenario();
+  s.test.sample_rate_hz = 200.0;
+  s.test.revolutions = revolutions;
+  s.test.rates_rad_s = {9.9, 7.0};
+  s.noise = GyroNoise{};
+  return s;
+}
+
+/// Large machine errors: a lever arm of 1 cm, runouts and wobbles of every joint to harmonic `highest`
+/// (amplitudes 2e-4 falling by half a harmonic), position-platform errors, a counter rate mismatch (so that
+/// the platform's heading drifts and the channels depend on both joint angles).
+void set_large_errors(Scenario& s, int highest) {
+  CentrifugeErrors& e = s.errors;
+  e.lever_arm_m = Eigen::Vector3d(0.01, -0.01, 0.01);
+  const auto series = [&](double amplitude, double phase) {
+    HarmonicSeries h;
+    for (int n = 1; n <= highest; ++n)
+      h.terms.push_back({n, amplitude / std::pow(2.0, n - 1), phase + 0.7 * n});
+    return h;
+  };
+  e.main_runout_x_m = series(2e-4, 0.3);
+  e.main_runout_y_m = series(1.5e-4, 0.7);
+  e.main_wobble_x_rad = series(2e-4, 0.2);
+  e.main_wobble_y_rad = series(1e-4, 1.9);
+  e.counter_wobble_x_rad = series(1.5e-4, 2.2);
+  e.counter_wobble_y_rad = series(2e-4, 1.2);
+  e.position_wobble_x_rad = series(1e-4, 0.3);
+  e.position_perpendicularity_x_rad = 2e-4;
+  e.position_angle_error_rad = 3e-4;
+  e.counter_rate_mismatch_rad_s = 2e-6;
+}
+
+Reduction reduce(const Scenario& s) {
+  Reducer reducer(s.test, ReduceOptions{}, "large_errors.csv", s.centrifuge.rate_rad_s);
+  SimulationOptions so;
+  so.seed = 3;
+  simulate(s, so, [&](const RecordSample& x) { reducer.push(x); });
+  return reducer.finish();
+}
+
+/// Every reduced channel of `fourier` within the stated bound of `every`'s: the aliased and truncated part
+/// of the series (twice the outer half band's sum, which majorises the tail of a decaying series) through
+/// the operator's L1 norm (at most sqrt(samples x white-noise gain) by Cauchy-Schwarz), plus the two sums'
+/// rounding (1e-13 of the channel's scale a sample, and 1e-15 of the joints' rates for a rate). Returns the
+/// largest ratio of difference to bound.
+double worst_ratio(const Reduction& r, const std::vector<PositionChannels>& fourier,
+                   const std::vector<PositionChannels>& every,
+                   const std::vector<DwellChannelsRoute>& routes) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < r.positions.size(); ++i) {
+    const ReducedPosition& p = r.positions[i];
+    const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
+    const DwellChannelsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
+    EXPECT_TRUE(route.fourier) << "position " << p.index;
+    if (!route.fourier) return worst;
+    std::vector<double> a = {fourier[i].omega_exact_deg_h, fourier[i].omega_nominal_deg_h,
+                             fourier[i].omega_seed_deg_h};
+    std::vector<double> b = {every[i].omega_exact_deg_h, every[i].omega_nominal_deg_h,
+                             every[i].omega_seed_deg_h};
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      a.push_back(fourier[i].regressors_exact[k]);
+      b.push_back(every[i].regressors_exact[k]);
+    }
+    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      a.push_back(fourier[i].regressors_nominal[k]);
+      b.push_back(every[i].regressors_nominal[k]);
+    }
+    a.push_back(fourier[i].omega_O_exact_deg_h);
+    a.push_back(fourier[i].omega_S_exact_deg_h);
+    b.push_back(every[i].omega_O_exact_deg_h);
+    b.push_back(every[i].omega_S_exact_deg_h);
+    const double l1 = std::sqrt(static_cast<double>(d.samples) *
+                                route.operator_gain[static_cast<std::size_t>(p.gamma_slot)]);
+    for (std::size_t c = 0; c < a.size(); ++c) {
+      // The rates (columns 0-2 and the last two, deg/h) are differences of terms as large as the joints'
+      // rates: each sample's rounding is ~1e-16 of those.
+      const bool rate = c < 3 || c + 2 >= a.size();
+      const double rates =
+          (std::abs(d.main.rate_rad_s) + std::abs(d.counter.rate_rad_s)) * kRadPerSecToDegPerHour;
+      const double rounding = 1e-13 * route.scale[c] + (rate ? 1e-15 * rates : 0.0);
+      const double bound = l1 * (2.0 * route.outer_tail[c] + rounding) + 1e-300;
+      if (std::abs(a[c] - b[c]) / bound > worst)
+        std::printf("position %d, column %zu: |difference| %.3g, bound %.3g\n", p.index, c,
+                    std::abs(a[c] - b[c]), bound);
+      worst = std::max(worst, std::abs(a[c] - b[c]) / bound);
+      EXPECT_LE(std::abs(a[c] - b[c]), bound)
+          << "position " << p.index << ", column " << c << ": " << a[c] << " vs " << b[c];
+    }
+  }
+  return worst;
+}
+
+TEST(FourierChannels, EqualTheEverySampleChannelsWithinTheirBoundOnAMachineWithLargeErrors) {
+  Scenario s = two_speed_test(60);
+  set_large_errors(s, 3);
+  const Reduction r = reduce(s);
+  std::vector<DwellChannelsRoute> routes;
+  const auto fourier = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
+  const auto every = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kEverySample);
+  ASSERT_EQ(routes.size(), r.dwells.size());
+  for (std::size_t i = 0; i < routes.size(); ++i)
+    std::printf("dwell %zu: %zu samples, %s, H = %d\n", i, r.dwells[i].samples,
+                routes[i].fourier ? "closed forms" : "every sample", routes[i].harmonics);
+  const double worst = worst_ratio(r, fourier, every, routes);
+  std::printf("largest |fourier - every sample| / bound: %.3g (H = %d)\n", worst, routes.front().harmonics);
+  // And the calibration from them is exact: every coefficient within 1e-7 of the truth (least squares, full
+  // compensation), as with the every-sample channels.
+  CalibrationOptions o;
+  o.method = Method::kLeastSquares;
+  o.compensation = Compensation::kFull;
+  const CalibrationResult c = identify(r, fourier, s.model(), o);
+  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    ASSERT_TRUE(c.coefficients[k].identifiable) << kCoefficientNames[k];
+    EXPECT_NEAR(c.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
+  }
+}
+
+TEST(FourierChannels, TakeEverySampleWhereTheSeriesCheckFails) {
+  // Wobbles and runouts to harmonic 9: H = 8 x 9 + 4 = 76 is beyond the closed forms' limit (64), so the
+  // channels are evaluated at every sample, and equal the every-sample route's exactly.
+  Scenario s = two_speed_test(4);
+  set_large_errors(s, 9);
+  const Reduction r = reduce(s);
+  std::vector<DwellChannelsRoute> routes;
+  const auto exact = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
+  const auto every = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kEverySample);
+  for (const DwellChannelsRoute& route : routes) EXPECT_FALSE(route.fourier);
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    EXPECT_EQ(exact[i].omega_exact_deg_h, every[i].omega_exact_deg_h);
+    EXPECT_EQ(exact[i].regressors_exact, every[i].regressors_exact);
+  }
+}
+
+}  // namespace
+}  // namespace gyrocal
