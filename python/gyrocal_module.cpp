@@ -151,7 +151,7 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
                                const std::string& method, const std::string& compensation,
                                const std::string& reduction, const std::vector<std::string>& estimate,
                                const std::string& name) {
-  const CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
+  CalibrationOptions options = calibration_options(scenario, method, compensation, reduction, estimate);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
   check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
   nlohmann::json j;
@@ -167,6 +167,7 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
       s.counter_angle_deg = counter_deg.data()[i];
       s.position_angle_deg = position_deg.data()[i];
       s.gyro_deg_h = gyro_deg_h.data()[i];
+      options.output.range.push(s.gyro_deg_h);  // for the misfit's causes (a flat top)
       reducer.push(s);
     }
     const Reduction reduction_result = reducer.finish();

@@ -579,7 +579,8 @@ RecordLayout read_record(const Reader& reader, Section& section, const toml::tab
     }
   }
   if (const toml::node* node = section.find("output_scale_per_deg_h")) {
-    layout.output_scale_per_deg_h = reader.number(*node, section.path("output_scale_per_deg_h"), kPositive);
+    // Any finite non-zero number: negative for an output whose sign is flipped (RecordLayout::IsValid).
+    layout.output_scale_per_deg_h = reader.number(*node, section.path("output_scale_per_deg_h"), kAnyValue);
   }
   section.reject_unknown();
   std::string error, key;

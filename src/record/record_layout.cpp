@@ -89,11 +89,13 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                                        "with: rows would be taken for comments",
                                        comment, printable(comment.front())));
   }
-  if (!(std::isfinite(output_scale_per_deg_h) && output_scale_per_deg_h > 0.0)) {
-    return fail("output_scale_per_deg_h",
-                fmt::format("record.output_scale_per_deg_h must be a finite number > 0 (output units per "
-                            "deg/h; the output is divided by it), not {}",
-                            output_scale_per_deg_h));
+  if (!(std::isfinite(output_scale_per_deg_h) && output_scale_per_deg_h != 0.0)) {
+    return fail(
+        "output_scale_per_deg_h",
+        fmt::format("record.output_scale_per_deg_h must be a finite number other than 0 (output units "
+                    "per deg/h, negative when the output's sign is flipped; the output is divided by "
+                    "it), not {}",
+                    output_scale_per_deg_h));
   }
   const std::array<std::pair<std::string_view, std::int64_t>, 3> counts = {{
       {"main_counts_per_revolution", main_counts_per_revolution},

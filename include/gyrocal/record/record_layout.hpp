@@ -49,7 +49,8 @@ struct RecordLayout {
   std::int64_t position_counts_per_revolution = 0;
   /// The gyro's output column; required. Default "gyro_deg_h".
   std::string output_column = "gyro_deg_h";
-  /// Output units per deg/h (e.g. mV per deg/h): the output is divided by it. Finite and > 0; default 1.
+  /// Output units per deg/h (e.g. mV per deg/h): the output is divided by it. Finite and non-zero, negative
+  /// for an output whose sign is flipped (a cable or a convention; the misfit names it); default 1.
   double output_scale_per_deg_h = 1.0;
 
   /// True when the layout can be read. Otherwise false, with `error` set (when not null) to one sentence
