@@ -161,7 +161,8 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
                                const std::string& reduction,
                                const std::optional<std::vector<std::string>>& estimate,
                                const std::string& gyro_model, const std::string& name) {
-  const CalibrationOptions options =
+  // Not const: the output's range is kept for the misfit's causes.
+  CalibrationOptions options =
       python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
   check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
@@ -178,6 +179,7 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
       s.counter_angle_deg = counter_deg.data()[i];
       s.position_angle_deg = position_deg.data()[i];
       s.gyro_deg_h = gyro_deg_h.data()[i];
+      options.output.range.push(s.gyro_deg_h);  // for the misfit's causes (a flat top)
       reducer.push(s);
     }
     const Reduction reduction_result = reducer.finish();

@@ -416,8 +416,12 @@ TEST(RigRecord, UncertaintiesDescribeTheSpreadOverSeeds) {
   const testing::RigImperfections all = rig_cases().at("all together");
   const int seeds = sanitized() ? 100 : 250;
   std::vector<std::vector<double>> z(kNumCoefficients);
+  // No good record is refused (a refusal throws here: docs/calibration.md, "When the residuals misfit");
+  // one in a thousand may have its std scaled by chance.
+  int scaled = 0;
   for (int seed = 0; seed < seeds; ++seed) {
     const Calibrated c = calibrate_rows(s, rig_record(s, all, 1000 + static_cast<std::uint64_t>(seed)));
+    scaled += c.result.misfit.scale > 1.0;
     for (std::size_t k = 0; k < kNumCoefficients; ++k)
       z[k].push_back((c.result.coefficients[k].value - s.gyro.values[k]) / c.result.coefficients[k].std);
   }
@@ -432,6 +436,8 @@ TEST(RigRecord, UncertaintiesDescribeTheSpreadOverSeeds) {
     EXPECT_GT(sd, 0.85) << kCoefficientNames[k];
     EXPECT_LT(sd, 1.15) << kCoefficientNames[k];
   }
+  std::printf("rig record: %d of %d records had their std scaled for a misfit\n", scaled, seeds);
+  EXPECT_LE(scaled, 2);
 }
 
 TEST(RigRecord, BeyondItsToleranceARecordIsRefusedNamingThePositionTheTimeAndTheReason) {

@@ -1204,12 +1204,15 @@ class ReadAhead {
 }  // namespace
 
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
-                        double reference_rate_rad_s) {
+                        double reference_rate_rad_s,
+                        const std::function<void(std::span<const RecordSample>)>& observe) {
   Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
   reducer.set_record_layout(reader.layout());
   ReadAhead ahead(reader);
-  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next())
+  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next()) {
+    if (observe) observe(rows);
     for (const RecordSample& s : rows) reducer.push(s);
+  }
   return reducer.finish();
 }
 

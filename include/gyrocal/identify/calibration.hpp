@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/misfit.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -55,6 +56,14 @@ struct CalibrationOptions {
   /// reduce_model_channels' max_samples_per_dwell (0 = every ReduceOptions::model_samples_per_revolution; a
   /// prediction passes the bound it evaluated its channels with).
   std::size_t max_model_samples_per_dwell = 0;
+  /// When the residuals misfit the weights, scale every std or refuse, naming the set-up mistake the data fit
+  /// (identify/misfit.hpp; docs/calibration.md, "When the residuals misfit"). False for a prediction, whose
+  /// outputs are noise-free by construction.
+  bool test_misfit = true;
+  MisfitRule misfit;  ///< the rule's thresholds
+  /// What the configuration says about the output (its [record] scale), for the fix a misfit's cause names;
+  /// calibrate_record sets it from the record's layout.
+  OutputConfiguration output;
 
   bool IsValid(std::string* error) const;
 };
@@ -149,12 +158,17 @@ struct CalibrationResult {
   /// of the same quantity from the same 16 positions and covariance (>= 1; 1 = no uncertainty given away).
   /// 0 when not computed.
   double uncertainty_amplification = 0.0;
+  /// The weighted residuals' sum of squares and its degrees of freedom (least squares; the closed forms: of
+  /// the least-squares fit of the same positions, which the misfit test judges).
   double chi2 = 0.0;
   int dof = 0;
   DataQuality data_quality;
   /// The estimated machine errors (CalibrationOptions::estimate), in its order; empty without.
   std::vector<MachineErrorEstimate> machine_errors;
   int iterations = 0;  ///< Gauss-Newton iterations of a self-calibration, 0 without
+  /// The misfit test of chi2 (identify/misfit.hpp): its p-value and the factor every std above was multiplied
+  /// by (1: the weights' own; docs/calibration.md, "When the residuals misfit").
+  MisfitTest misfit;
   std::vector<std::string> warnings;
 
   /// One line: method, compensation, rank, condition, warnings.

@@ -2,8 +2,10 @@
 // Reduce a record, read as a stream: split it into dwells from the encoder angles, drop the settle
 // interval, and reduce each dwell to one value per gamma of the plan (reduce/dwell_accumulator.hpp).
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -169,8 +171,11 @@ class Reducer {
   std::unique_ptr<State> state_;
 };
 
-/// Reduce a whole record file (streaming).
+/// Reduce a whole record file (streaming; the rows are read ahead on a thread of their own). `observe`, when
+/// given, sees every batch of rows before the reducer takes them (e.g. the output's range,
+/// identify/misfit.hpp).
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
-                        double reference_rate_rad_s);
+                        double reference_rate_rad_s,
+                        const std::function<void(std::span<const RecordSample>)>& observe = {});
 
 }  // namespace gyrocal

@@ -1,0 +1,337 @@
+#include "gyrocal/identify/misfit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+namespace {
+
+/// Continued fraction of the regularised incomplete beta function (modified Lentz).
+double beta_continued_fraction(double a, double b, double x) {
+  constexpr double kTiny = 1e-300;
+  const double qab = a + b, qap = a + 1.0, qam = a - 1.0;
+  double c = 1.0, d = 1.0 - qab * x / qap;
+  if (std::abs(d) < kTiny) d = kTiny;
+  d = 1.0 / d;
+  double h = d;
+  for (int m = 1; m <= 10000; ++m) {
+    const double m2 = 2.0 * m;
+    double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
+    d = 1.0 + aa * d;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = 1.0 + aa / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    h *= d * c;
+    aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
+    d = 1.0 + aa * d;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = 1.0 + aa / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-15) break;
+  }
+  return h;
+}
+
+/// The regularised incomplete beta function I_x(a, b).
+double incomplete_beta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front =
+      std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_continued_fraction(a, b, x) / a;
+  return 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b;
+}
+
+/// The regularised upper incomplete gamma function Q(a, x): series below x = a + 1, else a continued
+/// fraction.
+double upper_incomplete_gamma(double a, double x) {
+  if (x <= 0.0) return 1.0;
+  const double log_front = a * std::log(x) - x - std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int n = 1; n < 100000 && std::abs(term) > 1e-16 * std::abs(sum); ++n) {
+      term *= x / (a + n);
+      sum += term;
+    }
+    return 1.0 - sum * std::exp(log_front);
+  }
+  constexpr double kTiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 100000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = b + an / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-15) break;
+  }
+  return std::exp(log_front) * h;
+}
+
+/// The dwell's slot whose gamma is `gamma_rad` (modulo a turn, within 1e-6 deg), -1 if none.
+int slot_of(const Dwell& d, double gamma_rad) {
+  for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
+    if (std::abs(wrap_deg((d.gammas_rad[k] - gamma_rad) * kRadToDeg)) < 1e-6) return static_cast<int>(k);
+  return -1;
+}
+
+/// The position reduced from dwell `dwell`, slot `slot`; -1 if none.
+int position_of(const Reduction& r, int dwell, int slot) {
+  for (std::size_t i = 0; i < r.positions.size(); ++i)
+    if (r.positions[i].dwell == dwell && r.positions[i].gamma_slot == slot) return static_cast<int>(i);
+  return -1;
+}
+
+/// The reduction whose position (dwell d, slot k) holds what (dwell partner[d], slot slot_map[d][k]) held:
+/// the values, standard errors and covariances moved with the outputs, the model's side (angles, rates) kept.
+/// nullopt when a position has no partner, or when nothing moves.
+std::optional<Reduction> permute_outputs(const Reduction& r, const std::vector<int>& partner,
+                                         const std::vector<std::vector<int>>& slot_map) {
+  bool moved = false;
+  Reduction out = r;
+  for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+    const int p = partner[d];
+    if (p < 0) return std::nullopt;
+    const DwellValues& from = r.dwells[static_cast<std::size_t>(p)].gyro;
+    DwellValues& to = out.dwells[d].gyro;
+    const std::vector<int>& map = slot_map[d];
+    to = from;
+    for (std::size_t k = 0; k < map.size(); ++k) {
+      const auto m = static_cast<std::size_t>(map[k]);
+      moved |= p != static_cast<int>(d) || m != k;
+      if (m < from.value.size()) to.value[k] = from.value[m];
+      if (m < from.std_err.size()) to.std_err[k] = from.std_err[m];
+      if (static_cast<Eigen::Index>(m) < from.covariance.rows())
+        for (std::size_t l = 0; l < map.size(); ++l)
+          to.covariance(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(l)) =
+              from.covariance(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(map[l]));
+    }
+  }
+  if (!moved) return std::nullopt;
+  for (ReducedPosition& q : out.positions) {
+    const auto d = static_cast<std::size_t>(q.dwell);
+    const int src = position_of(r, partner[d], slot_map[d][static_cast<std::size_t>(q.gamma_slot)]);
+    if (src < 0) return std::nullopt;
+    const ReducedPosition& s = r.positions[static_cast<std::size_t>(src)];
+    q.mean_deg_h = s.mean_deg_h;
+    q.std_err_deg_h = s.std_err_deg_h;
+    q.outliers = s.outliers;
+  }
+  return out;
+}
+
+/// The counter platform's angle counted the other way: the output measured at gamma belongs to -gamma.
+std::optional<Reduction> mirror_gamma(const Reduction& r) {
+  std::vector<int> partner(r.dwells.size());
+  std::vector<std::vector<int>> slots(r.dwells.size());
+  for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+    partner[d] = static_cast<int>(d);
+    for (double g : r.dwells[d].gammas_rad) {
+      const int k = slot_of(r.dwells[d], -g);
+      if (k < 0) return std::nullopt;
+      slots[d].push_back(k);
+    }
+  }
+  return permute_outputs(r, partner, slots);
+}
+
+/// The position platform's angle counted the other way: the dwell measured at beta belongs to -beta.
+std::optional<Reduction> mirror_beta(const Reduction& r) {
+  std::vector<int> partner(r.dwells.size(), -1);
+  std::vector<std::vector<int>> slots(r.dwells.size());
+  for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+    const Dwell& a = r.dwells[d];
+    for (std::size_t e = 0; e < r.dwells.size() && partner[d] < 0; ++e) {
+      const Dwell& b = r.dwells[e];
+      if (a.is_static != b.is_static || a.planned_rate_rad_s != b.planned_rate_rad_s ||
+          a.planned_counter_rate_offset_rad_s != b.planned_counter_rate_offset_rad_s ||
+          std::abs(wrap_deg((a.beta_rad + b.beta_rad) * kRadToDeg)) > 1e-6)
+        continue;
+      std::vector<int> map;
+      for (double g : a.gammas_rad) map.push_back(slot_of(b, g));
+      if (std::find(map.begin(), map.end(), -1) != map.end()) continue;
+      partner[d] = static_cast<int>(e);
+      slots[d] = map;
+    }
+  }
+  return permute_outputs(r, partner, slots);
+}
+
+/// A standard error below 1e-6 deg/h is a noise-free output's rounding (1e-10..1e-8 deg/h), not noise: no
+/// gyro's reduced output is that quiet (0.002 deg/rt(h) over a few seconds leaves ~1e-2 deg/h).
+bool without_noise(double std_err_deg_h) {
+  return !(std_err_deg_h > 1e-6);
+}
+
+std::string number(double v) {
+  return fmt::format("{:.6g}", v);
+}
+
+}  // namespace
+
+double misfit_p_value(double chi2, int dof, double weight_dof) {
+  if (dof <= 0) return 1.0;
+  if (!(chi2 >= 0.0)) return std::isnan(chi2) ? 0.0 : 1.0;
+  if (std::isinf(chi2)) return 0.0;
+  const double d1 = dof;
+  if (!(weight_dof > 0.0) || weight_dof > 1e7) return upper_incomplete_gamma(0.5 * d1, 0.5 * chi2);
+  const double f = chi2 / d1;
+  return incomplete_beta(0.5 * weight_dof, 0.5 * d1, weight_dof / (weight_dof + d1 * f));
+}
+
+double weight_dof(const Reduction& reduction) {
+  double sum = 0.0;
+  bool measured = false;
+  for (const Dwell& d : reduction.dwells)
+    if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0) {
+      sum += d.gyro.dof;
+      measured = true;
+    }
+  return measured ? sum : std::numeric_limits<double>::infinity();
+}
+
+MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof) {
+  MisfitTest t;
+  t.chi2 = chi2;
+  t.dof = dof;
+  t.weight_dof = weight_dof(reduction);
+  const bool measured = std::any_of(reduction.positions.begin(), reduction.positions.end(),
+                                    [](const ReducedPosition& p) { return !without_noise(p.std_err_deg_h); });
+  // A prediction's covariance is known (its outputs are noise-free by construction): nothing to test.
+  t.tested = measured && dof > 0 && std::isfinite(t.weight_dof);
+  t.p_value = t.tested ? misfit_p_value(chi2, dof, t.weight_dof) : 1.0;
+  return t;
+}
+
+Reduction scale_outputs(const Reduction& reduction, double factor) {
+  Reduction out = reduction;
+  const double a = std::abs(factor);
+  for (ReducedPosition& p : out.positions) {
+    p.mean_deg_h *= factor;
+    p.std_err_deg_h *= a;
+  }
+  for (Dwell& d : out.dwells) {
+    for (double& v : d.gyro.value) v *= factor;
+    for (double& v : d.gyro.std_err) v *= a;
+    d.gyro.covariance *= factor * factor;
+    d.gyro.level *= factor * factor;
+  }
+  return out;
+}
+
+std::vector<MisfitCause> gyro_misfit_causes(const OutputConfiguration& output) {
+  std::vector<MisfitCause> causes;
+  const double s = output.scale;
+  const std::string key = "[record] " + output.scale_key;
+  // Each unit as output units per deg/h: a record written in it reads right with that scale.
+  struct Unit {
+    const char* name;
+    double per_deg_h;
+  };
+  static const Unit kUnits[] = {
+      {"deg/h", 1.0}, {"deg/s", 1.0 / 3600.0}, {"rad/s", kDegToRad / 3600.0}, {"rad/h", kDegToRad}};
+  const auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::abs(b); };
+  const auto add = [&](std::string name, double scale, std::string what) {
+    for (const MisfitCause& c : causes)
+      if (c.name == name) return;
+    const double k = s / scale;  // the reduced output times k is what the scale `scale` would have read
+    causes.push_back({std::move(name),
+                      [k](const Reduction& r) -> std::optional<Reduction> { return scale_outputs(r, k); },
+                      fmt::format("{}: set {} = {} (it is {})", what, key, number(scale), number(s))});
+  };
+  add("sign", -s, "the output's sign is flipped (a cable, or the sensor's sign convention)");
+  for (const Unit& u : kUnits)
+    for (double sign : {1.0, -1.0}) {
+      const double c = sign * u.per_deg_h;
+      if (same(c, s) || same(c, -s)) continue;
+      add(fmt::format("unit {}{}", sign < 0 ? "-" : "", u.name), c,
+          fmt::format("the output is in {}{}, not in the unit the configuration says", u.name,
+                      sign < 0 ? " with its sign flipped" : ""));
+    }
+  causes.push_back(
+      {"gamma counted the other way", mirror_gamma,
+       "the output at gamma belongs to -gamma: the counter platform's angle is counted the other "
+       "way than gyrocal's (docs/physics.md section 2): negate the record's counter angle column "
+       "([record] counter_angle_column), or check its wiring"});
+  causes.push_back(
+      {"beta counted the other way", mirror_beta,
+       "the output at beta belongs to -beta: the position platform's angle is counted the other "
+       "way than gyrocal's (docs/physics.md section 2): negate the record's position angle column "
+       "([record] position_angle_column), or check its wiring"});
+  return causes;
+}
+
+void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output) {
+  if (reduction.positions.size() < 2) return;
+  const double v0 = reduction.positions.front().mean_deg_h;
+  for (const ReducedPosition& p : reduction.positions)
+    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(1.0, std::abs(v0))) ||
+        !without_noise(p.std_err_deg_h))
+      return;
+  throw Error(fmt::format(
+      "the gyro output is the constant {} deg/h at every one of the {} positions, with no scatter at all: a "
+      "dead or disconnected sensor (or a [record] output_column that names a column that does not change; "
+      "{} = {}); nothing can be calibrated from it.",
+      number(v0), reduction.positions.size(), output.scale_key, number(output.scale)));
+}
+
+void OutputRange::push(double value) {
+  if (!std::isfinite(value)) return;
+  ++count_;
+  if (value > max_) max_ = value, at_max_ = 0;
+  if (value < min_) min_ = value, at_min_ = 0;
+  if (value == max_) ++at_max_;
+  if (value == min_) ++at_min_;
+}
+
+std::string saturation_cause(const Reduction& reduction, const OutputRange& range) {
+  const auto many = [&](std::size_t n) {
+    return n >= 10 && static_cast<double>(n) > 0.005 * static_cast<double>(range.count());
+  };
+  if (range.count() > 0 && range.max() > range.min() && (many(range.at_max()) || many(range.at_min()))) {
+    const bool top = range.at_max() >= range.at_min();
+    const std::size_t n = top ? range.at_max() : range.at_min();
+    return fmt::format(
+        "{} of the record's {} samples ({:.1f} %) sit exactly at its {} output, {} deg/h, which noise never "
+        "does: a saturated or clipped channel (a flat top); use a range of the gyro and its acquisition that "
+        "holds the largest output",
+        n, range.count(), 100.0 * static_cast<double>(n) / static_cast<double>(range.count()),
+        top ? "largest" : "smallest", number(top ? range.max() : range.min()));
+  }
+  const auto where = [&](std::size_t d) {
+    const Dwell& w = reduction.dwells[d];
+    return fmt::format("the {} at {:g} rad/s, beta {:g} deg (record time {:g} s to {:g} s)",
+                       w.is_static ? "static hold" : "dwell", w.planned_rate_rad_s, w.beta_rad * kRadToDeg,
+                       w.first_time_s, w.last_time_s);
+  };
+  std::size_t worst = reduction.dwells.size();
+  double worst_fraction = 0.05;
+  for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
+    const Dwell& w = reduction.dwells[d];
+    if (w.samples == 0) continue;
+    const double fraction = static_cast<double>(w.gyro.outliers) / static_cast<double>(w.samples);
+    if (fraction > worst_fraction) worst = d, worst_fraction = fraction;
+  }
+  if (worst < reduction.dwells.size())
+    return fmt::format(
+        "{:.0f} % of the samples of {} were rejected as outliers, which spikes never do: a saturated or "
+        "clipped channel (flat tops cut off the output); use a range of the gyro and its acquisition that "
+        "holds the largest output",
+        100.0 * worst_fraction, where(worst));
+  return {};
+}
+
+}  // namespace gyrocal
