@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "gyrocal/core/error.hpp"
 
 namespace gyrocal {
@@ -14,7 +16,7 @@ constexpr std::size_t kScale = static_cast<std::size_t>(AccelCoefficient::K1);
 
 std::array<double, kNumAccelCoefficients> accelerometer_regressors(const Eigen::Vector3d& f) {
   const double ai = f.x(), ap = f.y(), ao = f.z();
-  // Table order: K0, K1, K2, K3, Kip, Kio, Kpo, Kpp, Koo, delta_p, delta_o (docs/physics.md section 16).
+  // Table order: K0, K1, K2, K3, Kip, Kio, Kpo, Kpp, Koo, delta_p, delta_o (docs/accelerometer.md).
   return {kMicro,           ai,
           kMicro * ai * ai, kMicro * ai * ai * ai,
           kMicro * ai * ap, kMicro * ai * ao,
@@ -37,7 +39,7 @@ void validate_accelerometer_noise(const AccelerometerNoise& noise) {
     const double v = noise.*k.member;
     if (!std::isfinite(v) || v < 0.0) {
       throw Error("accelerometer.noise." + std::string(k.key) + " must be a finite number >= 0, not " +
-                  std::to_string(v) + ".");
+                  fmt::format("{}", v) + ".");
     }
   }
 }
@@ -87,7 +89,7 @@ ParameterEstimates Accelerometer::from_products(const Eigen::VectorXd& u, const 
   const auto s = static_cast<Eigen::Index>(kScale);
   const double k1 = u(s);
   if (!(std::isfinite(k1) && k1 != 0.0))
-    throw Error("the accelerometer's scale factor K1 came out as " + std::to_string(k1) +
+    throw Error("the accelerometer's scale factor K1 came out as " + fmt::format("{}", k1) +
                 ": the coefficients cannot be divided out of their products.");
   Eigen::VectorXd values(n);
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(n, n);

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "gyrocal/core/error.hpp"
 
 namespace gyrocal {
@@ -19,7 +21,8 @@ GyroNoise accelerometer_noise_as_generator_parameters(const AccelerometerNoise& 
 namespace {
 double checked_scale(double k1) {
   if (!std::isfinite(k1) || k1 == 0.0)
-    throw Error("accelerometer.K1 must be a finite non-zero scale factor, not " + std::to_string(k1) + ".");
+    throw Error("accelerometer.K1 must be a finite non-zero scale factor, not " + fmt::format("{}", k1) +
+                ".");
   return k1;
 }
 }  // namespace

@@ -1,6 +1,6 @@
 #pragma once
-// The pendulous accelerometer of IEEE Std 1293 on the centrifuge (docs/accelerometer.md; docs/physics.md
-// section 16). Axes i (input), p (pendulous), o (output hinge), right-handed (i x p = o), sit on the mount's
+// The pendulous accelerometer of IEEE Std 1293 on the centrifuge (docs/accelerometer.md).
+// Axes i (input), p (pendulous), o (output hinge), right-handed (i x p = o), sit on the mount's
 // first, second and third axes (where a gyro's I, O, S sit), so the exact specific force of exact_inputs,
 // (a_i, a_p, a_o) in g, is its input. The output, in output units (g for gyrocal's own record):
 //   E = K1 (K0 + a_i + K2 a_i^2 + K3 a_i^3 + Kip a_i a_p + Kio a_i a_o + Kpo a_p a_o + Kpp a_p^2 + Koo a_o^2
