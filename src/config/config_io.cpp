@@ -870,6 +870,93 @@ void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------------------
+// The sensor's own sections (docs/accelerometer.md): [sensor] kind, [accelerometer] and
+// [accelerometer.noise], their keys from the accelerometer's parameter table (sensor/accelerometer.hpp).
+
+/// Reads [sensor], [accelerometer] and [accelerometer.noise] into s.
+void read_sensor(const Reader& reader, Section& top, Scenario& s) {
+  Section sensor(reader, top.table("sensor"), "sensor");
+  if (const toml::node* node = sensor.find("kind")) {
+    const std::string text = reader.string(*node, "sensor.kind");
+    const std::optional<SensorKind> kind = parse_sensor_kind(text);
+    if (!kind)
+      reader.fail(node->source(), "sensor.kind must be \"gyro\" or \"accelerometer\", not \"" + text + "\"");
+    s.sensor_kind = *kind;
+  }
+  sensor.reject_unknown();
+
+  const toml::table* accelerometer_table = top.table("accelerometer");
+  Section accelerometer(reader, accelerometer_table, "accelerometer");
+  const toml::table* noise_table = accelerometer.table("noise");
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const SensorParameter& p = kAccelerometerParameters[k];
+    accelerometer.number(p.key, 1.0, kAnyValue, s.accelerometer.coefficients.values[k]);
+    if (p.name == "K1" && s.accelerometer.coefficients.values[k] == 0.0)
+      reader.fail(accelerometer_table->get(p.key)->source(),
+                  "accelerometer.K1 must be a non-zero scale factor (output units per g), not 0");
+  }
+  accelerometer.reject_unknown();
+  Section noise(reader, noise_table, "accelerometer.noise");
+  for (const AccelerometerNoiseKey& k : kAccelerometerNoiseKeys)
+    noise.number(k.key, 1.0, kNonNegative, s.accelerometer.noise.*k.member);
+  noise.reject_unknown();
+}
+
+/// Refuses, naming it, the first key (by line) that belongs to the other sensor: a [gyro] or [gyro.noise] key
+/// or calibration.gyro_model in an accelerometer configuration, an [accelerometer] or [accelerometer.noise]
+/// key in a gyro configuration.
+void refuse_other_sensor_keys(const Reader& reader, const toml::table& root, SensorKind kind) {
+  const std::string other = kind == SensorKind::kGyro ? "accelerometer" : "gyro";
+  const toml::key* first = nullptr;
+  std::string first_path;
+  const auto consider = [&](const toml::key& key, std::string path) {
+    if (first == nullptr || key.source().begin < first->source().begin) {
+      first = &key;
+      first_path = std::move(path);
+    }
+  };
+  if (const toml::table* table = root[other].as_table()) {
+    for (const auto& [key, node] : *table) {
+      if (const toml::table* sub = node.as_table()) {
+        for (const auto& [sub_key, sub_node] : *sub)
+          consider(sub_key, other + "." + std::string(key.str()) + "." + std::string(sub_key.str()));
+      } else {
+        consider(key, other + "." + std::string(key.str()));
+      }
+    }
+  }
+  if (kind == SensorKind::kAccelerometer) {
+    if (const toml::table* calibration = root["calibration"].as_table()) {
+      for (const auto& [key, node] : *calibration)
+        if (key.str() == "gyro_model") consider(key, "calibration.gyro_model");
+    }
+  }
+  if (first == nullptr) return;
+  if (kind == SensorKind::kAccelerometer)
+    reader.fail(first->source(), first_path + " is a gyro key, but sensor.kind is \"accelerometer\"");
+  reader.fail(first->source(),
+              first_path +
+                  " is an accelerometer key, but the sensor is the gyro (sensor.kind absent or "
+                  "\"gyro\"): set [sensor] kind = \"accelerometer\" or remove the key");
+}
+
+/// [sensor], [accelerometer] and [accelerometer.noise] of an accelerometer scenario.
+void write_accelerometer(TomlWriter& w, const Scenario& s) {
+  w.section("sensor", "The sensor whose output the record holds (docs/accelerometer.md).");
+  w.key("kind", "\"accelerometer\"", "\"gyro\" (the default) or \"accelerometer\"");
+  w.section("accelerometer",
+            "The accelerometer's IEEE 1293 coefficients (docs/accelerometer.md): the truth, for simulation.");
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const SensorParameter& p = kAccelerometerParameters[k];
+    w.key(p.key, toml_number(s.accelerometer.coefficients.values[k]),
+          std::string(p.meaning) + ", " + std::string(p.unit));
+  }
+  w.section("accelerometer.noise", "");
+  for (const AccelerometerNoiseKey& k : kAccelerometerNoiseKeys)
+    w.key(k.key, toml_number(s.accelerometer.noise.*k.member), k.meaning);
+}
+
 /// Refuses a character beyond ASCII anywhere but in a comment (and a UTF-8 byte order mark at the start).
 /// The keys and values of a configuration are ASCII, so this refuses nothing that could be read, and it keeps
 /// such characters away from toml++ 3.3.0 (Debian 12), whose whitespace test reaches __builtin_unreachable
@@ -1041,6 +1128,9 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
     s.record = read_record(reader, record, *record_table);
   }
 
+  read_sensor(reader, top, s);
+  refuse_other_sensor_keys(reader, root, s.sensor_kind);
+
   top.reject_unknown();
   return s;
 }
@@ -1132,22 +1222,26 @@ std::string scenario_to_toml(const Scenario& s) {
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
   write_errors(w, s.errors);
 
-  w.section("gyro", "The gyro's drift coefficients (docs/physics.md section 6): the truth, for simulation.");
-  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
-    w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
-          std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
+  if (s.sensor_kind == SensorKind::kAccelerometer) write_accelerometer(w, s);
+  if (s.sensor_kind == SensorKind::kGyro) {
+    w.section("gyro",
+              "The gyro's drift coefficients (docs/physics.md section 6): the truth, for simulation.");
+    for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+      w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
+            std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
+    }
+
+    w.key("scale_factor_error_ppm", toml_number(s.gyro_rate.scale_factor_error_ppm),
+          "e: sensed rate (1 + e)(wI + dO wO + dS wS) (physics.md section 15), ppm");
+    w.key("input_axis_misalignment_arcsec",
+          number_array(
+              {s.gyro_rate.input_axis_misalignment_O_arcsec, s.gyro_rate.input_axis_misalignment_S_arcsec},
+              1.0),
+          "[dO, dS]: the input axis tilted toward O and toward S, arcsec");
+
+    w.section("gyro.noise", "");
+    write_numbers(w, kNoiseKeys, s.noise);
   }
-
-  w.key("scale_factor_error_ppm", toml_number(s.gyro_rate.scale_factor_error_ppm),
-        "e: sensed rate (1 + e)(wI + dO wO + dS wS) (physics.md section 15), ppm");
-  w.key(
-      "input_axis_misalignment_arcsec",
-      number_array(
-          {s.gyro_rate.input_axis_misalignment_O_arcsec, s.gyro_rate.input_axis_misalignment_S_arcsec}, 1.0),
-      "[dO, dS]: the input axis tilted toward O and toward S, arcsec");
-
-  w.section("gyro.noise", "");
-  write_numbers(w, kNoiseKeys, s.noise);
 
   const TestSpec& t = s.test;
   w.section("test",
@@ -1180,8 +1274,9 @@ std::string scenario_to_toml(const Scenario& s) {
   w.key("estimate", names + "]",
         "machine errors estimated from the data (--estimate; docs/self_calibration.md): NAME, NAME_I/_O/_S, "
         "NAME:N");
-  w.key("gyro_model", s.gyro_model == GyroModel::kDrift ? "\"drift\"" : "\"drift+rate\"",
-        "\"drift\" or \"drift+rate\" (docs/physics.md section 15)");
+  if (s.sensor_kind == SensorKind::kGyro)
+    w.key("gyro_model", s.gyro_model == GyroModel::kDrift ? "\"drift\"" : "\"drift+rate\"",
+          "\"drift\" or \"drift+rate\" (docs/physics.md section 15)");
   w.key("reduction", s.reduce.method == ReduceOptions::Method::kWindowMean ? "\"window\"" : "\"harmonic\"",
         "\"harmonic\" (fit in gamma with drift) or \"window\" (mean around each gamma); as --reduction");
 

@@ -12,6 +12,7 @@
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/record/record_layout.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
+#include "gyrocal/sensor/sensor.hpp"
 
 namespace gyrocal {
 
@@ -36,6 +37,19 @@ struct Scenario {
   /// harmonic order...), and [calibration] reduction: its method. Defaults: ReduceOptions{}, whose header
   /// gives each default's reason. The command line's --reduction overrides the method.
   ReduceOptions reduce;
+  /// [sensor] kind: the sensor whose output the record holds (docs/accelerometer.md). The gyro by default;
+  /// an accelerometer configuration holds no [gyro] key and a gyro configuration no [accelerometer] key.
+  SensorKind sensor_kind = SensorKind::kGyro;
+  /// [accelerometer] and [accelerometer.noise]: the accelerometer's truth and noise, for simulation (used
+  /// when sensor_kind is kAccelerometer). Defaults: docs/contract.md's.
+  Accelerometer accelerometer;
+
+  /// The sensor this scenario describes: the gyro of [gyro], [gyro.noise] and calibration.gyro_model, or the
+  /// accelerometer.
+  Sensor sensor() const {
+    if (sensor_kind == SensorKind::kAccelerometer) return accelerometer;
+    return Gyro{gyro, gyro_rate, noise, gyro_model};
+  }
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
