@@ -249,7 +249,7 @@ def test_calibrate_takes_the_scenarios_gyro_model_and_estimate(tmp_path):
     run_cli("simulate", "--config", config, "--out", record)
     result = tmp_path / "result.json"
     run_cli("calibrate", record, "--config", config, "--json", result)
-    expected = json.loads(result.read_text())
+    expected = cli_result(result.read_text())
     assert len(expected["coefficients"]) == 13 and len(expected["machine_errors"]) == 1
     got = gyrocal.calibrate(str(record), sc)
     assert got == expected
@@ -259,7 +259,7 @@ def test_calibrate_takes_the_scenarios_gyro_model_and_estimate(tmp_path):
     run_cli("calibrate", record, "--config", config, "--gyro-model", "drift", "--estimate", "counter_rate_mismatch",
             "--json", result)
     overridden = gyrocal.calibrate(str(record), sc, gyro_model="drift", estimate=["counter_rate_mismatch"])
-    assert overridden == json.loads(result.read_text())
+    assert overridden == cli_result(result.read_text())
     assert len(overridden["coefficients"]) == 10
     # An empty list estimates nothing (the command line has no way to say so but leaving out [calibration]).
     assert "machine_errors" not in gyrocal.calibrate(str(record), sc, estimate=[])
