@@ -76,10 +76,11 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   j["chi2"] = number_or_null(r.chi2);
   j["dof"] = r.dof;
   // The misfit test (docs/calibration.md, "When the residuals misfit"): std_scale multiplied every std above.
-  j["misfit"] = {{"tested", r.misfit.tested},
-                 {"p_value", r.misfit.tested ? number_or_null(r.misfit.p_value) : nlohmann::ordered_json(nullptr)},
-                 {"weight_dof", number_or_null(r.misfit.weight_dof)},
-                 {"std_scale", r.misfit.scale}};
+  j["misfit"] = {
+      {"tested", r.misfit.tested},
+      {"p_value", r.misfit.tested ? number_or_null(r.misfit.p_value) : nlohmann::ordered_json(nullptr)},
+      {"weight_dof", number_or_null(r.misfit.weight_dof)},
+      {"std_scale", r.misfit.scale}};
   // A record's (a prediction reads none).
   if (r.data_quality.rows_read > 0)
     j["data_quality"] = {{"rows_read", r.data_quality.rows_read},
