@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/special_functions.hpp"
 
 namespace gyrocal {
 namespace {
@@ -22,41 +23,6 @@ constexpr double kSignificance = 2.0;
 // scatter of the fitted terms was 1.4 (N) and 2.0 (K) times their independent-point uncertainty. The stated
 // uncertainty is scaled by this factor (docs/noise.md); tests/test_noise_terms.cpp checks the z-scores.
 constexpr double kCorrelationFactor = 2.0;
-
-// The regularised lower incomplete gamma function P(a, x): its series below x = a + 1, else 1 - Q(a, x) from
-// the continued fraction of Q evaluated by the modified Lentz method (Numerical Recipes, section 6.2).
-double regularized_gamma_p(double a, double x) {
-  if (x <= 0.0) return 0.0;
-  const double log_prefactor = a * std::log(x) - x - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a;
-    double sum = term;
-    for (int n = 1; n < 10000; ++n) {
-      term *= x / (a + n);
-      sum += term;
-      if (std::abs(term) < std::abs(sum) * 1e-17) break;
-    }
-    return sum * std::exp(log_prefactor);
-  }
-  constexpr double tiny = 1e-300;
-  double b = x + 1.0 - a;
-  double c = 1.0 / tiny;
-  double d = 1.0 / b;
-  double h = d;
-  for (int i = 1; i < 10000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-17) break;
-  }
-  return 1.0 - std::exp(log_prefactor) * h;
-}
 
 // The basis of sigma^2(tau) in (deg/h)^2 for tau in s, one function per NoiseTerm (physics.md section 13).
 double basis(NoiseTerm term, double tau_s) {

@@ -6,80 +6,11 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/special_functions.hpp"
 #include "gyrocal/core/units.hpp"
 
 namespace gyrocal {
 namespace {
-
-/// Continued fraction of the regularised incomplete beta function (modified Lentz).
-double beta_continued_fraction(double a, double b, double x) {
-  constexpr double kTiny = 1e-300;
-  const double qab = a + b, qap = a + 1.0, qam = a - 1.0;
-  double c = 1.0, d = 1.0 - qab * x / qap;
-  if (std::abs(d) < kTiny) d = kTiny;
-  d = 1.0 / d;
-  double h = d;
-  for (int m = 1; m <= 10000; ++m) {
-    const double m2 = 2.0 * m;
-    double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-    d = 1.0 + aa * d;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = 1.0 + aa / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    h *= d * c;
-    aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-    d = 1.0 + aa * d;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = 1.0 + aa / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return h;
-}
-
-/// The regularised incomplete beta function I_x(a, b).
-double incomplete_beta(double a, double b, double x) {
-  if (x <= 0.0) return 0.0;
-  if (x >= 1.0) return 1.0;
-  const double front =
-      std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
-  if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_continued_fraction(a, b, x) / a;
-  return 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b;
-}
-
-/// The regularised upper incomplete gamma function Q(a, x): series below x = a + 1, else a continued
-/// fraction.
-double upper_incomplete_gamma(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double log_front = a * std::log(x) - x - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a, sum = term;
-    for (int n = 1; n < 100000 && std::abs(term) > 1e-16 * std::abs(sum); ++n) {
-      term *= x / (a + n);
-      sum += term;
-    }
-    return 1.0 - sum * std::exp(log_front);
-  }
-  constexpr double kTiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = b + an / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return std::exp(log_front) * h;
-}
 
 /// The dwell's slot whose gamma is `gamma_rad` (modulo a turn, within 1e-6 deg), -1 if none.
 int slot_of(const Dwell& d, double gamma_rad) {
@@ -187,9 +118,9 @@ double misfit_p_value(double chi2, int dof, double weight_dof) {
   if (!(chi2 >= 0.0)) return std::isnan(chi2) ? 0.0 : 1.0;
   if (std::isinf(chi2)) return 0.0;
   const double d1 = dof;
-  if (!(weight_dof > 0.0) || weight_dof > 1e7) return upper_incomplete_gamma(0.5 * d1, 0.5 * chi2);
+  if (!(weight_dof > 0.0) || weight_dof > 1e7) return regularized_gamma_q(0.5 * d1, 0.5 * chi2);
   const double f = chi2 / d1;
-  return incomplete_beta(0.5 * weight_dof, 0.5 * d1, weight_dof / (weight_dof + d1 * f));
+  return regularized_beta(0.5 * weight_dof, 0.5 * d1, weight_dof / (weight_dof + d1 * f));
 }
 
 double weight_dof(const Reduction& reduction) {
