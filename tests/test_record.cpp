@@ -100,7 +100,7 @@ TEST(Record, RoundTripIsBitForBit) {
       sample.main_angle_deg = random_double(random);
       sample.counter_angle_deg = random_double(random);
       sample.position_angle_deg = random_double(random);
-      sample.gyro_deg_h = random_double(random);
+      sample.output = random_double(random);
       sample.extra[0] = random_double(random);
       sample.extra[1] = random_double(random);
       writer.write(sample);
@@ -118,7 +118,7 @@ TEST(Record, RoundTripIsBitForBit) {
                                {a.main_angle_deg, b.main_angle_deg},
                                {a.counter_angle_deg, b.counter_angle_deg},
                                {a.position_angle_deg, b.position_angle_deg},
-                               {a.gyro_deg_h, b.gyro_deg_h},
+                               {a.output, b.output},
                                {a.extra[0], b.extra[0]},
                                {a.extra[1], b.extra[1]}};
     for (const auto& pair : pairs) {
@@ -277,7 +277,7 @@ TEST(Record, LinesCrossingChunkBoundariesFromAFile) {
     for (int i = 0; i < rows; ++i) {
       sample.time_s = i * 0.005;
       sample.main_angle_deg = i * 2.8359375;
-      sample.gyro_deg_h = 1.0 / (i + 1);
+      sample.output = 1.0 / (i + 1);
       sample.extra[0] = 20.0 + i * 1e-6;
       writer.write(sample);
     }
@@ -292,7 +292,7 @@ TEST(Record, LinesCrossingChunkBoundariesFromAFile) {
     while (reader.next(sample)) {
       ASSERT_EQ(sample.time_s, count * 0.005);
       ASSERT_EQ(sample.main_angle_deg, count * 2.8359375);
-      ASSERT_EQ(sample.gyro_deg_h, 1.0 / (count + 1));
+      ASSERT_EQ(sample.output, 1.0 / (count + 1));
       ASSERT_EQ(sample.extra[0], 20.0 + count * 1e-6);
       ++count;
     }
@@ -319,7 +319,7 @@ TEST(Record, WriterRefusesWhatTheReaderWouldRefuse) {
   writer.write(sample);
   EXPECT_THROW(writer.write(sample), Error);  // time does not increase
   sample.time_s = 1.0;
-  sample.gyro_deg_h = std::numeric_limits<double>::quiet_NaN();
+  sample.output = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(writer.write(sample), Error);
   EXPECT_THROW(RecordWriter(out, {{"a=b", "c"}}, {}), Error);
   EXPECT_THROW(RecordWriter(out, {{"a", "line\nbreak"}}, {}), Error);

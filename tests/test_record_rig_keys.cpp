@@ -69,12 +69,12 @@ position_angle_offset_deg = 90.0
   EXPECT_EQ(s.main_angle_deg, 3.0);       // 20.25 - 17.25
   EXPECT_EQ(s.counter_angle_deg, 2.0);    // 1.5 + 0.5
   EXPECT_EQ(s.position_angle_deg, 45.0);  // 135 - 90
-  EXPECT_EQ(s.gyro_deg_h, 10.0);          // (75 - 100) / -2.5
+  EXPECT_EQ(s.output, 10.0);          // (75 - 100) / -2.5
   ASSERT_TRUE(reader.next(s));
   EXPECT_EQ(s.time_s, 1.0);
   EXPECT_EQ(s.main_angle_deg, -27.25);
   EXPECT_EQ(s.position_angle_deg, 0.125);
-  EXPECT_EQ(s.gyro_deg_h, -10.0);  // (125 - 100) / -2.5
+  EXPECT_EQ(s.output, -10.0);  // (125 - 100) / -2.5
   EXPECT_FALSE(reader.next(s));
 
   // A '.' in a record read with a decimal comma is not a number, and the message says which field.
@@ -146,7 +146,7 @@ TEST(RecordRigKeys, AnInvertedOffsetRigRecordWithADecimalCommaCalibratesToTheTru
     out << "t_ms;gyro_mV;theta_cnt;psi_cnt;beta_cnt\nms;mV;counts;counts;counts\n";
     for (const testing::RigRow& r : rows) {
       // The output inverted (a cable), offset by 100 mV, written with a decimal comma.
-      std::string mv = fmt::format("{}", -kMilliVoltPerDegH * r.gyro_deg_h + kOffsetMilliVolt);
+      std::string mv = fmt::format("{}", -kMilliVoltPerDegH * r.output + kOffsetMilliVolt);
       for (char& c : mv)
         if (c == '.') c = ',';
       out << std::llround(r.time_s * 1e3) << ';' << mv << ';'
@@ -232,7 +232,7 @@ TEST(RecordRigKeys, EachUnitMistakeIsNamedByWhatTheRecordHolds) {
     out << "t_ms;gyro;theta;psi;beta\n";
     out.precision(17);
     for (const testing::RigRow& r : rows)
-      out << std::llround(r.time_s * 1e3) << ';' << r.gyro_deg_h << ';'
+      out << std::llround(r.time_s * 1e3) << ';' << r.output << ';'
           << wrapped_count(r.main_angle_deg, kFineCounts) << ';'
           << wrapped_count(r.counter_angle_deg, kFineCounts) << ';' << fmt::format("{}", r.position_angle_deg)
           << '\n';

@@ -39,7 +39,7 @@ void write_rig_layout(const std::filesystem::path& path, const std::vector<testi
   out << "t_ms;gyro_mV;theta_cnt;psi_cnt;beta_cnt\n";
   out.precision(17);
   for (const testing::RigRow& r : rows)
-    out << std::llround(r.time_s * 1e3) << ';' << r.gyro_deg_h * kMilliVoltPerDegH << ';'
+    out << std::llround(r.time_s * 1e3) << ';' << r.output * kMilliVoltPerDegH << ';'
         << wrapped_count(r.main_angle_deg, kMainCounts) << ';'
         << wrapped_count(r.counter_angle_deg, kMainCounts) << ';'
         << wrapped_count(r.position_angle_deg, kPositionCounts) << '\n';

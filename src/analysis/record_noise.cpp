@@ -260,7 +260,7 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
   while (reader.next(sample)) {
     sampling.add(sample.time_s);
     motion.add(sample);
-    rate_deg_h.push_back(sample.gyro_deg_h);
+    rate_deg_h.push_back(sample.output);
   }
   motion.check(name);
   return characterise(rate_deg_h, sampling.finish(), name);

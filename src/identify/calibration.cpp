@@ -1113,7 +1113,7 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
   const Reduction reduction = reduce_record(reader, plan, options.reduce, model.geometry().rate_rad_s,
                                             [&o](std::span<const RecordSample> rows) {
                                               for (const RecordSample& s : rows)
-                                                o.output.range.push(s.gyro_deg_h);
+                                                o.output.range.push(s.output);
                                             });
   const std::vector<PositionChannels> channels = reduce_model_channels(reduction, model, options.reduce);
   return identify(reduction, channels, model, o);

@@ -296,8 +296,13 @@ struct RecordReader::State {
     if (lone_output) {
       output_name = columns[1];
     } else {
+      // The fifth column names the sensor's output: gyro_deg_h, or accel_g for an accelerometer's record.
+      const bool accelerometer = columns.size() >= kRecordColumns.size() && columns[0] == kRecordColumns[0] &&
+                                 columns[4] == kLoneOutputColumns[1];
+      if (accelerometer) output_name = columns[4];
       for (std::size_t i = 0; i < kRecordColumns.size(); ++i) {
         const std::string_view alone = " (a record of the output alone: time_s,gyro_deg_h)";
+        if (i == 4 && accelerometer) continue;
         if (i == columns.size()) {
           fail(fmt::format("the header must begin with {}, but it has only {} column{}{}", header_text,
                            columns.size(), columns.size() == 1 ? "" : "s", alone));
@@ -703,14 +708,14 @@ bool RecordReader::next(RecordSample& sample) {
     if (s.lone_output) {
       constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
       sample.main_angle_deg = sample.counter_angle_deg = sample.position_angle_deg = kNaN;
-      sample.gyro_deg_h = values[4];
+      sample.output = values[4];
       std::copy(values + kRecordColumns.size(), values + s.columns.size() + 3, sample.extra.begin());
       return true;
     }
     sample.main_angle_deg = values[1];
     sample.counter_angle_deg = values[2];
     sample.position_angle_deg = values[3];
-    sample.gyro_deg_h = values[4];
+    sample.output = values[4];
     std::copy(values + kRecordColumns.size(), values + s.columns.size(), sample.extra.begin());
     return true;
   }
@@ -721,7 +726,7 @@ bool RecordReader::next(RecordSample& sample) {
                      ? values[i + 1] * s.angle_multiplier[i] / s.angle_divisor[i] - s.angle_offset[i]
                      : std::numeric_limits<double>::quiet_NaN();
   }
-  sample.gyro_deg_h = (values[4] - s.output_offset) / s.output_divisor;
+  sample.output = (values[4] - s.output_offset) / s.output_divisor;
   return true;
 }
 

@@ -28,11 +28,16 @@ bool is_column_name(std::string_view name) {
 }  // namespace
 
 RecordWriter::RecordWriter(std::ostream& out, const RecordMetadata& metadata,
-                           const std::vector<std::string>& extra_columns)
+                           const std::vector<std::string>& extra_columns, std::string_view output_column)
     : out_(out),
       columns_(kRecordColumns.begin(), kRecordColumns.end()),
       extra_count_(extra_columns.size()),
       buffer_(kBufferBytes) {
+  if (std::find(kLoneOutputColumns.begin(), kLoneOutputColumns.end(), output_column) ==
+      kLoneOutputColumns.end()) {
+    throw Error(fmt::format("A record's output column is gyro_deg_h or accel_g, not '{}'.", output_column));
+  }
+  columns_[4] = std::string(output_column);
   if (extra_columns.size() > kMaxExtraColumns) {
     throw Error(fmt::format("A record holds at most {} extra columns; {} were given.", kMaxExtraColumns,
                             extra_columns.size()));
@@ -72,7 +77,7 @@ RecordWriter::~RecordWriter() {
 
 void RecordWriter::write(const RecordSample& sample) {
   const double fixed[] = {sample.time_s, sample.main_angle_deg, sample.counter_angle_deg,
-                          sample.position_angle_deg, sample.gyro_deg_h};
+                          sample.position_angle_deg, sample.output};
   for (std::size_t i = 0; i < kRecordColumns.size() + extra_count_; ++i) {
     const double value = i < kRecordColumns.size() ? fixed[i] : sample.extra[i - kRecordColumns.size()];
     if (!std::isfinite(value)) {

@@ -982,7 +982,7 @@ void Reducer::push(const RecordSample& s) {
   ++st.rows;
   st.t_last = s.time_s;
   st.summary.add(s);
-  st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.gyro_deg_h});
+  st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output});
 }
 
 Reduction Reducer::finish() {

@@ -2,11 +2,14 @@
 
 #include <cmath>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "gyrocal/model/gyro.hpp"
+#include "gyrocal/sensor/sensor.hpp"
+#include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
@@ -41,7 +44,13 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
                       const SimulationOptions& options, Sink&& sink) {
   const CentrifugeModel model = scenario.model();
   const double fs = scenario.test.sample_rate_hz;
-  GyroNoiseGenerator noise(scenario.noise, fs, seed);
+  const Sensor sensor = scenario.sensor();
+  // The sensor's noise: the gyro's in deg/h, the accelerometer's referred to its input and scaled by K1.
+  std::variant<GyroNoiseGenerator, AccelerometerNoiseGenerator> noise =
+      scenario.sensor_kind == SensorKind::kAccelerometer
+          ? decltype(noise)(std::in_place_type<AccelerometerNoiseGenerator>, scenario.accelerometer.noise,
+                            scenario.accelerometer.coefficients[AccelCoefficient::K1], fs, seed)
+          : decltype(noise)(std::in_place_type<GyroNoiseGenerator>, scenario.noise, fs, seed);
   const std::uint64_t n = sample_count(timeline, fs);
   RecordSample sample;
   for (std::uint64_t k = 0; k < n; ++k) {
@@ -52,10 +61,11 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
     sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
     sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
     sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
-    // docs/physics.md sections 6 and 15: the sensed rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the
-    // drift; with no rate errors the sensed rate is omega_I bit for bit.
-    sample.gyro_deg_h = noise.next(sensed_rate_deg_h(scenario.gyro_rate, inputs.rate_rad_s) +
-                                   drift_deg_h(scenario.gyro, inputs.specific_force_g));
+    // The sensor's noise-free output at the exact inputs (Gyro: docs/physics.md sections 6 and 15, the sensed
+    // rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
+    // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
+    const double clean = sensor_output(sensor, inputs);
+    sample.output = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
     sink(sample);
     if (options.progress && (k + 1) % kProgressEverySamples == 0) {
       options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
@@ -90,12 +100,26 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
       {"angles", "encoder readings in deg, wrapped to [0, 360)"},
       {"duration_s", fmt::format("{}", timeline.duration_s)},
       {"samples", fmt::format("{}", sample_count(timeline, test.sample_rate_hz))},
-      {"noise_angle_random_walk_deg_rt_h", fmt::format("{}", noise.angle_random_walk_deg_rt_h)},
-      {"noise_bias_instability_deg_h", fmt::format("{}", noise.bias_instability_deg_h)},
-      {"noise_rate_random_walk_deg_h_rt_h", fmt::format("{}", noise.rate_random_walk_deg_h_rt_h)},
-      {"noise_quantization_deg_h", fmt::format("{}", noise.quantization_deg_h)},
-      {"noise_output_lag_s", fmt::format("{}", noise.output_lag_s)},
   };
+  if (scenario.sensor_kind == SensorKind::kAccelerometer) {
+    // An accelerometer's record: its kind, noise ([accelerometer.noise] keys) and truth (parameter table).
+    const Accelerometer& a = scenario.accelerometer;
+    m.emplace_back("sensor", std::string(Accelerometer::kind));
+    for (const AccelerometerNoiseKey& key : kAccelerometerNoiseKeys)
+      m.emplace_back(fmt::format("noise_{}", key.key), fmt::format("{}", a.noise.*key.member));
+    for (std::size_t i = 0; i < kNumAccelCoefficients; ++i)
+      m.emplace_back(fmt::format("truth_{}", kAccelerometerParameters[i].name),
+                     fmt::format("{}", a.coefficients.values[i]));
+    return m;
+  }
+  m.insert(m.end(),
+           {
+               {"noise_angle_random_walk_deg_rt_h", fmt::format("{}", noise.angle_random_walk_deg_rt_h)},
+               {"noise_bias_instability_deg_h", fmt::format("{}", noise.bias_instability_deg_h)},
+               {"noise_rate_random_walk_deg_h_rt_h", fmt::format("{}", noise.rate_random_walk_deg_h_rt_h)},
+               {"noise_quantization_deg_h", fmt::format("{}", noise.quantization_deg_h)},
+               {"noise_output_lag_s", fmt::format("{}", noise.output_lag_s)},
+           });
   for (std::size_t i = 0; i < kNumCoefficients; ++i) {
     m.emplace_back(fmt::format("truth_{}", kCoefficientNames[i]), fmt::format("{}", scenario.gyro.values[i]));
   }
@@ -123,7 +147,9 @@ SimulationSummary simulate_record(const Scenario& scenario, const SimulationOpti
                                   std::ostream& out) {
   const Timeline timeline = make_timeline(scenario.test, scenario.model());
   const std::uint64_t seed = options.seed.value_or(scenario.test.seed);
-  RecordWriter writer(out, simulation_metadata(scenario, timeline, seed), {});
+  const std::string_view column =
+      std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());
+  RecordWriter writer(out, simulation_metadata(scenario, timeline, seed), {}, column);
   const SimulationSummary summary =
       run(scenario, timeline, seed, options, [&writer](const RecordSample& s) { writer.write(s); });
   writer.finish();

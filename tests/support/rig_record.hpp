@@ -57,7 +57,7 @@ struct RigMotion {
 struct RigRow {
   double time_s = 0.0;
   double main_angle_deg = 0.0, counter_angle_deg = 0.0, position_angle_deg = 0.0;
-  double gyro_deg_h = 0.0;
+  double output = 0.0;
 };
 
 namespace rig_detail {
@@ -218,7 +218,7 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
       b = imp.position_count_deg *
           (std::floor(b / imp.position_count_deg) + (toggle(acquisition) ? 1.0 : 0.0));
     row.position_angle_deg = b + beta_read_offset;
-    row.gyro_deg_h = y;
+    row.output = y;
     emit(row);
   }
 }
@@ -230,7 +230,7 @@ inline void write_native(std::ostream& out, const std::vector<RigRow>& rows) {
   out.precision(17);
   for (const RigRow& r : rows)
     out << r.time_s << ',' << r.main_angle_deg << ',' << r.counter_angle_deg << ',' << r.position_angle_deg
-        << ',' << r.gyro_deg_h << '\n';
+        << ',' << r.output << '\n';
 }
 
 /// The rows as RecordSamples (what the native reader gives back).
@@ -243,7 +243,7 @@ inline std::vector<RecordSample> as_samples(const std::vector<RigRow>& rows) {
     x.main_angle_deg = r.main_angle_deg;
     x.counter_angle_deg = r.counter_angle_deg;
     x.position_angle_deg = r.position_angle_deg;
-    x.gyro_deg_h = r.gyro_deg_h;
+    x.output = r.output;
     out.push_back(x);
   }
   return out;

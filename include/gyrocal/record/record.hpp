@@ -62,7 +62,8 @@ struct RecordSample {
   double main_angle_deg = 0.0;      ///< main axis encoder θ, deg (wrapped or unwrapped)
   double counter_angle_deg = 0.0;   ///< counter-rotating platform ψr relative to the arm, deg
   double position_angle_deg = 0.0;  ///< position platform β, deg
-  double gyro_deg_h = 0.0;          ///< gyro output, deg/h (in g for a record whose output column is accel_g)
+  double output =
+      0.0;  ///< the sensor's output: deg/h for a gyro, g for an accelerometer (its column: accel_g)
   /// Values of the extra columns, in header order; only the first RecordReader::extra_column_count() are
   /// meaningful.
   std::array<double, kMaxExtraColumns> extra{};
@@ -78,8 +79,11 @@ class RecordWriter {
   /// or holds '=', a key or value holding a line break, or an extra column name that is not
   /// [A-Za-z0-9_]+, repeats a name, or exceeds kMaxExtraColumns. Spaces around a key or value do not
   /// survive a round trip (the reader trims them).
+  /// `output_column` names the fifth column: "gyro_deg_h" (a gyro's record) or "accel_g" (an
+  /// accelerometer's, in g); another name throws gyrocal::Error.
   RecordWriter(std::ostream& out, const RecordMetadata& metadata,
-               const std::vector<std::string>& extra_columns);
+               const std::vector<std::string>& extra_columns,
+               std::string_view output_column = kRecordColumns[4]);
   /// Flushes what finish() has not (errors are ignored here; call finish() to see them).
   ~RecordWriter();
   RecordWriter(const RecordWriter&) = delete;
@@ -156,7 +160,7 @@ class RecordReader {
   void require_angles() const;
   /// The name of the output column ("gyro_deg_h", "accel_g", or the layout's output_column).
   const std::string& output_column() const;
-  /// The unit of RecordSample::gyro_deg_h: "g" for gyrocal's own format with an accel_g column, else "deg/h".
+  /// The unit of RecordSample::output: "g" for gyrocal's own format with an accel_g column, else "deg/h".
   std::string_view output_unit() const;
   /// The layout read through, or nullopt for gyrocal's own format.
   const std::optional<RecordLayout>& layout() const;
