@@ -40,6 +40,14 @@ GYROCAL_TEST_PACKAGES=(chromium python3-pytest)
 build_gyrocal() {
   local dir=$1
   shift
-  cmake -S "$GYROCAL_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >&2
+  # ccache, when the machine has it (it is not required): a clone in another directory (CI's lone clone, a
+  # second checkout) reuses the objects of an identical compile. Paths are hashed relative to the clone, so a
+  # cached object is one the same source and flags gave; nothing is skipped, only recompiled less.
+  local launcher=()
+  if command -v ccache >/dev/null 2>&1; then
+    export CCACHE_BASEDIR="$GYROCAL_ROOT" CCACHE_NOHASHDIR=true
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  fi
+  cmake -S "$GYROCAL_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "$@" >&2
   cmake --build "$dir" -j "$(nproc)" >&2
 }
