@@ -263,6 +263,21 @@ TEST(PlanColouredNoise, ALagWhoseStartUpReachesTheDwellsIsSaid) {
   EXPECT_FALSE(warned(predict_calibration(s, CalibrationOptions{})));
 }
 
+TEST(PlanColouredNoise, AQuantizationStepBeyondTheNoiseIsSaid) {
+  // Quantization counts as white noise of q^2/12 a sample, which holds only where the white noise (0.3 deg/h
+  // a sample here) spans the step: a step of 2 deg/h is said, naming the key; 0.5 deg/h is not.
+  Scenario s = short_test();
+  s.noise.quantization_deg_h = 2.0;
+  const auto warned = [](const CalibrationResult& r) {
+    for (const std::string& w : r.warnings)
+      if (w.find("quantization_deg_h") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(warned(predict_calibration(s, CalibrationOptions{})));
+  s.noise.quantization_deg_h = 0.5;
+  EXPECT_FALSE(warned(predict_calibration(s, CalibrationOptions{})));
+}
+
 TEST(PlanColouredNoise, SimulatedRecordsScatterAsPredicted) {
   // Records of the short test simulated with every noise term (B 0.5 deg/h, K 5 deg/h/sqrt(h), N 0.0005
   // deg/sqrt(h), q 0.5 deg/h, lag 0.05 s), reduced as `calibrate` reduces them; the noise of each reduced

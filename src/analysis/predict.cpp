@@ -654,6 +654,15 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
       result.warnings.push_back(
           "the predicted uncertainties leave out the bias instability, rate random walk, quantization and "
           "output lag of the dwells reduced by the window mean; they add to them.");
+    // Quantization counts as white noise of q^2/12 a sample: right where the output moves by more than a step
+    // between samples (the white noise dithers it), not where it stays within one.
+    const double white_std = white_noise_sample_std_deg_h(s.noise, s.test.sample_rate_hz);
+    if (s.noise.quantization_deg_h > 0 && white_std < 0.5 * s.noise.quantization_deg_h)
+      result.warnings.push_back(fmt::format(
+          "[gyro.noise] quantization_deg_h = {:.3g} is more than twice the white noise's {:.3g} deg/h a "
+          "sample: the rounding error is then not white noise of q^2/12 a sample, as the predicted "
+          "uncertainties count it, but follows the signal.",
+          s.noise.quantization_deg_h, white_std));
     // The lag's start-up (y_0 = v_0) is left out of the prediction: terms e^{-t/T_lag} at a dwell's start t.
     double first_start_s = std::numeric_limits<double>::infinity();
     for (const Dwell& d : r.dwells) first_start_s = std::min(first_start_s, d.first_time_s);
