@@ -50,14 +50,7 @@ std::string read_error(const std::string& text, const std::optional<RecordLayout
 }
 
 /// The message of parsing a configuration, or "" when it parses.
-std::string config_error(const std::string& toml) {
-  try {
-    parse_scenario(toml, "rig.toml");
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::config_error;
 
 RecordLayout layout_from(const std::string& toml) {
   const Scenario s = parse_scenario(toml, "rig.toml");

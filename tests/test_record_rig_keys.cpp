@@ -28,14 +28,7 @@ RecordLayout layout_from(const std::string& toml) {
   return parse_scenario(toml, "rig.toml").record.value();
 }
 
-std::string config_error(const std::string& toml) {
-  try {
-    parse_scenario(toml, "rig.toml");
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::config_error;
 
 TEST(RecordRigKeys, ReadsADecimalCommaAPreambleAUnitsRowOffsetsAndAnInvertedOutput) {
   const RecordLayout layout = layout_from(R"([record]
@@ -175,13 +168,7 @@ output_offset = {2}
 main_angle_offset_deg = {3}
 )",
                                           kCounts, -kMilliVoltPerDegH, kOffsetMilliVolt, kMainZeroDeg);
-  {
-    std::ofstream toml(dir / "rig.toml");
-    toml << scenario_to_toml(s) << mapping;
-  }
-  const test::CliOutcome c = test::run_cli(
-      "calibrate " + (dir / "rig.csv").string() + " --config " + (dir / "rig.toml").string() + " --json -",
-      dir);
+  const test::CliOutcome c = test::calibrate_in(dir, "rig.csv", scenario_to_toml(s) + mapping);
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
   for (std::size_t k = 0; k < kNumCoefficients; ++k) {
@@ -194,15 +181,9 @@ main_angle_offset_deg = {3}
   // Without the encoder's zero the same record misfits: it is refused, or its std is scaled by the residuals
   // (docs/calibration.md, "When the residuals misfit") and honest again, or it lands off the truth; never a
   // good record's std on a wrong number. The key is what brings the weights' own std back.
-  {
-    std::ofstream toml(dir / "rig.toml");
-    std::string unzeroed = mapping;
-    unzeroed.insert(unzeroed.find("main_angle_offset_deg"), "# ");  // the key commented out
-    toml << scenario_to_toml(s) << unzeroed;
-  }
-  const test::CliOutcome off = test::run_cli(
-      "calibrate " + (dir / "rig.csv").string() + " --config " + (dir / "rig.toml").string() + " --json -",
-      dir);
+  std::string unzeroed = mapping;
+  unzeroed.insert(unzeroed.find("main_angle_offset_deg"), "# ");  // the key commented out
+  const test::CliOutcome off = test::calibrate_in(dir, "rig.csv", scenario_to_toml(s) + unzeroed);
   double worst_z = 0.0, std_scale = 1.0;
   if (off.status == 0) {
     const nlohmann::json o = nlohmann::json::parse(off.out);
@@ -253,13 +234,7 @@ output_column = "gyro"
                        time_unit, main_counts, kFineCounts);
   };
   const auto calibrate = [&](const std::string& m) {
-    {
-      std::ofstream toml(dir / "rig.toml");
-      toml << scenario_to_toml(s) << m;
-    }
-    return test::run_cli(
-        "calibrate " + (dir / "rig.csv").string() + " --config " + (dir / "rig.toml").string() + " --json -",
-        dir);
+    return test::calibrate_in(dir, "rig.csv", scenario_to_toml(s) + m);
   };
   const std::string main_counts = fmt::format("main_counts_per_revolution = {}", kFineCounts);
   // The mapping right: the record calibrates (so each refusal below is its mistake's).

@@ -23,6 +23,8 @@
 namespace gyrocal {
 namespace {
 
+using test::calibrate_in;
+
 constexpr std::int64_t kMainCounts = 3600;        // 0.1 deg per count, as the rig's quantum
 constexpr std::int64_t kPositionCounts = 180000;  // 0.002 deg per count
 constexpr double kMilliVoltPerDegH = 2.5;
@@ -76,13 +78,7 @@ TEST(RigRecord, EveryImperfectionAtOnceInTheRigsLayoutCalibratesToTheTruthThroug
 
   const std::filesystem::path dir = test::fresh_test_folder("gyrocal-rig-layout");
   write_rig_layout(dir / "rig.csv", rows);
-  {
-    std::ofstream toml(dir / "rig.toml");
-    toml << scenario_to_toml(s) << kMapping;
-  }
-  const test::CliOutcome c = test::run_cli(
-      "calibrate " + (dir / "rig.csv").string() + " --config " + (dir / "rig.toml").string() + " --json -",
-      dir);
+  const test::CliOutcome c = calibrate_in(dir, "rig.csv", scenario_to_toml(s) + kMapping);
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
   for (std::size_t k = 0; k < kNumCoefficients; ++k) {
@@ -113,18 +109,6 @@ std::string with_reduce_line(const Scenario& s, const std::string& key, const st
   return text.replace(at + 1, end - at - 1, key + " = " + value);
 }
 
-/// Calibrates `record` with the configuration text `toml` through the command line.
-test::CliOutcome calibrate_with(const std::filesystem::path& dir, const std::string& record,
-                                const std::string& toml_text, const std::string& extra = "") {
-  {
-    std::ofstream toml(dir / "rig.toml");
-    toml << toml_text;
-  }
-  return test::run_cli("calibrate " + (dir / record).string() + " --config " + (dir / "rig.toml").string() +
-                           " --json -" + extra,
-                       dir);
-}
-
 TEST(RigRecord, ARateToleranceSetInTheConfigurationChangesWhatTheReducerAccepts) {
   // The drive turns 0.3 % off its nominal rates: beyond the default rate_tolerance (2e-3), within 5e-3.
   Scenario s = default_scenario();
@@ -142,7 +126,7 @@ TEST(RigRecord, ARateToleranceSetInTheConfigurationChangesWhatTheReducerAccepts)
   }
 
   // The default: refused, the reason naming the tolerance and the measured offset.
-  const test::CliOutcome refused = calibrate_with(dir, "rig.csv", scenario_to_toml(s));
+  const test::CliOutcome refused = calibrate_in(dir, "rig.csv", scenario_to_toml(s));
   EXPECT_NE(refused.status, 0);
   EXPECT_NE(refused.err.find("3.00e-03 (relative) from the planned 9.9 rad/s (rate_tolerance 2e-03)"),
             std::string::npos)
@@ -150,7 +134,7 @@ TEST(RigRecord, ARateToleranceSetInTheConfigurationChangesWhatTheReducerAccepts)
   EXPECT_TRUE(refused.out.empty()) << refused.out;
 
   // [reduce] rate_tolerance = 5e-3: the same record calibrates to the truth within its uncertainties.
-  const test::CliOutcome c = calibrate_with(dir, "rig.csv", with_reduce_line(s, "rate_tolerance", "5e-3"));
+  const test::CliOutcome c = calibrate_in(dir, "rig.csv", with_reduce_line(s, "rate_tolerance", "5e-3"));
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
   for (std::size_t k = 0; k < kNumCoefficients; ++k) {
@@ -192,12 +176,11 @@ TEST(RigRecord, TheReductionMethodComesFromTheConfigurationUnlessTheCommandLineS
   ASSERT_NE(at, std::string::npos) << window;
   window.replace(at + 1, std::string("reduction = \"harmonic\"").size(), "reduction = \"window\"");
 
-  const nlohmann::json by_default = coefficients(calibrate_with(dir, "rig.csv", harmonic));
-  const nlohmann::json by_flag =
-      coefficients(calibrate_with(dir, "rig.csv", harmonic, " --reduction window"));
-  const nlohmann::json by_config = coefficients(calibrate_with(dir, "rig.csv", window));
+  const nlohmann::json by_default = coefficients(calibrate_in(dir, "rig.csv", harmonic));
+  const nlohmann::json by_flag = coefficients(calibrate_in(dir, "rig.csv", harmonic, " --reduction window"));
+  const nlohmann::json by_config = coefficients(calibrate_in(dir, "rig.csv", window));
   const nlohmann::json overridden =
-      coefficients(calibrate_with(dir, "rig.csv", window, " --reduction harmonic"));
+      coefficients(calibrate_in(dir, "rig.csv", window, " --reduction harmonic"));
   EXPECT_NE(by_flag, by_default);  // the two methods differ on a noisy record
   EXPECT_EQ(by_config, by_flag);
   EXPECT_EQ(overridden, by_default);

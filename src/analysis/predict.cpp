@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/reduce/dwell_reduction.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
@@ -203,15 +205,86 @@ Eigen::MatrixXd predicted_position_covariance(const Reduction& r, const ReduceOp
 
 namespace {
 
-/// The reduction operator of a dwell as rows over its samples: value of gamma slot g = sum_i a(g, i) y_i.
-/// A static hold: the mean; a spinning dwell reduced by the harmonic fit: a_g = X M^-1 b_g with X the fit's
-/// basis at the samples (as harmonic_fit_covariance), M = X'X and b_g the basis at gamma_g and mid-time.
-/// Nothing for the window mean (its operator is not formed here).
-std::optional<Eigen::MatrixXd> dwell_operator(const Dwell& d, const ReduceOptions& options) {
+/// The sums over i < count of the linear recurrence z_{i+1} = B z_i from z_0: sum_i z_i z_i' (gram), sum_i
+/// z_i (sum) and z_{count-1} (last; zero when count is 0). By doubling: a block of 2^k steps is two blocks of
+/// 2^(k-1), the second the first mapped by B^(2^(k-1)) (gram(m + l) = gram(m) + B^m gram(l) B^m'), so the
+/// cost is O(log count) products of D x D matrices and the rounding grows as log count, but for the powers of
+/// B themselves (a rotation's phase after count steps carries ~count eps, as does count * step in any route).
+struct RecurrenceSums {
+  Eigen::MatrixXd gram;
+  Eigen::VectorXd sum;
+  Eigen::VectorXd last;
+};
+
+RecurrenceSums recurrence_sums(const Eigen::MatrixXd& b, const Eigen::VectorXd& z0, std::uint64_t count) {
+  const Eigen::Index dim = z0.size();
+  RecurrenceSums out{Eigen::MatrixXd::Zero(dim, dim), Eigen::VectorXd::Zero(dim), Eigen::VectorXd::Zero(dim)};
+  Eigen::MatrixXd power = b, gram = z0 * z0.transpose(), prefix = Eigen::MatrixXd::Identity(dim, dim);
+  Eigen::VectorXd sum = z0, last = z0;  // the block of 2^k steps: B^(2^k), its gram, sum and last state
+  while (count > 0) {
+    if (count & 1u) {  // append the block after the `prefix` steps taken so far
+      out.gram += prefix * gram * prefix.transpose();
+      out.sum += prefix * sum;
+      out.last = prefix * last;
+      prefix = prefix * power;
+    }
+    count >>= 1;
+    if (count == 0) break;
+    gram += power * gram * power.transpose();
+    sum += power * sum;
+    last = power * last;
+    power = power * power;
+  }
+  return out;
+}
+
+/// The Kronecker product a (x) b.
+Eigen::MatrixXd kron(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  Eigen::MatrixXd out(a.rows() * b.rows(), a.cols() * b.cols());
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+    for (Eigen::Index j = 0; j < a.cols(); ++j)
+      out.block(i * b.rows(), j * b.cols(), b.rows(), b.cols()) = a(i, j) * b;
+  return out;
+}
+
+/// M^m for a small square matrix, by squaring.
+Eigen::MatrixXd matrix_power(const Eigen::MatrixXd& m, std::uint64_t count) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Identity(m.rows(), m.cols()), p = m;
+  for (; count > 0; count >>= 1) {
+    if (count & 1u) out = out * p;
+    p = p * p;
+  }
+  return out;
+}
+
+/// A dwell's reduction as a linear map of its samples: the value of gamma slot g is sum_i (c_g' x_i) y_i, x_i
+/// the basis at sample i. A static hold: x_i = 1, c = 1/N (the mean). A spinning dwell reduced by the
+/// harmonic fit: x_i = (1, cos k gamma_i, sin k gamma_i (k <= order) [, t_i scaled to [-0.5, 0.5] over the
+/// planned duration]), c_g = M^-1 b_g with M = sum_i x_i x_i' and b_g the basis at gamma_g and the mid-time.
+/// On the plan's constant-rate joints x_{i+1} = A x_i: rotations by k (gamma step) and t's step alpha (times
+/// the constant 1). None for the window mean (its operator is not formed here).
+struct DwellBasis {
+  Eigen::MatrixXd step;          ///< A: x_{i+1} = A x_i
+  Eigen::MatrixXd back;          ///< A^-1: x_{i-1} = A^-1 x_i
+  Eigen::VectorXd first, last;   ///< x_0, x_{N-1}
+  Eigen::MatrixXd coefficients;  ///< c: basis size x gammas
+  std::uint64_t samples = 0;     ///< N
+  double first_index = 0.0;      ///< the record's index of sample 0 (t = k / fs)
+};
+
+std::optional<DwellBasis> dwell_basis(const Dwell& d, const ReduceOptions& options, double sample_rate_hz) {
   const auto ng = static_cast<Eigen::Index>(d.gammas_rad.size());
-  const auto n = static_cast<Eigen::Index>(d.samples);
-  if (n == 0) return std::nullopt;
-  if (d.is_static) return Eigen::MatrixXd::Constant(ng, n, 1.0 / static_cast<double>(n));
+  if (d.samples == 0) return std::nullopt;
+  DwellBasis out;
+  out.samples = d.samples;
+  out.first_index = std::round(d.first_time_s * sample_rate_hz);
+  const double n = static_cast<double>(d.samples);
+  if (d.is_static) {
+    out.step = out.back = Eigen::MatrixXd::Identity(1, 1);
+    out.first = out.last = Eigen::VectorXd::Ones(1);
+    out.coefficients = Eigen::MatrixXd::Constant(1, ng, 1.0 / n);
+    return out;
+  }
   if (options.method != ReduceOptions::Method::kHarmonicFit || d.counter.rate_rad_s == 0.0)
     return std::nullopt;
   const int order = options.harmonic_order;
@@ -219,25 +292,109 @@ std::optional<Eigen::MatrixXd> dwell_operator(const Dwell& d, const ReduceOption
   const int size = harmonics + (options.linear_drift ? 1 : 0);
   const double g0 = -d.counter.at_first_rad, step = -d.counter.rate_rad_s * d.sample_interval_s;
   const double alpha = d.sample_interval_s / d.planned_duration_s;
-  const auto basis_at = [&](double gamma, double t_scaled, double* out) {
-    out[0] = 1.0;
-    for (int h = 1; h <= order; ++h) {
-      out[2 * h - 1] = std::cos(h * gamma);
-      out[2 * h] = std::sin(h * gamma);
-    }
-    if (options.linear_drift) out[harmonics] = t_scaled;
+  const auto basis_at = [&](double gamma, double t_scaled) {
+    Eigen::VectorXd x(size);
+    harmonic_basis(gamma, order, x.data());
+    if (options.linear_drift) x[harmonics] = t_scaled;
+    return x;
   };
-  Eigen::MatrixXd x(size, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double fi = static_cast<double>(i);
-    basis_at(g0 + fi * step, alpha * fi - 0.5, x.col(i).data());
-  }
-  const double t_mid = alpha * 0.5 * static_cast<double>(n - 1) - 0.5;
+  const auto step_matrix = [&](double sign) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(size, size);
+    a(0, 0) = 1.0;
+    for (int h = 1; h <= order; ++h) {
+      const double c = std::cos(sign * h * step), s = std::sin(sign * h * step);
+      a(2 * h - 1, 2 * h - 1) = c;  // cos(h (gamma + step)) = cos cos - sin sin
+      a(2 * h - 1, 2 * h) = -s;
+      a(2 * h, 2 * h - 1) = s;  // sin(h (gamma + step)) = sin cos + cos sin
+      a(2 * h, 2 * h) = c;
+    }
+    if (options.linear_drift) {
+      a(harmonics, harmonics) = 1.0;
+      a(harmonics, 0) = sign * alpha;
+    }
+    return a;
+  };
+  out.step = step_matrix(1.0);
+  out.back = step_matrix(-1.0);
+  out.first = basis_at(g0, -0.5);
+  out.last = basis_at(g0 + (n - 1.0) * step, alpha * (n - 1.0) - 0.5);
+  const Eigen::MatrixXd normal = recurrence_sums(out.step, out.first, d.samples).gram;
+  const double t_mid = alpha * 0.5 * (n - 1.0) - 0.5;
   Eigen::MatrixXd b(size, ng);
-  for (Eigen::Index k = 0; k < ng; ++k)
-    basis_at(d.gammas_rad[static_cast<std::size_t>(k)], t_mid, b.col(k).data());
-  const Eigen::MatrixXd c = (x * x.transpose()).ldlt().solve(b);  // size x ng
-  return c.transpose() * x;                                       // ng x n
+  for (Eigen::Index k = 0; k < ng; ++k) b.col(k) = basis_at(d.gammas_rad[static_cast<std::size_t>(k)], t_mid);
+  out.coefficients = normal.ldlt().solve(b);
+  return out;
+}
+
+/// A stationary kernel in state-space form: cov(y_k, y_l) = h' Phi^|k-l| u (u = P h, P the state's stationary
+/// covariance). A Gauss-Markov process: Phi = rho = e^{-dt/T}, u = its variance, h = 1; one seen through the
+/// output lag: its two states (process, lagged output).
+struct StateKernel {
+  Eigen::MatrixXd phi;
+  Eigen::VectorXd u, h;
+};
+
+/// The noise's covariance between two samples k, l of the record as a sum of kernels: state-space kernels,
+/// w min(k, l) (the rate random walk from the record's start) and a constant.
+struct NoiseKernels {
+  std::vector<StateKernel> states;
+  double walk = 0.0;
+  double constant = 0.0;
+};
+
+/// The noise of `noise` beyond the white rate noise's own (unlagged) term, as kernels over the record's
+/// samples (docs/noise.md, "Coloured noise in the prediction"), and the white variance per sample to add
+/// (negative where the lag replaces the white term by its lagged kernel). The lag's start-up (y_0 = v_0) is
+/// left out: its terms are e^{-t/T_lag} at a dwell's start t.
+NoiseKernels coloured_kernels(const GyroNoise& noise, double sample_rate_hz, double* extra_white) {
+  NoiseKernels k;
+  const double dt = 1.0 / sample_rate_hz;
+  const double white = std::pow(white_noise_sample_std_deg_h(noise, sample_rate_hz), 2);
+  const double quantization = noise.quantization_deg_h * noise.quantization_deg_h / 12.0;
+  const double walk_step = rate_random_walk_step_std_deg_h(noise.rate_random_walk_deg_h_rt_h, sample_rate_hz);
+  const double s2 = walk_step * walk_step, b2 = noise.bias_instability_deg_h * noise.bias_instability_deg_h;
+  const bool lag = noise.output_lag_s > 0.0;
+  // The lag y_k = lambda y_{k-1} + (1 - lambda) v_k; 1 - lambda, 1 - lambda rho without cancellation.
+  const double lambda = lag ? std::exp(-dt / noise.output_lag_s) : 0.0;
+  const double one_minus_lambda = lag ? -std::expm1(-dt / noise.output_lag_s) : 1.0;
+  // Quantization after the lag: white, q^2 / 12 per sample (the output spans many steps between samples).
+  *extra_white = quantization;
+  const auto one = [](double v) { return Eigen::VectorXd::Constant(1, v); };
+  if (lag && white > 0.0) {
+    // White noise through the lag: a Gauss-Markov process of decay lambda, variance sigma^2 (1-l)/(1+l).
+    *extra_white -= white;
+    k.states.push_back(
+        {Eigen::MatrixXd::Constant(1, 1, lambda), one(white * one_minus_lambda / (1.0 + lambda)), one(1.0)});
+  }
+  if (b2 > 0.0)
+    for (std::size_t p = 0; p < kBiasInstabilityProcesses; ++p) {
+      const double tp = kBiasInstabilityCorrelationTimesS[p], var = b2 * kBiasInstabilityVarianceWeights[p];
+      const double rho = std::exp(-dt / tp);
+      if (!lag) {
+        k.states.push_back({Eigen::MatrixXd::Constant(1, 1, rho), one(var), one(1.0)});
+        continue;
+      }
+      // States (x, y): x_{k+1} = rho x_k + w_k, y_{k+1} = lambda y_k + (1 - lambda) x_{k+1}. Stationary:
+      // var x = var, cov(x, y) = var (1-l)/(1 - l rho), var y = var (1-l)(1 + l rho)/((1+l)(1 - l rho)).
+      const double one_minus_lambda_rho = -std::expm1(-dt / noise.output_lag_s - dt / tp);
+      Eigen::MatrixXd phi(2, 2);
+      phi << rho, 0.0, one_minus_lambda * rho, lambda;
+      Eigen::VectorXd u(2), h(2);
+      u << var * one_minus_lambda / one_minus_lambda_rho,
+          var * one_minus_lambda * (1.0 + lambda * rho) / ((1.0 + lambda) * one_minus_lambda_rho);
+      h << 0.0, 1.0;
+      k.states.push_back({phi, u, h});
+    }
+  if (s2 > 0.0) {
+    k.walk = s2;
+    if (lag) {
+      // y_k = s sum_{m<k} n_m (1 - lambda^(k-m)): cov = s^2 [min(k, l) - l/(1-l) - l/(1-l^2) lambda^|k-l|].
+      k.constant = -s2 * lambda / one_minus_lambda;
+      k.states.push_back({Eigen::MatrixXd::Constant(1, 1, lambda),
+                          one(-s2 * lambda / (one_minus_lambda * (1.0 + lambda))), one(1.0)});
+    }
+  }
+  return k;
 }
 
 }  // namespace
@@ -248,109 +405,106 @@ Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& r, const Red
   const auto np = static_cast<Eigen::Index>(r.positions.size());
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
   if (complete) *complete = true;
-  const double b2 = noise.bias_instability_deg_h * noise.bias_instability_deg_h;
-  const double walk_step = rate_random_walk_step_std_deg_h(noise.rate_random_walk_deg_h_rt_h, sample_rate_hz);
-  const double s2 = walk_step * walk_step;
-  if (b2 == 0.0 && s2 == 0.0) return cov;
-  // The coloured noise's covariance is not in closed form: it walks the samples and holds each dwell's
-  // operator (gammas x samples). Beyond kMaxColouredNoiseSamples it would take minutes and gigabytes, so it
-  // is refused, never left out in silence (docs/performance.md, "plan in closed form").
-  double total = 0.0;
-  for (const Dwell& d : r.dwells) total += static_cast<double>(d.samples);
-  if (total > kMaxColouredNoiseSamples)
-    throw Error(fmt::format(
-        "the bias instability and rate random walk are predicted by walking every sample of the dwells, and "
-        "this test has {:.3g} of them, more than the {:.3g} that fit in memory: lower [test] revolutions (or "
-        "sample_rate_hz), or set [gyro.noise] bias_instability_deg_h and rate_random_walk_deg_h_rt_h to 0 "
-        "for the white noise's prediction alone.",
-        total, kMaxColouredNoiseSamples));
+  double extra_white = 0.0;
+  const NoiseKernels kernels = coloured_kernels(noise, sample_rate_hz, &extra_white);
+  if (kernels.states.empty() && kernels.walk == 0.0 && extra_white == 0.0) return cov;
+  // Each kernel's sums over a dwell's samples come from linear recurrences over them, summed by doubling:
+  // a cost of O(log N) per dwell, not O(N) (docs/noise.md, docs/performance.md).
   const std::size_t nd = r.dwells.size();
-  std::vector<std::optional<Eigen::MatrixXd>> ops(nd);
+  std::vector<std::optional<DwellBasis>> basis(nd);
   for (std::size_t d = 0; d < nd; ++d) {
-    ops[d] = dwell_operator(r.dwells[d], options);
-    if (!ops[d] && complete) *complete = false;
+    basis[d] = dwell_basis(r.dwells[d], options, sample_rate_hz);
+    if (!basis[d] && complete) *complete = false;
   }
   // Dwell-level covariance blocks (ng_d x ng_e), then scattered to the positions.
   std::vector<std::vector<Eigen::MatrixXd>> block(nd, std::vector<Eigen::MatrixXd>(nd));
   for (std::size_t d = 0; d < nd; ++d)
     for (std::size_t e = 0; e < nd; ++e)
-      if (ops[d] && ops[e]) block[d][e] = Eigen::MatrixXd::Zero(ops[d]->rows(), ops[e]->rows());
-  // Global sample index of a dwell's first sample (the record's sample k is at t = k / fs).
-  const auto first_index = [&](const Dwell& d) { return std::round(d.first_time_s * sample_rate_hz); };
+      if (basis[d] && basis[e])
+        block[d][e] = Eigen::MatrixXd::Zero(basis[d]->coefficients.cols(), basis[e]->coefficients.cols());
+  // Each pair of dwells once, the earlier first; the samples from the last of d to the first of e.
+  const auto gap = [&](std::size_t d, std::size_t e) -> std::optional<std::uint64_t> {
+    if (d == e || !basis[d] || !basis[e] || !(r.dwells[d].last_time_s < r.dwells[e].first_time_s))
+      return std::nullopt;
+    return static_cast<std::uint64_t>(basis[e]->first_index - basis[d]->first_index) - basis[d]->samples + 1;
+  };
 
-  // Bias instability: the simulator's sum of stationary Gauss-Markov processes, covariance
-  // B^2 w_p e^{-|t - t'|/T_p} between samples (docs/noise.md). Within a dwell, K a_h by a forward and a
-  // backward first-order recursion; across dwells the kernel factorises at the gap between them.
-  if (b2 > 0.0) {
-    for (std::size_t p = 0; p < kBiasInstabilityProcesses; ++p) {
-      const double tp = kBiasInstabilityCorrelationTimesS[p], var = b2 * kBiasInstabilityVarianceWeights[p];
-      std::vector<Eigen::VectorXd> left(nd), right(nd);  // sum_i a_gi rho^(N-1-i), sum_i a_gi rho^i
-      for (std::size_t d = 0; d < nd; ++d) {
-        if (!ops[d]) continue;
-        const Eigen::MatrixXd& a = *ops[d];
-        const Eigen::Index ng = a.rows(), n = a.cols();
-        const double rho = std::exp(-r.dwells[d].sample_interval_s / tp);
-        Eigen::MatrixXd ka(ng, n);
-        left[d].resize(ng);
-        right[d].resize(ng);
-        for (Eigen::Index h = 0; h < ng; ++h) {
-          Eigen::VectorXd forward(n), backward(n);
-          double u = 0.0;
-          for (Eigen::Index i = 0; i < n; ++i) forward[i] = u = rho * u + a(h, i);
-          u = 0.0;
-          for (Eigen::Index i = n - 1; i >= 0; --i) backward[i] = u = rho * u + a(h, i);
-          ka.row(h) = (forward + backward - a.row(h).transpose()).transpose();
-          left[d][h] = forward[n - 1];
-          right[d][h] = backward[0];
-        }
-        block[d][d] += var * a * ka.transpose();
-      }
-      for (std::size_t d = 0; d < nd; ++d)
-        for (std::size_t e = 0; e < nd; ++e) {
-          if (d == e || !ops[d] || !ops[e]) continue;
-          const Dwell &early = r.dwells[d], &late = r.dwells[e];
-          if (!(early.last_time_s < late.first_time_s)) continue;  // each pair once, earlier dwell first
-          const double gap = std::exp(-(late.first_time_s - early.last_time_s) / tp);
-          const Eigen::MatrixXd c = var * gap * left[d] * right[e].transpose();
+  // Extra white noise (quantization; minus the white term where the lag colours it): within a dwell only.
+  if (extra_white != 0.0)
+    for (std::size_t d = 0; d < nd; ++d)
+      if (basis[d]) block[d][d] += extra_white * dwell_white_noise_covariance(r.dwells[d], options);
+
+  // A state-space kernel h' Phi^|i-j| u. Within a dwell: with F_i = sum_{j<=i} Phi^(i-j) u x_j' (r x s),
+  // sum_ij x_i x_j' K(i-j) = W + W' - K(0) M, W = sum_i x_i (h' F_i); the state (x_i, vec F_i) advances by
+  // [[A, 0], [A (x) u, I (x) Phi]]. Across dwells d before e, K factorises at the gap g:
+  // (sum_i a_gi Phi^(N-1-i) u)' Phi^g' (sum_j a_hj Phi^j' h), the left from F_{N-1}, the right a sum of the
+  // recurrence x_j (x) Phi^j' h.
+  for (const StateKernel& k : kernels.states) {
+    const Eigen::Index rs = k.phi.rows();
+    std::vector<Eigen::MatrixXd> left(nd), right(nd);  // r x ng each
+    for (std::size_t d = 0; d < nd; ++d) {
+      if (!basis[d]) continue;
+      const DwellBasis& b = *basis[d];
+      const Eigen::Index s = b.step.rows();
+      Eigen::MatrixXd step = Eigen::MatrixXd::Zero(s + rs * s, s + rs * s);
+      step.topLeftCorner(s, s) = b.step;
+      step.bottomLeftCorner(rs * s, s) = kron(b.step, k.u);
+      step.bottomRightCorner(rs * s, rs * s) = kron(Eigen::MatrixXd::Identity(s, s), k.phi);
+      Eigen::VectorXd z0(s + rs * s);
+      z0 << b.first, kron(b.first, k.u);
+      const RecurrenceSums f = recurrence_sums(step, z0, b.samples);
+      const Eigen::MatrixXd w = f.gram.block(0, s, s, rs * s) * kron(Eigen::MatrixXd::Identity(s, s), k.h);
+      const Eigen::MatrixXd q = w + w.transpose() - k.h.dot(k.u) * f.gram.topLeftCorner(s, s);
+      block[d][d] += b.coefficients.transpose() * q * b.coefficients;
+      const Eigen::Map<const Eigen::MatrixXd> last_f(f.last.data() + s, rs, s);
+      left[d] = last_f * b.coefficients;
+      const RecurrenceSums g =
+          recurrence_sums(kron(b.step, k.phi.transpose()), kron(b.first, k.h), b.samples);
+      right[d] = Eigen::Map<const Eigen::MatrixXd>(g.sum.data(), rs, s) * b.coefficients;
+    }
+    for (std::size_t d = 0; d < nd; ++d)
+      for (std::size_t e = 0; e < nd; ++e)
+        if (const auto g = gap(d, e)) {
+          const Eigen::MatrixXd c = left[d].transpose() * matrix_power(k.phi, *g).transpose() * right[e];
           block[d][e] += c;
           block[e][d] += c.transpose();
         }
-    }
   }
 
-  // Rate random walk: r_k = s sum_{m<k} n_m from the record's start, so cov(r_k, r_l) = s^2 min(k, l). Within
-  // a dwell starting at sample k0: k0 (sum a_g)(sum a_h) + sum_{m>=1} S_g(m) S_h(m), S(m) = sum_{i>=m} a_i
-  // (min(i, j) counts the m in 1..min(i, j)); across dwells (d before e): s^2 (sum_i a_gi k_i)(sum_j a_hj).
-  if (s2 > 0.0) {
+  // Rate random walk: r_k = s sum_{m<k} n_m from the record's start, cov(r_k, r_l) = s^2 min(k, l) (w below).
+  // Within a dwell starting at sample k0: k0 (sum a_g)(sum a_h) + sum_{m>=1} S_g(m) S_h(m), S(m) = sum_{i>=m}
+  // a_i; the tail sums of the basis S(m) = x_m + S(m+1) by the backward recurrence (x_m, S(m)) from m = N-1,
+  // [[A^-1, 0], [A^-1, I]], whose sum over m >= 1 is also sum_i i x_i. Across dwells (d before e):
+  // w (sum_i a_gi k_i)(sum_j a_hj). A constant kernel (the lag's) reaches every pair through sum a.
+  if (kernels.walk != 0.0 || kernels.constant != 0.0) {
     std::vector<Eigen::VectorXd> sums(nd), index_moments(nd);
     for (std::size_t d = 0; d < nd; ++d) {
-      if (!ops[d]) continue;
-      const Eigen::MatrixXd& a = *ops[d];
-      const Eigen::Index ng = a.rows(), n = a.cols();
-      const double k0 = first_index(r.dwells[d]);
-      sums[d] = a.rowwise().sum();
-      index_moments[d].resize(ng);
-      Eigen::MatrixXd tails(ng, n);  // tails(g, m) = S_g(m)
-      for (Eigen::Index g = 0; g < ng; ++g) {
-        double tail = 0.0, moment = 0.0;
-        for (Eigen::Index i = n - 1; i >= 0; --i) {
-          tail += a(g, i);
-          tails(g, i) = tail;
-          moment += a(g, i) * (k0 + static_cast<double>(i));
-        }
-        index_moments[d][g] = moment;
-      }
-      const Eigen::MatrixXd inner = tails.rightCols(n - 1) * tails.rightCols(n - 1).transpose();
-      block[d][d] += s2 * (k0 * sums[d] * sums[d].transpose() + inner);
+      if (!basis[d]) continue;
+      const DwellBasis& b = *basis[d];
+      const Eigen::Index s = b.step.rows();
+      Eigen::MatrixXd step = Eigen::MatrixXd::Zero(2 * s, 2 * s);
+      step.topLeftCorner(s, s) = b.back;
+      step.bottomLeftCorner(s, s) = b.back;
+      step.bottomRightCorner(s, s) = Eigen::MatrixXd::Identity(s, s);
+      Eigen::VectorXd z0(2 * s);
+      z0 << b.last, b.last;
+      const RecurrenceSums tails = recurrence_sums(step, z0, b.samples - 1);
+      const Eigen::VectorXd total = b.first + tails.last.tail(s);  // S(0) = x_0 + S(1)
+      sums[d] = b.coefficients.transpose() * total;
+      index_moments[d] = b.coefficients.transpose() * (b.first_index * total + tails.sum.tail(s));
+      const Eigen::MatrixXd inner =
+          b.coefficients.transpose() * tails.gram.bottomRightCorner(s, s) * b.coefficients;
+      block[d][d] += kernels.walk * (b.first_index * sums[d] * sums[d].transpose() + inner) +
+                     kernels.constant * sums[d] * sums[d].transpose();
     }
     for (std::size_t d = 0; d < nd; ++d)
-      for (std::size_t e = 0; e < nd; ++e) {
-        if (d == e || !ops[d] || !ops[e]) continue;
-        if (!(r.dwells[d].last_time_s < r.dwells[e].first_time_s)) continue;
-        const Eigen::MatrixXd c = s2 * index_moments[d] * sums[e].transpose();
-        block[d][e] += c;
-        block[e][d] += c.transpose();
-      }
+      for (std::size_t e = 0; e < nd; ++e)
+        if (gap(d, e)) {
+          const Eigen::MatrixXd c = kernels.walk * index_moments[d] * sums[e].transpose() +
+                                    kernels.constant * sums[d] * sums[e].transpose();
+          block[d][e] += c;
+          block[e][d] += c.transpose();
+        }
   }
 
   for (Eigen::Index i = 0; i < np; ++i)
@@ -490,15 +644,34 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   for (const Dwell& d : r.dwells) longest_dwell_s = std::max(longest_dwell_s, d.planned_duration_s);
   if (std::string w = dominant_noise_warning(s.noise, longest_dwell_s); !w.empty())
     result.warnings.push_back(std::move(w));
-  if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0) {
+  if (s.noise.bias_instability_deg_h > 0 || s.noise.rate_random_walk_deg_h_rt_h > 0 ||
+      s.noise.quantization_deg_h > 0 || s.noise.output_lag_s > 0) {
     bool complete = true;
     const Eigen::MatrixXd covariance =
         predicted_noise_position_covariance(r, options.reduce, s.noise, s.test.sample_rate_hz, &complete);
     count_whole_noise(result, r, channels, model, identify_options, covariance);
     if (!complete)
       result.warnings.push_back(
-          "the predicted uncertainties leave out the bias instability and rate random walk of the dwells "
-          "reduced by the window mean; they add to them.");
+          "the predicted uncertainties leave out the bias instability, rate random walk, quantization and "
+          "output lag of the dwells reduced by the window mean; they add to them.");
+    // Quantization counts as white noise of q^2/12 a sample: right where the output moves by more than a step
+    // between samples (the white noise dithers it), not where it stays within one.
+    const double white_std = white_noise_sample_std_deg_h(s.noise, s.test.sample_rate_hz);
+    if (s.noise.quantization_deg_h > 0 && white_std < 0.5 * s.noise.quantization_deg_h)
+      result.warnings.push_back(fmt::format(
+          "[gyro.noise] quantization_deg_h = {:.3g} is more than twice the white noise's {:.3g} deg/h a "
+          "sample: the rounding error is then not white noise of q^2/12 a sample, as the predicted "
+          "uncertainties count it, but follows the signal.",
+          s.noise.quantization_deg_h, white_std));
+    // The lag's start-up (y_0 = v_0) is left out of the prediction: terms e^{-t/T_lag} at a dwell's start t.
+    double first_start_s = std::numeric_limits<double>::infinity();
+    for (const Dwell& d : r.dwells) first_start_s = std::min(first_start_s, d.first_time_s);
+    if (s.noise.output_lag_s > 0 && first_start_s < 23.0 * s.noise.output_lag_s)
+      result.warnings.push_back(fmt::format(
+          "the first dwell starts {:.3g} s after the record's start, within 23 output lags ([gyro.noise] "
+          "output_lag_s = {:.3g}): the lag's start-up, left out of the predicted uncertainties, reaches its "
+          "values by up to e^(-t/T) = {:.2g}.",
+          first_start_s, s.noise.output_lag_s, std::exp(-first_start_s / s.noise.output_lag_s)));
   } else if (s.noise.angle_random_walk_deg_rt_h == 0) {
     result.warnings.push_back("the configured gyro noise is zero: the predicted uncertainties are zero.");
   }

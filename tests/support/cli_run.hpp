@@ -14,6 +14,7 @@
 
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
 
 namespace gyrocal::test {
 
@@ -56,6 +57,29 @@ inline CliOutcome run_cli(const std::string& args, const std::filesystem::path& 
   std::filesystem::remove(out);
   std::filesystem::remove(err);
   return o;
+}
+
+/// The sentence parsing configuration text `toml` (as the file `name`) is refused with; "" if it parses.
+inline std::string config_error(const std::string& toml, const std::string& name = "rig.toml") {
+  try {
+    parse_scenario(toml, name);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// `gyrocal calibrate DIR/RECORD --config DIR/rig.toml --json -EXTRA`, the configuration text `toml` written
+/// to DIR/rig.toml first: the rig tests' round trip through the command line (the JSON on the outcome's out).
+inline CliOutcome calibrate_in(const std::filesystem::path& dir, const std::string& record,
+                               const std::string& toml, const std::string& extra = "") {
+  {
+    std::ofstream file(dir / "rig.toml");
+    file << toml;
+  }
+  return run_cli("calibrate " + (dir / record).string() + " --config " + (dir / "rig.toml").string() +
+                     " --json -" + extra,
+                 dir);
 }
 
 /// A short test (12 revolutions per dwell at 100 Hz) so that a command-line round trip is quick.

@@ -36,16 +36,16 @@ Eigen::MatrixXd dwell_white_noise_covariance(const Dwell& dwell, const ReduceOpt
 Eigen::MatrixXd predicted_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                               double sample_std_deg_h);
 
-/// The most samples (over all dwells) whose coloured-noise covariance is predicted: it walks them, holding a
-/// gammas x samples operator per dwell (~14 bytes a sample, 0.5 GB here).
-inline constexpr double kMaxColouredNoiseSamples = 33554432.0;  // 2^25
-
-/// Covariance (deg/h)^2 of the reduced positions under the bias instability and the rate random walk of
-/// `noise`, across dwells as well as within them (docs/noise.md, "Coloured noise in the prediction"): the
-/// reduction operator of each dwell applied to the samples' covariance as the simulator makes the noise
-/// (a sum of Gauss-Markov processes; a random walk from the record's start). Dwells whose operator is not
-/// formed (a spinning dwell reduced by the window mean) are left out, and *complete (if given) is set to
-/// false. Throws Error beyond kMaxColouredNoiseSamples samples in the dwells (with coloured noise only).
+/// Covariance (deg/h)^2 of the reduced positions under the noise of `noise` beyond its white rate noise's own
+/// term (predicted_position_covariance), across dwells as well as within them (docs/noise.md, "Coloured noise
+/// in the prediction"): the bias instability (the simulator's sum of Gauss-Markov processes), the rate random
+/// walk from the record's start, the quantization as white noise of q^2/12 per sample, and the output lag
+/// (every term but the quantization seen through it; with a lag this part holds the lagged white noise's
+/// covariance minus the unlagged one's). Each dwell's reduction applied to the samples' covariance by sums in
+/// closed form (linear recurrences over the samples summed by doubling): a cost independent of the number of
+/// samples. The lag's start-up at the record's first sample is left out (terms e^{-t/T_lag} at a dwell's
+/// start t). Dwells whose operator is not formed (a spinning dwell reduced by the window mean) are left out,
+/// and *complete (if given) is set to false.
 Eigen::MatrixXd coloured_noise_position_covariance(const Reduction& reduction, const ReduceOptions& options,
                                                    const GyroNoise& noise, double sample_rate_hz,
                                                    bool* complete = nullptr);
@@ -81,9 +81,9 @@ std::string dominant_noise_warning(const GyroNoise& noise, double dwell_s);
 /// What `gyrocal plan` reports: the identification the plan permits with its predicted uncertainties
 /// (least squares, full compensation, noise-free outputs of the configured truth). The weights are the
 /// white noise's (as a calibration of a record weights its dwells); the uncertainties count the whole
-/// configured noise, bias instability and rate random walk across dwells included
-/// (predicted_noise_position_covariance through the estimator's gain). Warns when bias instability or rate
-/// random walk dominates at the dwell's duration (dominant_noise_warning).
+/// configured noise, bias instability and rate random walk across dwells, quantization and output lag
+/// included (predicted_noise_position_covariance through the estimator's gain). Warns when bias instability
+/// or rate random walk dominates at the dwell's duration (dominant_noise_warning).
 CalibrationResult predict_calibration(const Scenario& scenario, const CalibrationOptions& options);
 
 }  // namespace gyrocal
