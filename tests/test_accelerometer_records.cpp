@@ -12,7 +12,9 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
@@ -20,6 +22,7 @@
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/record/record.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "support/cli_run.hpp"
 #include "support/rig_record.hpp"
 
@@ -304,6 +307,120 @@ TEST(AccelerometerRigRecord, ARigsRecordInMillivoltsPerGReadsBackInG) {
                     holds = s.test.beta_rad.size() * s.test.gamma_rad.size();
   EXPECT_EQ(reduction.dwells.size(), spinning + holds);
   // (The platform's moves between holds and the rest before the test are steady runs that give no dwell.)
+}
+
+bool sanitized() {
+  return std::getenv("GYROCAL_SANITIZED") != nullptr;
+}
+
+/// A static accelerometer's output (its input axis up: 1 g) with `noise`, in output units of `k1` per g, at
+/// fs, written as "time,output" rows after `head`.
+void write_static_accelerometer(const fs::path& path, const std::string& head,
+                                const AccelerometerNoise& noise, double k1, double fs, std::size_t rows,
+                                std::uint64_t seed) {
+  AccelerometerNoiseGenerator generator(noise, k1, fs, seed);
+  std::ofstream out(path);
+  out << head;
+  for (std::size_t i = 0; i < rows; ++i)
+    out << fmt::format("{},{}\n", static_cast<double>(i) / fs, generator.next(k1 * 1.0));
+}
+
+TEST_F(AccelerometerRecordCli, NoiseRecoversAStaticAccelerometersWhiteNoiseAndBiasInstability) {
+  // White noise of 10 ug/sqrt(Hz) and a bias instability of 1.5 ug, whose floor (1.0 ug) meets the white
+  // noise's 10/sqrt(tau) ug at tau ~ 100 s: a record of 11 h at 5 Hz sees both.
+  AccelerometerNoise noise;
+  noise.velocity_random_walk_ug_rt_hz = 10.0;
+  noise.bias_instability_ug = 1.5;
+  const double fs = 5.0;
+  const std::size_t rows = sanitized() ? 50000 : 200000;
+  const fs::path native = dir_ / "static.csv", rig = dir_ / "rig.csv", config = dir_ / "rig.toml";
+  write_static_accelerometer(native, std::string(kRecordMagic) + "\ntime_s,accel_g\n", noise, 1.0, fs, rows,
+                             8);
+  // The same noise from a channel of 2 V/g, read through [record] output_scale_per_g.
+  write_static_accelerometer(rig, "t,U_V\n", noise, 2.0, fs, rows, 8);
+  {
+    std::ofstream c(config);
+    c << kAccelerometer
+      << "[record]\ntime_column = \"t\"\noutput_column = \"U_V\"\noutput_scale_per_g = 2.0\n";
+  }
+  const test::CliOutcome o =
+      test::run_cli("noise " + native.string() + " --json " + (dir_ / "noise.json").string(), dir_);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir_ / "noise.json"));
+  EXPECT_EQ(j["sensor"], "accelerometer");
+  EXPECT_EQ(j["unit"], "ug");
+  const nlohmann::json& terms = j["terms"];
+  ASSERT_TRUE(terms.contains("velocity_random_walk_ug_rt_hz")) << terms.dump();
+  ASSERT_TRUE(terms.contains("bias_instability_ug")) << terms.dump();
+  EXPECT_FALSE(terms.contains("angle_random_walk_deg_rt_h"));
+  const double n = terms["velocity_random_walk_ug_rt_hz"]["value"],
+               n_std = terms["velocity_random_walk_ug_rt_hz"]["std"];
+  const double b = terms["bias_instability_ug"]["value"], b_std = terms["bias_instability_ug"]["std"];
+  // Within three stated standard uncertainties, and the uncertainties themselves a fraction of the values.
+  EXPECT_NEAR(n, 10.0, 3.0 * n_std);
+  EXPECT_NEAR(b, 1.5, 3.0 * b_std);
+  EXPECT_LT(n_std, 0.1 * n);
+  EXPECT_LT(b_std, 0.3 * b);
+  // The Allan deviation at the first octave is the white noise's, in ug: N sqrt(fs) (one sample's sigma).
+  EXPECT_NEAR(j["allan"][0]["adev"].get<double>() / (10.0 * std::sqrt(fs)), 1.0, 0.02);
+
+  // Through [record]: the same rows in g, so the same characterisation, bit for bit; --toml prints
+  // [accelerometer.noise], which an accelerometer's configuration takes as it is.
+  RecordNoiseOptions options;
+  options.sensor = SensorKind::kAccelerometer;
+  const RecordNoise from_rig = characterise_record_noise(rig, options, load_scenario(config).record);
+  const RecordNoise from_native = characterise_record_noise(native);
+  EXPECT_EQ(from_rig.noise.allan.deviation, from_native.noise.allan.deviation);
+  const test::CliOutcome t =
+      test::run_cli("noise " + rig.string() + " --config " + config.string() + " --toml", dir_);
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("[accelerometer.noise]"), std::string::npos) << t.out;
+  const Scenario s = parse_scenario(std::string(kAccelerometer) + t.out, "noise --toml");
+  EXPECT_EQ(s.accelerometer.noise.velocity_random_walk_ug_rt_hz, n);
+  EXPECT_EQ(s.accelerometer.noise.bias_instability_ug, b);
+  EXPECT_EQ(s.accelerometer.noise.quantization_ug, 0.0);  // a continuous output: no grid
+
+  // The report page names the accelerometer's terms and units.
+  const test::CliOutcome html =
+      test::run_cli("noise " + native.string() + " --html " + (dir_ / "noise.html").string(), dir_);
+  ASSERT_EQ(html.status, 0) << html.err;
+  const std::string page = test::slurp(dir_ / "noise.html");
+  EXPECT_NE(page.find("velocity random walk"), std::string::npos);
+  EXPECT_NE(page.find("velocity_random_walk_ug_rt_hz"), std::string::npos);
+  EXPECT_NE(page.find("\xC2\xB5g"), std::string::npos);
+  EXPECT_EQ(page.find("angle random walk"), std::string::npos);
+}
+
+TEST(AccelerometerNoiseRecord, AnOutputsResolutionIsTheStepOfTheGridItsValuesLieOn) {
+  // quantization_ug = 2: every output is a multiple of 2 ug (referred to the input), whatever K1.
+  AccelerometerNoise noise;
+  noise.velocity_random_walk_ug_rt_hz = 10.0;
+  noise.quantization_ug = 2.0;
+  const double fs = 100.0;
+  AccelerometerNoiseGenerator generator(noise, 2.0, fs, 4);
+  std::vector<double> t, g;
+  for (int i = 0; i < 20000; ++i) {
+    t.push_back(i / fs);
+    g.push_back(generator.next(2.0 * -1.0) / 2.0);  // input axis down, read in g
+  }
+  RecordNoiseOptions options;
+  options.sensor = SensorKind::kAccelerometer;
+  const RecordNoise r = characterise_samples_noise(t, g, "q", options);
+  ASSERT_TRUE(r.resolution.has_value());
+  EXPECT_NEAR(*r.resolution, 2.0, 1e-6);
+  // A continuous output lies on no grid; nor do values whose steps are not multiples of one step.
+  noise.quantization_ug = 0.0;
+  AccelerometerNoiseGenerator continuous(noise, 1.0, fs, 4);
+  std::vector<double> c;
+  for (std::size_t i = 0; i < t.size(); ++i) c.push_back(continuous.next(1.0));
+  EXPECT_FALSE(characterise_samples_noise(t, c, "c", options).resolution.has_value());
+  const auto repeated = [](std::vector<double> levels) {
+    std::vector<double> v;
+    for (int k = 0; k < 4; ++k) v.insert(v.end(), levels.begin(), levels.end());
+    return v;
+  };
+  EXPECT_FALSE(output_grid_step(repeated({0.0, 1.0, 2.5})).has_value());
+  EXPECT_NEAR(output_grid_step(repeated({0.0, 3.0, 9.0, 6.0})).value(), 3.0, 1e-12);
 }
 
 }  // namespace
