@@ -22,6 +22,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -43,6 +44,14 @@ using Column = py::array_t<double, py::array::c_style | py::array::forcecast>;
 /// it).
 py::object json_to_python(const nlohmann::ordered_json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
+}
+
+/// The name a scenario's record, configuration and Python messages go by.
+constexpr const char* kScenarioName = "the scenario";
+
+/// gyrocal's own output column of a sensor: gyro_deg_h (deg/h) or accel_g (g).
+std::string native_output_column(SensorKind kind) {
+  return std::string(kind == SensorKind::kAccelerometer ? Accelerometer::native_column : Gyro::native_column);
 }
 
 /// The options `gyrocal calibrate` builds, by the same library function (identify/scenario_options.hpp):
@@ -133,7 +142,8 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
   }
   py::dict out;
   for (std::size_t c = 0; c < kRecordColumns.size(); ++c) {
-    const std::string key(kRecordColumns[c]);
+    // The output keyed by the sensor's own column (gyro_deg_h, or accel_g in g), as the record's header.
+    const std::string key(c == 4 ? native_output_column(scenario.sensor_kind) : kRecordColumns[c]);
     out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
   }
   return out;
@@ -148,6 +158,8 @@ py::object calibrate_path_py(const std::string& path, const Scenario& scenario, 
   nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;
+    // The record's output must be the scenario's sensor's, as `gyrocal calibrate` checks.
+    require_output_for_sensor(RecordReader(path, scenario.record), scenario.sensor_kind, kScenarioName);
     j = calibration_to_json(
         calibrate_record(path, scenario.model(), scenario.test, options, scenario.record));
   }
@@ -195,22 +207,37 @@ py::object noise_path_py(const std::string& path, const std::optional<Scenario>&
   nlohmann::json j;
   {
     py::gil_scoped_release release;
-    // The scenario's [record] says how the record is laid out (docs/records.md).
-    j = noise_to_json(characterise_record_noise(path, {}, scenario ? scenario->record : std::nullopt));
+    // The scenario's [record] says how the record is laid out (docs/records.md), its [sensor] kind whose
+    // output it holds (without a scenario, the record's output column says).
+    RecordNoiseOptions options;
+    if (scenario) {
+      options.sensor = scenario->sensor_kind;
+      options.config_name = kScenarioName;
+    }
+    j = noise_to_json(characterise_record_noise(path, options, scenario ? scenario->record : std::nullopt));
   }
   return json_to_python(j);
 }
 
-py::object noise_arrays_py(const Column& time_s, const Column& gyro_deg_h, const std::string& name) {
-  check_columns({&time_s, &gyro_deg_h}, {"time_s", "gyro_deg_h"}, name);
+/// `output` is the column named `output_column` (gyro_deg_h in deg/h, accel_g in g).
+py::object noise_arrays_py(const Column& time_s, const Column& output, const std::string& output_column,
+                           const std::string& name) {
+  check_columns({&time_s, &output}, {"time_s", output_column}, name);
   const std::vector<double> t(time_s.data(), time_s.data() + time_s.size());
-  const std::vector<double> w(gyro_deg_h.data(), gyro_deg_h.data() + gyro_deg_h.size());
+  const std::vector<double> w(output.data(), output.data() + output.size());
+  RecordNoiseOptions options;
+  options.sensor = sensor_of_output_column(output_column).value_or(SensorKind::kGyro);
   nlohmann::json j;
   {
     py::gil_scoped_release release;
-    j = noise_to_json(characterise_samples_noise(t, w, name));
+    j = noise_to_json(characterise_samples_noise(t, w, name, options));
   }
   return json_to_python(j);
+}
+
+/// Refuses, as the command line does, a record whose output column is the other sensor's.
+void check_output_column_py(const std::string& column, const Scenario& scenario, const std::string& name) {
+  require_output_column_for_sensor(column, scenario.sensor_kind, name, kScenarioName);
 }
 
 }  // namespace
@@ -245,7 +272,13 @@ PYBIND11_MODULE(_gyrocal, m) {
            "The scenario as a commented configuration file (TOML), as init writes.")
       .def_property_readonly("rate_rad_s", [](const Scenario& s) { return s.centrifuge.rate_rad_s; })
       .def_property_readonly("sample_rate_hz", [](const Scenario& s) { return s.test.sample_rate_hz; })
-      .def_property_readonly("seed", [](const Scenario& s) { return s.test.seed; });
+      .def_property_readonly("seed", [](const Scenario& s) { return s.test.seed; })
+      .def_property_readonly(
+          "sensor_kind", [](const Scenario& s) { return std::string(to_string(s.sensor_kind)); },
+          "[sensor] kind: \"gyro\" or \"accelerometer\".")
+      .def_property_readonly(
+          "output_column", [](const Scenario& s) { return native_output_column(s.sensor_kind); },
+          "gyrocal's own output column of the scenario's sensor: gyro_deg_h (deg/h) or accel_g (g).");
 
   m.def("_exact_inputs", &exact_inputs_py, py::arg("scenario"), py::arg("time_s"), py::arg("beta_deg"));
   m.def("_simulate", &simulate_py, py::arg("scenario"), py::arg("seed"));
@@ -253,4 +286,5 @@ PYBIND11_MODULE(_gyrocal, m) {
   m.def("_calibrate_arrays", &calibrate_arrays_py);
   m.def("_noise_path", &noise_path_py);
   m.def("_noise_arrays", &noise_arrays_py);
+  m.def("_check_output_column", &check_output_column_py);
 }

@@ -136,7 +136,16 @@ TEST_F(NoiseRecord, AnAccelerometersOutputAloneIsReadInGAndNotTakenForAGyros) {
   EXPECT_EQ(s.output, y[0]);
   EXPECT_EQ(s.extra[0], 21.5);
   EXPECT_TRUE(std::isnan(s.main_angle_deg));
-  EXPECT_NE(error_of(dir_ / "accel.csv").find("accel_g (g), an accelerometer's"), std::string::npos);
+  // Characterised as an accelerometer's (in ug), not a gyro's; a gyro's configuration refuses it.
+  EXPECT_EQ(characterise_record_noise(dir_ / "accel.csv").sensor, SensorKind::kAccelerometer);
+  RecordNoiseOptions gyro;
+  gyro.sensor = SensorKind::kGyro;
+  try {
+    characterise_record_noise(dir_ / "accel.csv", gyro);
+    ADD_FAILURE() << "no refusal";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("its output column is accel_g"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(NoiseRecord, ASpinningRecordIsRefusedNamingTheAxisAndItsRate) {

@@ -54,10 +54,13 @@ void register_calibrate(CLI::App& app) {
     const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
     require_angle_columns(s.record, opt->record);
-    // The record's metadata against the configuration, before the record is read (docs/interface.md).
+    // The record's output column and metadata against the configuration, before the record is read
+    // (docs/interface.md).
+    const std::string config_name = opt->config.empty() ? "the built-in scenario" : opt->config;
+    const RecordReader head(opt->record, s.record);
+    require_output_for_sensor(head, s.sensor_kind, config_name);
     const std::vector<std::string> metadata_warnings =
-        check_record_metadata(RecordReader(opt->record, s.record).metadata(), opt->record, s,
-                              opt->config.empty() ? "the built-in scenario" : opt->config);
+        check_record_metadata(head.metadata(), opt->record, s, config_name);
     for (const std::string& w : metadata_warnings) fmt::print(stderr, "gyrocal: warning: {}\n", w);
     CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options, s.record);
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());

@@ -1,4 +1,5 @@
-// gyrocal init [FILE]: the default scenario as a commented configuration.
+// gyrocal init [FILE] [--sensor accelerometer]: the default scenario (of the gyro, or of an accelerometer) as
+// a commented configuration.
 #include "cli.hpp"
 #include "gyrocal/config/config_io.hpp"
 
@@ -7,15 +8,20 @@ namespace gyrocal::cli {
 void register_init(CLI::App& app) {
   struct Options {
     std::string file = "-";
+    std::string sensor = "gyro";
     bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("init", "Write the default scenario as a commented configuration file");
   sub->add_option("FILE", opt->file, "Configuration file to write ('-' or none: standard output)");
   sub->add_flag("--force", opt->force, "Overwrite an existing file");
+  sub->add_option("--sensor", opt->sensor,
+                  "gyro (default) or accelerometer: the default scenario of that sensor "
+                  "(docs/accelerometer.md)")
+      ->check(CLI::IsMember({"gyro", "accelerometer"}));
   sub->callback([opt] {
-    write_output(opt->file, scenario_to_toml(default_scenario()), OutputKind::kConfiguration, opt->force,
-                 "FILE");
+    const Scenario s = opt->sensor == "accelerometer" ? default_accelerometer_scenario() : default_scenario();
+    write_output(opt->file, scenario_to_toml(s), OutputKind::kConfiguration, opt->force, "FILE");
   });
 }
 

@@ -21,14 +21,16 @@ void register_noise(CLI::App& app) {
       "Noise of a record's output: overlapping Allan deviation with 68.3 % bounds and the IEEE 952 terms");
   sub->add_option("RECORD", opt->record, "Record of a static test (CSV, docs/contract.md)")->required();
   sub->add_option("--config", opt->config,
-                  "Configuration file (TOML); only its [record] section (the record's layout) is used");
+                  "Configuration file (TOML); only its [sensor] kind and [record] section (the record's "
+                  "layout) are used");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_option(
       "--html", opt->html,
       "Write a self-contained HTML report (log-log Allan plot, fitted terms) to FILE ('-' = standard "
       "output)");
   add_force_flag(sub, opt->force);
-  sub->add_flag("--toml", opt->toml, "Print the fitted terms as a [gyro.noise] configuration section");
+  sub->add_flag("--toml", opt->toml,
+                "Print the fitted terms as a [gyro.noise] (or [accelerometer.noise]) configuration section");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
@@ -39,7 +41,14 @@ void register_noise(CLI::App& app) {
     if (opt->json == "-" && opt->html == "-")
       throw Error("--json and --html cannot both write to standard output.");
     const Scenario s = load_configuration(opt->config);
-    const RecordNoise r = characterise_record_noise(opt->record, {}, s.record);
+    // With a configuration, its sensor's output is characterised (a record of the other sensor is refused);
+    // without one, the record's output column says which sensor (accel_g: an accelerometer).
+    RecordNoiseOptions noise_options;
+    if (!opt->config.empty()) {
+      noise_options.sensor = s.sensor_kind;
+      noise_options.config_name = opt->config;
+    }
+    const RecordNoise r = characterise_record_noise(opt->record, noise_options, s.record);
     const nlohmann::json j = noise_to_json(r);
     // Both outputs are opened (and a refused path refused) before either is written: a refused --html
     // leaves no --json, and a refused --json no report.

@@ -39,6 +39,29 @@ def _column(rec, name):
     return np.ascontiguousarray(values, dtype=np.float64)
 
 
+#: gyrocal's own output columns: a gyro's (deg/h) and an accelerometer's (g).
+_GYRO_COLUMN = "gyro_deg_h"
+_ACCEL_COLUMN = "accel_g"
+
+
+def _has_column(rec, name):
+    try:
+        rec[name]
+    except (KeyError, IndexError, TypeError):
+        return False
+    return True
+
+
+def _output_column(rec, scenario):
+    """The output column of the scenario's sensor (gyro_deg_h or accel_g); a mapping that holds the other
+    sensor's column instead raises ValueError naming it and the scenario's [sensor] kind."""
+    column = scenario.output_column
+    other = _ACCEL_COLUMN if column == _GYRO_COLUMN else _GYRO_COLUMN
+    if not _has_column(rec, column) and _has_column(rec, other):
+        _gyrocal._check_output_column(other, scenario, _ARRAYS_NAME)
+    return column
+
+
 def exact_inputs(scenario, time_s, beta_deg):
     """Exact inputs to the gyro at the instants time_s (s) of a dwell at the scenario's rate and beta_deg,
     as `gyrocal inputs --time-s T --beta-deg B`: (omega, specific_force), each an (n, 3) float64 array of
@@ -57,7 +80,7 @@ _MAX_SEED = 2**64 - 1
 
 def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
-    record's columns (RECORD_COLUMNS). seed=None takes the scenario's [test] seed, as without --seed; any other
+    record's columns (RECORD_COLUMNS; an accelerometer's output is keyed accel_g, in g, as its record's header). seed=None takes the scenario's [test] seed, as without --seed; any other
     seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
     if seed is not None:
         try:
@@ -74,7 +97,8 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
               gyro_model=None):
     """`gyrocal calibrate --json` as a dict. rec is a record's path (read through the scenario's [record]
     layout when its configuration has one, as `gyrocal calibrate --config`) or a mapping of arrays (a dict such
-    as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS; other columns are ignored.
+    as simulate() returns, a pandas DataFrame, ...) holding RECORD_COLUMNS (with accel_g for the output of an
+    accelerometer's scenario; the other sensor's column is refused by name); other columns are ignored.
     method: "least-squares" or "closed-form"; compensation: "none", "seed" or "full"; reduction: "harmonic" or
     "window"; gyro_model: "drift" or "drift+rate"; estimate: machine errors estimated with the coefficients
     (self-calibration, as --estimate: NAME, NAME_I/_O/_S, NAME:N; docs/self_calibration.md), a list of names or
@@ -91,15 +115,23 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     options = (method, compensation, reduction, estimate, gyro_model)
     if _is_path(rec):
         return _gyrocal._calibrate_path(os.fspath(rec), scenario, *options)
-    columns = [_column(rec, name) for name in RECORD_COLUMNS]
+    names = RECORD_COLUMNS[:4] + (_output_column(rec, scenario),)
+    columns = [_column(rec, name) for name in names]
     return _gyrocal._calibrate_arrays(*columns, scenario, *options, _ARRAYS_NAME)
 
 
 def noise(rec, scenario=None):
     """`gyrocal noise --json` as a dict: the overlapping Allan deviation of the record's output and the fitted
-    IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and gyro_deg_h. A record's
-    path is read through the scenario's [record] layout when it has one (as `gyrocal noise --config`); the
-    noise itself does not depend on the scenario."""
+    IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and the output: gyro_deg_h
+    (a gyro's, deg/h) or accel_g (an accelerometer's, g; its terms keyed as [accelerometer.noise], in ug).
+    A record's path is read through the scenario's [record] layout when it has one (as `gyrocal noise
+    --config`), and the scenario's [sensor] kind says whose output it must hold; without a scenario the
+    record's output column says. The noise itself does not depend on the scenario."""
     if _is_path(rec):
         return _gyrocal._noise_path(os.fspath(rec), scenario)
-    return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, "gyro_deg_h"), _ARRAYS_NAME)
+    if scenario is not None:
+        column = _output_column(rec, scenario)
+    else:
+        column = _ACCEL_COLUMN if _has_column(rec, _ACCEL_COLUMN) and not _has_column(rec, _GYRO_COLUMN) \
+            else _GYRO_COLUMN
+    return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, column), column, _ARRAYS_NAME)

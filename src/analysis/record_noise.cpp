@@ -10,6 +10,7 @@
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace gyrocal {
@@ -212,21 +213,92 @@ void check_output_is_noise(std::span<const double> rate_deg_h, const std::string
   }
 }
 
-RecordNoise characterise(std::span<const double> rate_deg_h, double interval_s, const std::string& name) {
-  if (rate_deg_h.size() < 16) {
+/// One g in the unit an accelerometer's output is characterised in (ug).
+constexpr double kMicroGPerG = 1e6;
+/// A grid of output values: every distinct value within this many steps of the grid (the values' rounding is
+/// ~1e-10 step for a 1 ug step at 1 g).
+constexpr double kGridTolerance = 1e-4;
+
+/// `output` (deg/h, or ug for an accelerometer) characterised for `sensor`.
+RecordNoise characterise(std::span<const double> output, double interval_s, const std::string& name,
+                         SensorKind sensor) {
+  if (output.size() < 16) {
     throw Error(fmt::format("{}: noise characterisation needs at least 16 rows, the record has {}.", name,
-                            rate_deg_h.size()));
+                            output.size()));
   }
-  check_output_is_noise(rate_deg_h, name);
+  check_output_is_noise(output, name);
   RecordNoise result;
+  result.sensor = sensor;
   result.sample_rate_hz = 1.0 / interval_s;
-  result.samples = rate_deg_h.size();
+  result.samples = output.size();
   result.record = name;
-  result.noise = characterise_noise(rate_deg_h, result.sample_rate_hz);
+  result.noise = characterise_noise(output, result.sample_rate_hz);
+  if (sensor == SensorKind::kAccelerometer) result.resolution = output_grid_step(output);
   return result;
 }
 
+/// The terms as each sensor names them (record_noise.hpp), by NoiseTerm.
+constexpr SensorNoiseTerm kGyroTerms[kNoiseTermCount] = {
+    {"angle_quantization_deg", "deg", "angle quantization", 1.0, false},
+    {"angle_random_walk_deg_rt_h", "deg/\u221ah", "angle random walk", 1.0, true},
+    {"bias_instability_deg_h", "deg/h", "bias instability", 1.0, true},
+    {"rate_random_walk_deg_h_rt_h", "deg/h/\u221ah", "rate random walk", 1.0, true},
+    {"rate_ramp_deg_h_per_h", "deg/h/h", "rate ramp", 1.0, false},
+};
+constexpr SensorNoiseTerm kAccelerometerTerms[kNoiseTermCount] = {
+    {"velocity_quantization_ug_s", "\u00b5g s", "velocity quantization", 3600.0, false},
+    {"velocity_random_walk_ug_rt_hz", "\u00b5g/\u221aHz", "velocity random walk", 60.0, true},
+    {"bias_instability_ug", "\u00b5g", "bias instability", 1.0, true},
+    {"acceleration_random_walk_ug_rt_s", "\u00b5g/\u221as", "acceleration random walk", 1.0 / 60.0, false},
+    {"acceleration_ramp_ug_per_s", "\u00b5g/s", "acceleration ramp", 1.0 / 3600.0, false},
+};
+
 }  // namespace
+
+SensorNoiseTerm sensor_noise_term(SensorKind sensor, NoiseTerm term) {
+  const auto i = static_cast<std::size_t>(term);
+  return sensor == SensorKind::kAccelerometer ? kAccelerometerTerms[i] : kGyroTerms[i];
+}
+
+std::optional<NoiseTerm> sensor_noise_term_from_key(SensorKind sensor, std::string_view key) {
+  for (std::size_t i = 0; i < kNoiseTermCount; ++i) {
+    const auto term = static_cast<NoiseTerm>(i);
+    if (sensor_noise_term(sensor, term).key == key) return term;
+  }
+  return std::nullopt;
+}
+
+std::string_view noise_output_unit(SensorKind sensor) {
+  return sensor == SensorKind::kAccelerometer ? "ug" : "deg/h";
+}
+
+FittedNoiseTerm sensor_term(const RecordNoise& result, NoiseTerm term) {
+  FittedNoiseTerm t = result.noise.term(term);
+  const double factor = sensor_noise_term(result.sensor, term).per_gyro_value;
+  t.value *= factor;
+  t.std *= factor;
+  return t;
+}
+
+std::optional<double> output_grid_step(std::span<const double> values) {
+  std::vector<double> levels(values.begin(), values.end());
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  if (levels.size() < 3 || 4 * levels.size() > values.size()) return std::nullopt;
+  double smallest = levels[1] - levels[0];
+  for (std::size_t i = 2; i < levels.size(); ++i) smallest = std::min(smallest, levels[i] - levels[i - 1]);
+  // The step from the whole span (the smallest gap alone carries the values' rounding), then every level
+  // on the grid it defines.
+  const double span = levels.back() - levels.front();
+  const double steps = std::round(span / smallest);
+  if (!(smallest > 0.0) || steps > 1e7) return std::nullopt;
+  const double step = span / steps;
+  for (const double v : levels) {
+    const double k = (v - levels.front()) / step;
+    if (std::abs(k - std::round(k)) > kGridTolerance) return std::nullopt;
+  }
+  return step;
+}
 
 RecordNoise characterise_samples_noise(const std::vector<double>& time_s,
                                        const std::vector<double>& rate_deg_h, const std::string& name,
@@ -238,20 +310,30 @@ RecordNoise characterise_samples_noise(const std::vector<double>& time_s,
   EvenSampling sampling(name, options);
   for (double t : time_s) sampling.add(t);
   const double interval_s = sampling.finish();
-  return characterise(rate_deg_h, interval_s, name);
+  const SensorKind sensor = options.sensor.value_or(SensorKind::kGyro);
+  if (sensor == SensorKind::kGyro) return characterise(rate_deg_h, interval_s, name, sensor);
+  std::vector<double> ug(rate_deg_h);
+  for (double& v : ug) v *= kMicroGPerG;
+  return characterise(ug, interval_s, name, sensor);
 }
 
 RecordNoise characterise_record_noise(const std::filesystem::path& path, const RecordNoiseOptions& options,
                                       const std::optional<RecordLayout>& layout) {
   RecordReader reader(path, layout);
   const std::string name = path.string();
-  if (reader.output_unit() != "deg/h") {
-    throw Error(fmt::format(
-        "{}: its output column is {} ({}), an accelerometer's: noise characterises a gyro's output in deg/h "
-        "(angle random walk, bias instability, rate random walk), and this gyrocal has no accelerometer's "
-        "noise terms yet.",
-        name, reader.output_column(), reader.output_unit()));
+  // The configured sensor's output, or the sensor the record's output says (its unit: g or deg/h).
+  if (options.sensor) require_output_for_sensor(reader, *options.sensor, options.config_name);
+  const SensorKind sensor = options.sensor.value_or(
+      reader.output_unit() == Accelerometer::output_unit ? SensorKind::kAccelerometer : SensorKind::kGyro);
+  // A layout reads the output in its sensor's unit: a gyro's configuration cannot read g, nor the reverse.
+  if (reader.output_unit() !=
+      (sensor == SensorKind::kAccelerometer ? Accelerometer::output_unit : Gyro::output_unit)) {
+    throw Error(
+        fmt::format("{}: its output {} is read in {}, but the sensor is {}; set [sensor] kind to the "
+                    "sensor whose output the record holds.",
+                    name, reader.output_column(), reader.output_unit(), to_string(sensor)));
   }
+  const double to_noise_unit = sensor == SensorKind::kAccelerometer ? kMicroGPerG : 1.0;
   MotionCheck motion;
   EvenSampling sampling(name, options);
   std::vector<double> rate_deg_h;
@@ -260,10 +342,10 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
   while (reader.next(sample)) {
     sampling.add(sample.time_s);
     motion.add(sample);
-    rate_deg_h.push_back(sample.output);
+    rate_deg_h.push_back(sample.output * to_noise_unit);
   }
   motion.check(name);
-  return characterise(rate_deg_h, sampling.finish(), name);
+  return characterise(rate_deg_h, sampling.finish(), name, sensor);
 }
 
 }  // namespace gyrocal

@@ -579,16 +579,49 @@ constexpr std::pair<std::string_view, std::int64_t RecordLayout::*> kRecordCount
 /// The number keys of [record] (any finite value; RecordLayout::IsValid checks the scale's sign).
 constexpr std::pair<std::string_view, double RecordLayout::*> kRecordNumberKeys[] = {
     {"output_scale_per_deg_h", &RecordLayout::output_scale_per_deg_h},
+    {"output_scale_per_g", &RecordLayout::output_scale_per_g},
     {"output_offset", &RecordLayout::output_offset},
     {"main_angle_offset_deg", &RecordLayout::main_angle_offset_deg},
     {"counter_angle_offset_deg", &RecordLayout::counter_angle_offset_deg},
     {"position_angle_offset_deg", &RecordLayout::position_angle_offset_deg},
 };
 
-/// [record]: a rig's own record layout (docs/records.md). The layout's own check (RecordLayout::IsValid)
-/// names the key; its line is that key's.
-RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table) {
+/// The output's quantity of a [record] read for `kind`'s sensor (docs/records.md): an accelerometer's output
+/// is a specific force, scaled by output_scale_per_g, and its column defaults to accel_g; a gyro's is a rate,
+/// scaled by output_scale_per_deg_h. The scale of the other sensor, or both scales, are refused naming the
+/// key and the kind.
+void read_record_output(const Reader& reader, const toml::table& table, SensorKind kind,
+                        RecordLayout& layout) {
+  const toml::node* per_deg_h = table.get("output_scale_per_deg_h");
+  const toml::node* per_g = table.get("output_scale_per_g");
+  if (per_deg_h != nullptr && per_g != nullptr) {
+    const bool g_later = per_deg_h->source().begin < per_g->source().begin;
+    reader.fail((g_later ? per_g : per_deg_h)->source(),
+                "record.output_scale_per_deg_h and record.output_scale_per_g are both given, but one output "
+                "has one scale: per deg/h for a gyro, per g for an accelerometer (sensor.kind is \"" +
+                    std::string(to_string(kind)) + "\")");
+  }
+  if (kind == SensorKind::kAccelerometer) {
+    if (per_deg_h != nullptr)
+      reader.fail(per_deg_h->source(),
+                  "record.output_scale_per_deg_h is a gyro's scale (output units per deg/h), but sensor.kind "
+                  "is \"accelerometer\": give the output units per g as record.output_scale_per_g");
+    layout.output_quantity = OutputQuantity::kSpecificForce;
+    if (table.get("output_column") == nullptr)
+      layout.output_column = std::string(Accelerometer::native_column);
+  } else if (per_g != nullptr) {
+    reader.fail(per_g->source(),
+                "record.output_scale_per_g is an accelerometer's scale (output units per g), but the sensor "
+                "is the gyro (sensor.kind absent or \"gyro\"): set [sensor] kind = \"accelerometer\", or "
+                "give the output units per deg/h as record.output_scale_per_deg_h");
+  }
+}
+
+/// [record]: a rig's own record layout (docs/records.md), for `kind`'s sensor. The layout's own check
+/// (RecordLayout::IsValid) names the key; its line is that key's.
+RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table, SensorKind kind) {
   RecordLayout layout;
+  read_record_output(reader, table, kind, layout);
   if (const toml::node* node = section.find("delimiter")) {
     const std::string text = reader.string(*node, section.path("delimiter"));
     if (text.size() != 1) {
@@ -823,11 +856,19 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
         "> 0 (>= 2): the column holds encoder counts, wrapped or not");
   w.key("counter_counts_per_revolution", std::to_string(l.counter_counts_per_revolution), "likewise");
   w.key("position_counts_per_revolution", std::to_string(l.position_counts_per_revolution), "likewise");
-  w.key("output_column", toml_string(l.output_column), "the gyro's output");
-  w.key("output_scale_per_deg_h", toml_number(l.output_scale_per_deg_h),
-        "output units per deg/h (e.g. mV per deg/h), non-zero, negative for an inverted output");
-  w.key("output_offset", toml_number(l.output_offset),
-        "what the output reads at zero rate, its own units: deg/h = (output - offset) / scale");
+  if (l.output_quantity == OutputQuantity::kSpecificForce) {
+    w.key("output_column", toml_string(l.output_column), "the accelerometer's output");
+    w.key("output_scale_per_g", toml_number(l.output_scale_per_g),
+          "output units per g (e.g. mV per g), non-zero, negative for an inverted output");
+    w.key("output_offset", toml_number(l.output_offset),
+          "what the output reads at zero specific force, its own units: g = (output - offset) / scale");
+  } else {
+    w.key("output_column", toml_string(l.output_column), "the gyro's output");
+    w.key("output_scale_per_deg_h", toml_number(l.output_scale_per_deg_h),
+          "output units per deg/h (e.g. mV per deg/h), non-zero, negative for an inverted output");
+    w.key("output_offset", toml_number(l.output_offset),
+          "what the output reads at zero rate, its own units: deg/h = (output - offset) / scale");
+  }
   w.key("main_angle_offset_deg", toml_number(l.main_angle_offset_deg),
         "what the main angle reads (deg) at its zero: subtracted");
   w.key("counter_angle_offset_deg", toml_number(l.counter_angle_offset_deg), "likewise");
@@ -1123,13 +1164,13 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   const toml::table* reduce_table = top.table("reduce");
   Section reduce(reader, reduce_table, "reduce");
   read_reduce(reader, reduce, reduce_table, s.reduce);
-  if (const toml::table* record_table = top.table("record")) {
-    Section record(reader, record_table, "record");
-    s.record = read_record(reader, record, *record_table);
-  }
-
   read_sensor(reader, top, s);
   refuse_other_sensor_keys(reader, root, s.sensor_kind);
+  // After [sensor]: the record's output is the sensor's, in its unit.
+  if (const toml::table* record_table = top.table("record")) {
+    Section record(reader, record_table, "record");
+    s.record = read_record(reader, record, *record_table, s.sensor_kind);
+  }
 
   top.reject_unknown();
   return s;
@@ -1303,7 +1344,12 @@ std::string scenario_to_toml(const Scenario& s) {
   } else {
     // Commented out, so that the file reads back as the scenario it was written from.
     TomlWriter keys;
-    write_record_keys(keys, RecordLayout{});
+    RecordLayout layout;
+    if (s.sensor_kind == SensorKind::kAccelerometer) {
+      layout.output_quantity = OutputQuantity::kSpecificForce;
+      layout.output_column = std::string(Accelerometer::native_column);
+    }
+    write_record_keys(keys, layout);
     w.section_commented("record", kRecordNote, keys.text());
   }
   return w.text();

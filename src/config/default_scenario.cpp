@@ -32,6 +32,27 @@ Scenario default_scenario() {
   return s;
 }
 
+Scenario default_accelerometer_scenario() {
+  // docs/accelerometer.md, "Test design": the default machine, site and errors, the accelerometer's default
+  // truth and noise ([accelerometer], [accelerometer.noise]), and a test that identifies all eleven
+  // coefficients: a static set (the main axis stopped, the platform indexed to each gamma) and two speeds
+  // break the one-speed degeneracy of K0, K2, Kpp, Koo; four beta reverse the input axis against gravity and
+  // the centripetal force; eight gamma keep a revolution's third harmonic (four would fold K3 onto the
+  // scale).
+  Scenario s = default_scenario();
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  TestSpec& t = s.test;
+  t.rates_rad_s = {0.0, 6.0, 12.0};
+  t.beta_rad = {0.0, kPi, kPi / 2, 3 * kPi / 2};
+  t.gamma_rad.clear();
+  for (int k = 0; k < 8; ++k) t.gamma_rad.push_back(k * kPi / 4);
+  t.revolutions = 100;
+  t.static_hold_s = 10.0;
+  s.centrifuge.rate_rad_s = 6.0;  // the test's first non-zero rate, which [centrifuge] rate_rad_s follows
+  return s;
+}
+
 Scenario demo_scenario() {
   Scenario s = default_scenario();
   CentrifugeErrors& u = s.uncertainty;

@@ -65,6 +65,31 @@ std::string list_text(const std::vector<double>& values, double scale) {
 
 }  // namespace
 
+std::optional<SensorKind> sensor_of_output_column(std::string_view column) {
+  if (column == Gyro::native_column) return SensorKind::kGyro;
+  if (column == Accelerometer::native_column) return SensorKind::kAccelerometer;
+  return std::nullopt;
+}
+
+void require_output_for_sensor(const RecordReader& reader, SensorKind kind, const std::string& config_name) {
+  require_output_column_for_sensor(reader.output_column(), kind, reader.name(), config_name);
+}
+
+void require_output_column_for_sensor(std::string_view column, SensorKind kind,
+                                      const std::string& record_name, const std::string& config_name) {
+  const std::optional<SensorKind> holds = sensor_of_output_column(column);
+  if (!holds || *holds == kind) return;
+  // The kinds' names written out here: this stage does not link the sensor stage's functions.
+  const bool gyro = kind == SensorKind::kGyro;
+  throw Error(fmt::format(
+      "{}: its output column is {}, {}, but the sensor of {} is {}: {}.", record_name, column,
+      gyro ? "an accelerometer's output in g" : "a gyro's output in deg/h", config_name,
+      gyro ? "the gyro (sensor.kind absent or \"gyro\")"
+           : "an accelerometer (sensor.kind = \"accelerometer\")",
+      gyro ? "set [sensor] kind = \"accelerometer\" in the configuration to read an accelerometer's record"
+           : "give the accelerometer's record (column accel_g), or leave sensor.kind out to read a gyro's"));
+}
+
 std::vector<std::string> check_record_metadata(const RecordMetadata& metadata, const std::string& record_name,
                                                const Scenario& s, const std::string& config_name) {
   std::vector<std::string> warnings;

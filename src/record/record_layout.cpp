@@ -107,6 +107,27 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                     "deg/h, negative for an inverted output; the output is divided by it), not {}",
                     output_scale_per_deg_h));
   }
+  if (!(std::isfinite(output_scale_per_g) && output_scale_per_g != 0.0)) {
+    return fail("output_scale_per_g",
+                fmt::format("record.output_scale_per_g must be a finite non-zero number (output units per g, "
+                            "negative for an inverted output; the output is divided by it), not {}",
+                            output_scale_per_g));
+  }
+  // One scale applies, the one of the quantity the output measures; the other must stay at its default.
+  if (output_quantity == OutputQuantity::kRate && output_scale_per_g != 1.0) {
+    return fail(
+        "output_scale_per_g",
+        fmt::format("record.output_scale_per_g = {} is an accelerometer's scale (output units per g), "
+                    "but the output is a gyro's rate: give record.output_scale_per_deg_h instead",
+                    output_scale_per_g));
+  }
+  if (output_quantity == OutputQuantity::kSpecificForce && output_scale_per_deg_h != 1.0) {
+    return fail("output_scale_per_deg_h",
+                fmt::format("record.output_scale_per_deg_h = {} is a gyro's scale (output units per deg/h), "
+                            "but the output is an accelerometer's specific force: give "
+                            "record.output_scale_per_g instead",
+                            output_scale_per_deg_h));
+  }
   const std::array<std::pair<std::string_view, double>, 4> offsets = {{
       {"output_offset", output_offset},
       {"main_angle_offset_deg", main_angle_offset_deg},
@@ -186,6 +207,23 @@ bool RecordLayout::is_default_angle_name(std::string_view name) {
   const RecordLayout defaults;
   return name == defaults.main_angle_column || name == defaults.counter_angle_column ||
          name == defaults.position_angle_column;
+}
+
+double RecordLayout::output_scale() const {
+  return output_quantity == OutputQuantity::kSpecificForce ? output_scale_per_g : output_scale_per_deg_h;
+}
+
+std::string_view RecordLayout::output_unit() const {
+  return output_quantity == OutputQuantity::kSpecificForce ? "g" : "deg/h";
+}
+
+std::string_view RecordLayout::output_scale_key() const {
+  return output_quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g" : "output_scale_per_deg_h";
+}
+
+double output_scale_per_g(const std::optional<RecordLayout>& layout) {
+  return layout && layout->output_quantity == OutputQuantity::kSpecificForce ? layout->output_scale_per_g
+                                                                             : 1.0;
 }
 
 bool RecordLayout::has_angles() const {

@@ -169,7 +169,7 @@ struct RecordReader::State {
     }
     angle_offset = {l.main_angle_offset_deg, l.counter_angle_offset_deg, l.position_angle_offset_deg};
     output_offset = l.output_offset;
-    output_divisor = l.output_scale_per_deg_h;
+    output_divisor = l.output_scale();
     decimal = l.decimal;
     number_options = fast_float::parse_options{fast_float::chars_format::general, l.decimal};
   }
@@ -673,7 +673,8 @@ const std::string& RecordReader::output_column() const {
   return state_->layout ? state_->layout->output_column : state_->output_name;
 }
 std::string_view RecordReader::output_unit() const {
-  return !state_->layout && state_->output_name == kLoneOutputColumns[1] ? "g" : "deg/h";
+  if (state_->layout) return state_->layout->output_unit();
+  return state_->output_name == kLoneOutputColumns[1] ? "g" : "deg/h";
 }
 void RecordReader::require_angles() const {
   if (has_angles()) return;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "charts.hpp"
+#include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/noise_terms.hpp"
 #include "html_writing.hpp"
@@ -19,29 +20,40 @@ namespace gyrocal {
 namespace report {
 namespace {
 
-/// How a term appears in the report, by NoiseTerm: its name, the formula of its line and its colour.
+/// How a term appears in the report, by NoiseTerm: the formula of its line and its colour (its key, name and
+/// unit are the sensor's: sensor_noise_term).
 struct TermLook {
   NoiseTerm term;
-  const char* name;
   const char* line;  // the line's label: its Allan deviation (physics.md section 13)
-  const char* unit;
   const char* colour;
 };
 constexpr TermLook kTermLooks[] = {
-    {NoiseTerm::AngleQuantization, "angle quantization",
+    {NoiseTerm::AngleQuantization,
      "\xE2\x88\x9A"
      "3 Q/\xCF\x84",
-     "deg", "#76b7b2"},
-    {NoiseTerm::AngleRandomWalk, "angle random walk", "N/\xE2\x88\x9A\xCF\x84", "deg/\xE2\x88\x9Ah",
-     "#4e79a7"},
-    {NoiseTerm::BiasInstability, "bias instability", "0.664 B", "deg/h", "#59a14f"},
-    {NoiseTerm::RateRandomWalk, "rate random walk", "K \xE2\x88\x9A(\xCF\x84/3)", "deg/h/\xE2\x88\x9Ah",
-     "#f28e2b"},
-    {NoiseTerm::RateRamp, "rate ramp",
+     "#76b7b2"},
+    {NoiseTerm::AngleRandomWalk, "N/\xE2\x88\x9A\xCF\x84", "#4e79a7"},
+    {NoiseTerm::BiasInstability, "0.664 B", "#59a14f"},
+    {NoiseTerm::RateRandomWalk, "K \xE2\x88\x9A(\xCF\x84/3)", "#f28e2b"},
+    {NoiseTerm::RateRamp,
      "R \xCF\x84/\xE2\x88\x9A"
      "2",
-     "deg/h/h", "#b07aa1"},
+     "#b07aa1"},
 };
+
+/// The sensor whose noise the result holds: its "sensor" (a result without one is a gyro's).
+SensorKind sensor_of(const json& noise) {
+  const json* s = find(noise, "sensor");
+  if (s != nullptr && s->is_string()) {
+    if (const std::optional<SensorKind> kind = parse_sensor_kind(s->get<std::string>())) return *kind;
+  }
+  return SensorKind::kGyro;
+}
+
+/// The unit of the Allan deviation as the page writes it: deg/h, or \xC2\xB5g for an accelerometer's.
+std::string deviation_unit(const json& noise) {
+  return sensor_of(noise) == SensorKind::kAccelerometer ? "\xC2\xB5g" : "deg/h";
+}
 
 struct AllanPoint {
   double tau_s = 0.0, adev = 0.0;
@@ -65,6 +77,7 @@ std::vector<AllanPoint> allan_points(const json& noise) {
 
 struct FittedTerm {
   const TermLook* look;
+  SensorNoiseTerm name;
   std::string key;
   std::optional<double> value, std;
 };
@@ -73,17 +86,19 @@ struct FittedTerm {
 std::vector<FittedTerm> fitted_terms(const json& noise, std::vector<std::string>* other = nullptr) {
   const json& t = member(noise, "terms", "the result");
   expect(t, json::value_t::object, "terms");
+  const SensorKind sensor = sensor_of(noise);
   std::vector<FittedTerm> out;
   for (const TermLook& look : kTermLooks) {
-    const std::string key(noise_term_key(look.term));
+    const SensorNoiseTerm name = sensor_noise_term(sensor, look.term);
+    const std::string key(name.key);
     const json* e = find(t, key);
     if (e == nullptr) continue;
     expect(*e, json::value_t::object, "terms." + key);
-    out.push_back({&look, key, number(*e, "value", "terms." + key), number(*e, "std", "terms." + key)});
+    out.push_back({&look, name, key, number(*e, "value", "terms." + key), number(*e, "std", "terms." + key)});
   }
   if (other)
     for (const auto& [key, v] : t.items())
-      if (!noise_term_from_key(key)) other->push_back(key);
+      if (!sensor_noise_term_from_key(sensor, key)) other->push_back(key);
   return out;
 }
 
@@ -113,15 +128,16 @@ void allan(const json& noise, Page& page, std::string& out) {
   chart.points_label = "Allan deviation";
   chart.bars_label = "68.3 % confidence";
   chart.xlabel = "averaging time \xCF\x84, s";
-  chart.ylabel = "Allan deviation \xCF\x83(\xCF\x84), deg/h";
+  const std::string unit = deviation_unit(noise);
+  chart.ylabel = "Allan deviation \xCF\x83(\xCF\x84), " + unit;
   std::vector<std::vector<Cell>> rows;
   for (std::size_t k = 0; k < points.size(); ++k) {
     const AllanPoint& p = points[k];
     chart.points.push_back({{"x", p.tau_s}, {"y", p.adev}});
     chart.low.push_back(opt_json(p.low));
     chart.high.push_back(opt_json(p.high));
-    chart.tips.push_back(fmt::format("\xCF\x84 = {} s: \xCF\x83 = {} deg/h (68.3 %: {} \xE2\x80\x93 {})",
-                                     num(p.tau_s, 4), num(p.adev, 4), num(p.low, 3), num(p.high, 3)));
+    chart.tips.push_back(fmt::format("\xCF\x84 = {} s: \xCF\x83 = {} {} (68.3 %: {} \xE2\x80\x93 {})",
+                                     num(p.tau_s, 4), num(p.adev, 4), unit, num(p.low, 3), num(p.high, 3)));
     const std::string where = fmt::format("allan[{}]", k);
     rows.push_back({num_cell(num(p.tau_s)), num_cell(num(p.adev, 4)), num_cell(num(p.low, 4)),
                     num_cell(num(p.high, 4)), num_cell(num(number(a[k], "clusters", where), 15)),
@@ -135,11 +151,13 @@ void allan(const json& noise, Page& page, std::string& out) {
     std::vector<std::pair<NoiseTerm, double>> present;
     for (const FittedTerm& f : fitted_terms(noise)) {
       if (!f.value || *f.value <= 0) continue;
-      present.emplace_back(f.look->term, *f.value);
+      // The term as characterise_noise states it (a gyro's units on samples in the deviation's unit).
+      const double value = *f.value / f.name.per_gyro_value;
+      present.emplace_back(f.look->term, value);
       json line = json::array();
       for (const double tau : {t0, t1})
-        line.push_back({{"x", tau}, {"y", noise_term_deviation(f.look->term, *f.value, tau)}});
-      chart.lines.push_back({{"name", fmt::format("{} ({})", f.look->line, f.look->name)},
+        line.push_back({{"x", tau}, {"y", noise_term_deviation(f.look->term, value, tau)}});
+      chart.lines.push_back({{"name", fmt::format("{} ({})", f.look->line, f.name.name)},
                              {"colour", f.look->colour},
                              {"dash", true},
                              {"points", line}});
@@ -168,7 +186,7 @@ void allan(const json& noise, Page& page, std::string& out) {
       "noise "
       "that dominates there. Dashed: each fitted term alone; solid: their sum (docs/physics.md section "
       "13).</p>\n";
-  out += table({"\xCF\x84, s", "\xCF\x83, deg/h", "68.3 % low", "68.3 % high", "clusters",
+  out += table({"\xCF\x84, s", "\xCF\x83, " + unit, "68.3 % low", "68.3 % high", "clusters",
                 "degrees of freedom", "dominant term"},
                rows, "compact");
 }
@@ -180,8 +198,8 @@ void terms(const json& noise, Page&, std::string& out) {
   for (const FittedTerm& f : fitted) {
     const std::string relative =
         f.value && f.std && *f.value > 0 ? fmt::format("{:.1f} %", 100.0 * *f.std / *f.value) : kDash;
-    rows.push_back({text_cell(f.look->name), text_cell(f.key), num_cell(value_pm(f.value, f.std)),
-                    text_cell(f.look->unit), num_cell(relative), text_cell(f.look->line)});
+    rows.push_back({text_cell(std::string(f.name.name)), text_cell(f.key), num_cell(value_pm(f.value, f.std)),
+                    text_cell(std::string(f.name.unit)), num_cell(relative), text_cell(f.look->line)});
   }
   for (const auto& key : other) {
     const json& e = noise["terms"][key];
@@ -197,10 +215,15 @@ void terms(const json& noise, Page&, std::string& out) {
   out += table({"term", "key", "value \xC2\xB1 standard uncertainty", "unit", "relative uncertainty",
                 "Allan deviation"},
                rows);
-  out +=
-      "<p class=\"note\">The keys are those of <code>[gyro.noise]</code> where one exists: "
+  const bool accelerometer = sensor_of(noise) == SensorKind::kAccelerometer;
+  out += fmt::format(
+      "<p class=\"note\">The keys are those of <code>[{}.noise]</code> where one exists: "
       "<code>gyrocal noise --toml</code> prints them as a section that <code>plan</code> and "
-      "<code>simulate</code> take as they are. A term the fit did not keep is not listed.</p>\n";
+      "<code>simulate</code> take as they are. A term the fit did not keep is not listed.{}</p>\n",
+      accelerometer ? "accelerometer" : "gyro",
+      accelerometer ? " <code>quantization_ug</code> is the step of the grid the output's values lie on (its "
+                      "resolution), not an Allan term."
+                    : "");
 }
 
 bool always(const json&) {

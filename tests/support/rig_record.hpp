@@ -3,10 +3,13 @@
 // timeline (plan/timeline.hpp). The machine starts at rest, ramps smoothly to each rate, moves the position
 // platform smoothly between dwells, and visits the plan's (rate, beta) pairs in an order of its own, each
 // dwell longer than planned. Its drive turns at the planned rate times (1 + offset), with a sinusoidal
-// ripple. The gyro output is the exact model (model/centrifuge.hpp exact_inputs, model/gyro.hpp) at the
-// generator's own joint states plus white noise. What the acquisition then does to it: a uniform clock read
-// with jitter and rounded, quantised angle encoders, a position encoder toggling by one count, a gap, a clock
-// jump, spikes in the output, a glitch of beta in one row.
+// ripple. The output is the scenario's sensor at the generator's own joint states: a gyro's exact model
+// (model/centrifuge.hpp exact_inputs, model/gyro.hpp) plus white noise, or, for an accelerometer scenario
+// ([sensor] kind = "accelerometer"), the IEEE 1293 model (sensor/accelerometer.hpp) at the exact specific
+// force, in its output units (K1 per g), with its [accelerometer.noise]. A rate of 0 is a static set: the
+// main axis stopped and the counter platform indexed to each gamma. What the acquisition then does to it: a
+// uniform clock read with jitter and rounded, quantised angle encoders, a position encoder toggling by one
+// count, a gap, a clock jump, spikes in the output, a glitch of beta in one row.
 //
 // rig_rows() yields rows of numbers (physical units); write_native() writes gyrocal's own format. Another
 // layout (encoder counts, ms, ';', mV) is another writer over the same rows.
@@ -14,10 +17,12 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <ostream>
 #include <random>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrocal/config/scenario.hpp"
@@ -25,6 +30,8 @@
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/record/record.hpp"
+#include "gyrocal/sensor/accelerometer.hpp"
+#include "gyrocal/simulate/accelerometer_noise.hpp"
 
 namespace gyrocal::testing {
 
@@ -39,8 +46,9 @@ struct RigImperfections {
   double ripple_hz = 0.37;          ///< its frequency, Hz
   double gap_fraction = 0.0;        ///< rows missing from the middle of the third dwell: this fraction of it
   double clock_jump_s = 0.0;        ///< the clock jumps by this in the middle of the fifth dwell
-  int spikes = 0;                   ///< output spikes of spike_deg_h, spread over the record
+  int spikes = 0;  ///< output spikes of spike_deg_h (a gyro's) or spike_g, spread over the record
   double spike_deg_h = 1e6;
+  double spike_g = 1.0;                 ///< an accelerometer's spike, g (K1 x this in output units)
   double beta_glitch_deg = 0.0;         ///< one row in the middle of the second dwell reads beta off by this
   double beta_move_in_dwell_deg = 0.0;  ///< beta moves by this 0.5 s into the settle time of the fourth dwell
 };
@@ -50,7 +58,8 @@ struct RigMotion {
   double ramp_s = 4.0;         ///< a smooth ramp between two rates
   double move_s = 3.0;         ///< a smooth move of the position platform
   double extra_dwell_s = 3.0;  ///< each dwell lasts settle + planned + this
-  double noise_deg_h = 0.5;    ///< white noise on each output sample, deg/h
+  double noise_deg_h = 0.5;    ///< white noise on each output sample, deg/h (a gyro's; an accelerometer's is
+                               ///< its scenario's [accelerometer.noise])
 };
 
 /// One row in physical units.
@@ -75,6 +84,11 @@ struct Phase {
   double rate0 = 0.0, rate1 = 0.0;  // the drive's rate at its start and end (a ramp when they differ)
   double beta0 = 0.0, beta1 = 0.0;  // rad (a move when they differ)
   double theta0 = 0.0;              // main angle at t0
+  // The counter platform: servoed (psi_r = psi0 - theta, the platform keeps its heading) while the main axis
+  // turns, else indexed from counter0 to counter1 (rad; a move when they differ) with the main axis stopped.
+  bool servoed = true;
+  double psi0 = 0.0;
+  double counter0 = 0.0, counter1 = 0.0;
   bool dwell = false;
   int dwell_index = -1;
 };
@@ -97,23 +111,41 @@ inline RigImperfections every_imperfection() {
   return all;
 }
 
-/// Calls emit(row) for each row of a rig's record of `s`'s plan (spinning rates only), in time order.
+/// Calls emit(row) for each row of a rig's record of `s`'s plan, in time order. A spinning rate is one dwell
+/// per beta; a rate of 0 one hold per beta and gamma (the rig's own gamma order), each lasting settle +
+/// the planned hold + extra.
 inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion,
                      std::uint64_t seed, const std::function<void(const RigRow&)>& emit) {
   using rig_detail::Phase;
   const CentrifugeModel model = s.model();
   const TestSpec& test = s.test;
-  // The rig's own order: rates last to first, betas rotated by one and reversed.
-  std::vector<std::pair<double, double>> order;
+  const bool accelerometer = s.sensor_kind == SensorKind::kAccelerometer;
+  // The rig's own order: rates last to first, betas rotated by one and reversed, a static set's gammas
+  // reversed. Each entry: rate, beta, gamma (a static hold's; unused while spinning).
+  struct Visit {
+    double rate, beta, gamma;
+  };
+  std::vector<Visit> order;
   for (auto r = test.rates_rad_s.rbegin(); r != test.rates_rad_s.rend(); ++r) {
     std::vector<double> betas(test.beta_rad);
     std::rotate(betas.begin(), betas.begin() + 1, betas.end());
     std::reverse(betas.begin(), betas.end());
-    for (double b : betas) order.push_back({*r, b});
+    for (double b : betas) {
+      if (*r != 0.0) {
+        order.push_back({*r, b, 0.0});
+        continue;
+      }
+      for (auto g = test.gamma_rad.rbegin(); g != test.gamma_rad.rend(); ++g) order.push_back({*r, b, *g});
+    }
   }
+  const double hold_s = static_hold_duration_s(test, reference_rate_rad_s(test, s.centrifuge.rate_rad_s));
   std::vector<Phase> phases;
-  double t = 0.0, rate = 0.0, beta = order.front().second, theta = 0.0;
-  const auto add = [&](double duration, double rate1, double beta1, bool dwell) {
+  double t = 0.0, rate = 0.0, beta = order.front().beta, theta = 0.0;
+  // The counter platform starts servoed at rest with psi_r = psi0 - theta.
+  bool servoed = true;
+  double psi0 = 0.7, counter = psi0;  // rad
+  const auto add = [&](double duration, double rate1, double beta1, bool dwell,
+                       double counter1 = std::numeric_limits<double>::quiet_NaN()) {
     Phase p;
     p.t0 = t;
     p.t1 = t + duration;
@@ -122,6 +154,20 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     p.beta0 = beta;
     p.beta1 = beta1;
     p.theta0 = theta;
+    // The servo engages when the main axis starts (keeping the counter platform where it is) and releases
+    // when it has stopped; an indexed platform moves to counter1.
+    if (!servoed && rate1 != 0.0) {
+      servoed = true;
+      psi0 = counter + theta;
+    } else if (servoed && rate == 0.0 && rate1 == 0.0) {
+      servoed = false;
+      counter = psi0 - theta;
+    }
+    p.servoed = servoed;
+    p.psi0 = psi0;
+    p.counter0 = counter;
+    p.counter1 = servoed || std::isnan(counter1) ? counter : counter1;  // NaN: the platform stays
+    if (!servoed) counter = p.counter1;
     p.dwell = dwell;
     if (dwell)
       p.dwell_index = static_cast<int>(
@@ -138,24 +184,34 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     beta = beta1;
   };
   add(2.0, 0.0, beta, false);  // at rest
-  for (const auto& [r, b] : order) {
-    const double drive = r * (1.0 + imp.rate_offset);
+  for (const Visit& v : order) {
+    const double drive = v.rate * (1.0 + imp.rate_offset);
     if (drive != rate) add(motion.ramp_s, drive, beta, false);
-    if (b != beta) add(motion.move_s, rate, b, false);
-    const double planned = test.revolutions * 2.0 * kPi / std::abs(r);
+    if (v.beta != beta) add(motion.move_s, rate, v.beta, false);
+    if (v.rate == 0.0) {
+      // Stopped: the servo lets go, the counter platform is indexed to psi_r = -gamma (the shorter way
+      // round), then the hold.
+      if (servoed) add(0.5, 0.0, beta, false);
+      const double target = counter + wrap_deg((-v.gamma - counter) * kRadToDeg) * kDegToRad;
+      if (target != counter) add(motion.move_s, 0.0, beta, false, target);
+      add(test.settle_s + hold_s + motion.extra_dwell_s, 0.0, beta, true);
+      continue;
+    }
+    const double planned = test.revolutions * 2.0 * kPi / std::abs(v.rate);
     add(test.settle_s + planned + motion.extra_dwell_s, rate, beta, true);
   }
-  add(motion.ramp_s, 0.0, beta, false);
+  if (rate != 0.0) add(motion.ramp_s, 0.0, beta, false);
 
   // The output's noise and the acquisition's imperfections draw from separate streams: a record with and
   // without jitter has the same noise.
   std::mt19937_64 rng(seed), acquisition(seed ^ 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> noise(0.0, motion.noise_deg_h);
+  const double k1 = s.accelerometer.coefficients[AccelCoefficient::K1];
+  AccelerometerNoiseGenerator accelerometer_noise(s.accelerometer.noise, k1, test.sample_rate_hz, seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::bernoulli_distribution toggle(0.5);
   const double fs = test.sample_rate_hz;
   const auto n = static_cast<std::uint64_t>(std::floor(t * fs));
-  const double psi0 = 0.7;  // the counter platform's angle at rest, rad
   const auto spike_every = imp.spikes > 0 ? n / static_cast<std::uint64_t>(imp.spikes + 1) : 0;
   const auto quantise = [](double a, double q) { return q > 0 ? q * std::round(a / q) : a; };
   std::size_t pi = 0;
@@ -180,9 +236,17 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     j.main_angle_rad = th;
     j.main_rate_rad_s = w;
     j.main_accel_rad_s2 = acc;
-    j.counter_angle_rad = psi0 - th;
-    j.counter_rate_rad_s = -w;
-    j.counter_accel_rad_s2 = -acc;
+    if (p.servoed) {
+      j.counter_angle_rad = p.psi0 - th;
+      j.counter_rate_rad_s = -w;
+      j.counter_accel_rad_s2 = -acc;
+    } else {
+      const double dc = p.counter1 - p.counter0;
+      j.counter_angle_rad = p.counter0 + dc * rig_detail::step(u);
+      j.counter_rate_rad_s = dc * rig_detail::step_rate(u) / d;
+      j.counter_accel_rad_s2 =
+          dc * 0.5 * kPi * kPi * std::cos(kPi * u) / (d * d) * (u > 0 && u < 1 ? 1.0 : 0.0);
+    }
     const double db = p.beta1 - p.beta0;
     j.position_angle_rad = p.beta0 + db * rig_detail::step(u);
     j.position_rate_rad_s = db * rig_detail::step_rate(u) / d;
@@ -194,10 +258,11 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
       j.position_angle_rad += imp.beta_move_in_dwell_deg * kDegToRad;
     }
     const GyroInputs in = exact_inputs(model, j);
-    double y = gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) + noise(rng);
+    double y = accelerometer ? accelerometer_noise.next(s.accelerometer.output(in))
+                             : gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) + noise(rng);
     if (spike_every > 0 && k % spike_every == spike_every / 2 &&
         k / spike_every <= static_cast<std::uint64_t>(imp.spikes))
-      y += imp.spike_deg_h;
+      y += accelerometer ? k1 * imp.spike_g : imp.spike_deg_h;
     // The acquisition.
     const double mid = 0.5 * (p.t0 + p.t1);
     if (p.dwell && p.dwell_index == 2 && imp.gap_fraction > 0.0 &&
@@ -223,10 +288,12 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
   }
 }
 
-/// The rows of rig_rows() as gyrocal's native record (columns in degrees, time in s).
-inline void write_native(std::ostream& out, const std::vector<RigRow>& rows) {
+/// The rows of rig_rows() as gyrocal's native record (columns in degrees, time in s; the output column a
+/// gyro's, or "accel_g" for an accelerometer's in g).
+inline void write_native(std::ostream& out, const std::vector<RigRow>& rows,
+                         std::string_view output_column = "gyro_deg_h") {
   out << kRecordMagic << "\n";
-  out << "time_s,main_angle_deg,counter_angle_deg,position_angle_deg,gyro_deg_h\n";
+  out << "time_s,main_angle_deg,counter_angle_deg,position_angle_deg," << output_column << "\n";
   out.precision(17);
   for (const RigRow& r : rows)
     out << r.time_s << ',' << r.main_angle_deg << ',' << r.counter_angle_deg << ',' << r.position_angle_deg

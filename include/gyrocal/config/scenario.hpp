@@ -58,6 +58,12 @@ struct Scenario {
 /// The default scenario of docs/physics.md section 11.
 Scenario default_scenario();
 
+/// The default accelerometer scenario (`gyrocal init --sensor accelerometer`; docs/accelerometer.md): the
+/// default scenario's machine and site with [sensor] kind = "accelerometer", the accelerometer's default
+/// truth and noise (10 ug/sqrt(Hz)), and a test that identifies all eleven coefficients: rates 0 (a static
+/// set of 10 s holds), 6 and 12 rad/s, beta 0, 180, 90, 270 deg, eight gamma every 45 deg, 100 revolutions.
+Scenario default_accelerometer_scenario();
+
 /// What `gyrocal demo` runs: the default scenario, with a standard uncertainty of 10% of each configured
 /// machine error in [uncertainty] (docs/physics.md gives none; only the Monte Carlo budget uses them).
 Scenario demo_scenario();

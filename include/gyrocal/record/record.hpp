@@ -23,7 +23,8 @@
 //
 // A rig's own layout is read through a RecordLayout (record/record_layout.hpp, the configuration's [record]
 // section; docs/records.md): its delimiter, comment prefix, columns found by name in any order (the others
-// skipped unread) and units converted to s, deg and deg/h; no magic line is needed.
+// skipped unread) and units converted to s, deg and deg/h (or g, an accelerometer's); no magic line is
+// needed.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -160,7 +161,8 @@ class RecordReader {
   void require_angles() const;
   /// The name of the output column ("gyro_deg_h", "accel_g", or the layout's output_column).
   const std::string& output_column() const;
-  /// The unit of RecordSample::output: "g" for gyrocal's own format with an accel_g column, else "deg/h".
+  /// The unit of RecordSample::output: "g" for gyrocal's own format with an accel_g column, or through a
+  /// layout whose output is a specific force (RecordLayout::output_quantity); else "deg/h".
   std::string_view output_unit() const;
   /// The layout read through, or nullopt for gyrocal's own format.
   const std::optional<RecordLayout>& layout() const;

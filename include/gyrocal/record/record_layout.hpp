@@ -14,6 +14,9 @@ namespace gyrocal {
 enum class TimeUnit { kSeconds, kMilliseconds, kMicroseconds, kNanoseconds };
 /// The unit of a record's angle columns that do not hold encoder counts.
 enum class AngleUnit { kDegrees, kRadians };
+/// What a record's output column measures: a gyro's rate (read into deg/h) or an accelerometer's specific
+/// force (read into g). The configuration sets it from [sensor] kind.
+enum class OutputQuantity { kRate, kSpecificForce };
 
 /// The names of the units as a configuration writes them ("s", "ms", "us", "ns"; "deg", "rad").
 std::string_view to_string(TimeUnit unit);
@@ -47,14 +50,21 @@ struct RecordLayout {
   std::int64_t main_counts_per_revolution = 0;
   std::int64_t counter_counts_per_revolution = 0;
   std::int64_t position_counts_per_revolution = 0;
-  /// The gyro's output column; required. Default "gyro_deg_h".
+  /// The sensor's output column; required. Default "gyro_deg_h" (a configuration of an accelerometer
+  /// defaults it to "accel_g").
   std::string output_column = "gyro_deg_h";
-  /// Output units per deg/h (e.g. mV per deg/h): the output, less output_offset, is divided by it. Finite and
-  /// non-zero; negative for an output whose sign is the opposite of gyrocal's (a cable or a convention).
-  /// Default 1.
+  /// What the output column measures (default a gyro's rate); it chooses the scale below that applies.
+  OutputQuantity output_quantity = OutputQuantity::kRate;
+  /// A gyro's output units per deg/h (e.g. mV per deg/h): the output, less output_offset, is divided by it.
+  /// Finite and non-zero; negative for an output whose sign is the opposite of gyrocal's (a cable or a
+  /// convention). Default 1; must stay 1 when output_quantity is kSpecificForce.
   double output_scale_per_deg_h = 1.0;
-  /// What the output column reads at zero rate, in the column's own units (e.g. mV): subtracted before the
-  /// scale, deg/h = (value - output_offset) / output_scale_per_deg_h. Finite; default 0.
+  /// An accelerometer's output units per g (e.g. mV per g), likewise: g = (value - output_offset) /
+  /// output_scale_per_g. Finite and non-zero, negative for an inverted output. Default 1; must stay 1 when
+  /// output_quantity is kRate.
+  double output_scale_per_g = 1.0;
+  /// What the output column reads at zero input, in the column's own units (e.g. mV): subtracted before the
+  /// scale, deg/h (or g) = (value - output_offset) / output_scale(). Finite; default 0.
   double output_offset = 0.0;
   /// What each angle column reads, in deg after its unit's conversion, when its angle is zero (an encoder's
   /// zero off the machine's): subtracted from every reading. Finite; default 0.
@@ -74,6 +84,13 @@ struct RecordLayout {
   bool IsValid(std::string* error, std::string* key = nullptr) const;
   /// True when all three angle columns are named (what a calibration needs).
   bool has_angles() const;
+  /// The scale the output is divided by, output units per unit of output_unit(): output_scale_per_deg_h for
+  /// a rate, output_scale_per_g for a specific force.
+  double output_scale() const;
+  /// The unit the reader gives the output in: "deg/h" for a rate, "g" for a specific force.
+  std::string_view output_unit() const;
+  /// The [record] key of the scale that applies ("output_scale_per_deg_h" or "output_scale_per_g").
+  std::string_view output_scale_key() const;
   /// True when `name` is the default name of an angle column ("main_angle_deg", …): such a column may be
   /// missing from a header and is then absent (a noise logger's record through a [record] naming only the
   /// time and the output; docs/records.md).
@@ -81,6 +98,11 @@ struct RecordLayout {
 
   friend bool operator==(const RecordLayout&, const RecordLayout&) = default;
 };
+
+/// A record's output units per g as its layout reads it (`output_scale_per_g`; 1 for gyrocal's own format,
+/// whose accel_g column is in g, and for a layout of a gyro's rate). The accelerometer's scale factor K1 in
+/// the rig's own output units per g is this times the K1 fitted to the rows the reader gives (in g).
+double output_scale_per_g(const std::optional<RecordLayout>& layout);
 
 /// Throws gyrocal::Error, naming `record_name` and the [record] keys left empty, when `layout` lacks an angle
 /// column: a calibration reduces the record by its angles. Nothing happens for nullopt (gyrocal's own format
