@@ -23,7 +23,9 @@ namespace {
 
 /// A small two-speed accelerometer test: static holds at four gamma, 6 and 12 rad/s, four beta, the default
 /// truth of [accelerometer], the default machine's wobbles plus a lever arm and a main-axis runout. Few
-/// revolutions at 50 Hz, so that a record is simulated, reduced and identified in milliseconds.
+/// revolutions at 50 Hz, so that a record is simulated, reduced and identified in milliseconds. The settle is
+/// the default 2 s: with 0.5 s the first spinning dwell after the static holds still holds the end of the
+/// machine's transition, which the constant-rate channels lack (~20 ug at 6 rad/s; docs/accelerometer.md).
 Scenario accelerometer_scenario(bool noisy) {
   Scenario s = default_scenario();
   s.sensor_kind = SensorKind::kAccelerometer;
@@ -32,7 +34,7 @@ Scenario accelerometer_scenario(bool noisy) {
   s.test.rates_rad_s = {0.0, 6.0, 12.0};
   s.test.revolutions = 8;
   s.test.sample_rate_hz = 50.0;
-  s.test.settle_s = 0.5;
+  s.test.settle_s = 2.0;
   s.test.static_hold_s = 2.0;
   s.errors.lever_arm_m = Eigen::Vector3d(0.01, -0.004, 0.002);
   s.errors.main_runout_x_m.terms = {{1, 2e-6, 0.3}};
@@ -87,8 +89,7 @@ TEST(AccelerometerCalibration, SpinningDwellsKeepTheirWholeHarmonicContent) {
 
 TEST(AccelerometerCalibration, NoiseFreeRecordGivesTheElevenCoefficients) {
   const Scenario s = accelerometer_scenario(false);
-  const std::uint64_t seed = std::getenv("SEED") ? std::strtoull(std::getenv("SEED"), nullptr, 10) : 1u;
-  const CalibrationResult r = calibrate(s, simulate_and_reduce(s, seed));
+  const CalibrationResult r = calibrate(s, simulate_and_reduce(s, 1));
   ASSERT_EQ(r.sensor_coefficients.size(), kNumAccelCoefficients);
   EXPECT_EQ(r.rank, 11);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
@@ -107,15 +108,16 @@ TEST(AccelerometerCalibration, NoiseFreeRecordGivesTheElevenCoefficients) {
 }
 
 TEST(AccelerometerCalibration, NoisyZScoresHaveUnitSpread) {
-  // (estimate - truth) / std over independent records: its spread is 1 when the stated std is honest.
-  // 200 seeds: the std of 200 unit normals lies in [0.9, 1.1] with probability ~0.95 each; the band is
-  // [0.85, 1.15] (issue 19).
+  // (estimate - truth) / std over independent records: spread 1 and mean 0 when the stated std is honest and
+  // the estimate unbiased. 200 seeds (issue 19): the std of 200 unit normals lies within [0.9, 1.1] with
+  // probability ~0.95; the band is [0.85, 1.15], and the mean within 4 / sqrt(200). Small records (8
+  // revolutions at 50 Hz) keep it to seconds, under the sanitizers too.
   const Scenario s = accelerometer_scenario(true);
-  const int seeds = std::getenv("SEEDS") ? std::atoi(std::getenv("SEEDS")) : 200;
+  const int seeds = 200;
+  const double low = 0.85, high = 1.15;
   std::vector<std::vector<double>> z(kNumAccelCoefficients);
   for (int seed = 1; seed <= seeds; ++seed) {
-    const CalibrationResult r =
-        calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed) * 7919u + 12345u));
+    const CalibrationResult r = calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed)));
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
       const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
       ASSERT_TRUE(c.identifiable) << c.name;
@@ -127,12 +129,12 @@ TEST(AccelerometerCalibration, NoisyZScoresHaveUnitSpread) {
     for (double v : z[k]) mean += v / seeds;
     for (double v : z[k]) sq += (v - mean) * (v - mean);
     const double sd = std::sqrt(sq / (seeds - 1));
-    EXPECT_GE(sd, 0.85) << kAccelerometerParameters[k].name;
-    EXPECT_LE(sd, 1.15) << kAccelerometerParameters[k].name;
-    // The mean is printed, not asserted: K0, K1, K3 and a delta show a mean z of 0.3..0.5 over 200 seeds
-    // (docs/accelerometer.md, "Open"), while noise-free records are exact.
     std::printf("%s: z mean %.3f, std %.3f over %d seeds\n",
                 std::string(kAccelerometerParameters[k].name).c_str(), mean, sd, seeds);
+    EXPECT_GE(sd, low) << kAccelerometerParameters[k].name;
+    EXPECT_LE(sd, high) << kAccelerometerParameters[k].name;
+    EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(seeds)))
+        << kAccelerometerParameters[k].name;
   }
 }
 
@@ -191,6 +193,39 @@ TEST(AccelerometerCalibration, EstimatesTheRadiusErrorAndStretch) {
   EXPECT_LT(std::abs(n.machine_errors[0].value - 30e-6), 4.0 * n.machine_errors[0].std);
   std::printf("radius_error: %.3g +- %.3g um (truth 30 um)\n", n.machine_errors[0].value * 1e6,
               n.machine_errors[0].std * 1e6);
+}
+
+TEST(AccelerometerCalibration, RadiusZScoresHaveUnitSpread) {
+  // The radius error and the stretch estimated from the accelerometer's own data, over 200 records: their
+  // z-scores about the simulated truth spread as unit normals.
+  Scenario truth = accelerometer_scenario(true);
+  truth.errors.radius_error_m = 30e-6;
+  truth.errors.radius_stretch_m_per_rad2_s2 = 2e-7;
+  const Scenario config = accelerometer_scenario(true);
+  CalibrationOptions o;
+  o.estimate = parse_machine_error_names({"radius_error", "radius_stretch"}, "test");
+  const int seeds = 200;
+  const double expected[2] = {30e-6, 2e-7};
+  double sum[2] = {0.0, 0.0}, sq[2] = {0.0, 0.0};
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const CalibrationResult r =
+        calibrate(config, simulate_and_reduce(truth, static_cast<std::uint64_t>(seed)), o);
+    for (std::size_t j = 0; j < 2; ++j) {
+      ASSERT_TRUE(r.machine_errors[j].identifiable) << r.machine_errors[j].reason;
+      const double z = (r.machine_errors[j].value - expected[j]) / r.machine_errors[j].std;
+      sum[j] += z;
+      sq[j] += z * z;
+    }
+  }
+  for (std::size_t j = 0; j < 2; ++j) {
+    const double mean = sum[j] / seeds;
+    const double sd = std::sqrt((sq[j] - seeds * mean * mean) / (seeds - 1));
+    std::printf("%s: z mean %.3f, std %.3f over %d seeds\n", j == 0 ? "radius_error" : "radius_stretch", mean,
+                sd, seeds);
+    EXPECT_GE(sd, 0.85);
+    EXPECT_LE(sd, 1.15);
+    EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(seeds)));
+  }
 }
 
 TEST(AccelerometerCalibration, TheGyrosRoutesAreRefusedNamingTheOption) {
