@@ -5,11 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
@@ -17,6 +21,7 @@
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/cli_run.hpp"
 
 namespace gyrocal {
 namespace {
@@ -32,6 +37,7 @@ Scenario accelerometer_scenario(bool noisy) {
   s.accelerometer = Accelerometer{};
   if (!noisy) s.accelerometer.noise = AccelerometerNoise{};
   s.test.rates_rad_s = {0.0, 6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;  // the first non-zero rate, as a configuration states it
   s.test.revolutions = 8;
   s.test.sample_rate_hz = 50.0;
   s.test.settle_s = 2.0;
@@ -143,6 +149,7 @@ TEST(AccelerometerCalibration, OneSpeedNamesK0K2KppKooUnidentifiable) {
   // K2 - Kpp, K2 - Koo, K0 + (1 + Ar^2) K2 remain (docs/accelerometer.md, "Test design").
   Scenario s = accelerometer_scenario(true);
   s.test.rates_rad_s = {12.0};
+  s.centrifuge.rate_rad_s = 12.0;
   const CalibrationResult r = calibrate(s, simulate_and_reduce(s, 3));
   const auto& c = r.sensor_coefficients;
   for (AccelCoefficient k :
@@ -251,6 +258,42 @@ TEST(AccelerometerCalibration, TheGyrosRoutesAreRefusedNamingTheOption) {
   CalibrationOptions rate;
   rate.gyro_model = GyroModel::kDriftRate;
   EXPECT_NE(message(rate).find("drift+rate"), std::string::npos) << message(rate);
+}
+
+TEST(AccelerometerCalibrationCli, SimulateThenCalibrateGivesTheTableAndRefusesTheSeed) {
+  // What a user runs: `gyrocal simulate` then `gyrocal calibrate --json` on an accelerometer's configuration.
+  const auto dir = test::fresh_test_folder("acore");
+  const Scenario s = accelerometer_scenario(false);
+  {
+    std::ofstream out(dir / "a.toml");
+    out << scenario_to_toml(s);
+  }
+  const std::string config = (dir / "a.toml").string(), record = (dir / "a.csv").string();
+  const test::CliOutcome sim = test::run_cli("simulate --config " + config + " --out " + record, dir);
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const test::CliOutcome cal = test::run_cli(
+      "calibrate " + record + " --config " + config + " --json " + (dir / "a.json").string(), dir);
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  EXPECT_NE(cal.out.find("delta_p"), std::string::npos) << cal.out;
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir / "a.json"));
+  EXPECT_EQ(j.at("sensor"), "accelerometer");
+  ASSERT_EQ(j.at("coefficients").size(), kNumAccelCoefficients);
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const nlohmann::json& c = j.at("coefficients").at(std::string(kAccelerometerParameters[k].name));
+    EXPECT_EQ(c.at("unit"), kAccelerometerParameters[k].unit);
+    EXPECT_TRUE(c.at("identifiable").get<bool>());
+    EXPECT_NEAR(c.at("value").get<double>(), truth_of(s, k), k == 1 ? 1e-9 : 1e-4)
+        << kAccelerometerParameters[k].name;
+  }
+  const test::CliOutcome seed =
+      test::run_cli("calibrate " + record + " --config " + config + " --compensation seed", dir);
+  EXPECT_NE(seed.status, 0);
+  EXPECT_NE(seed.err.find("--compensation seed"), std::string::npos) << seed.err;
+  const test::CliOutcome closed =
+      test::run_cli("calibrate " + record + " --config " + config + " --method closed-form", dir);
+  EXPECT_NE(closed.status, 0);
+  EXPECT_NE(closed.err.find("--method closed-form"), std::string::npos) << closed.err;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
