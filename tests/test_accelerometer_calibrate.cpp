@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
@@ -233,6 +234,42 @@ TEST(AccelerometerCalibration, RadiusZScoresHaveUnitSpread) {
     EXPECT_LE(sd, 1.15);
     EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(seeds)));
   }
+}
+
+TEST(AccelerometerPlan, PredictsTheStdOfARecordsCalibrationAndNamesTheOneSpeedDirection) {
+  // The plan's predicted std against a calibration's of a simulated record of the same test (which measures
+  // its levels from the record's scatter): within 25 % (the record's levels rest on ~40 degrees of freedom a
+  // dwell), and the estimates are the configured truth.
+  const Scenario s = accelerometer_scenario(true);
+  CalibrationOptions o;
+  o.sensor = SensorKind::kAccelerometer;
+  const CalibrationResult plan = predict_calibration(s, o);
+  const CalibrationResult record = calibrate(s, simulate_and_reduce(s, 11));
+  ASSERT_EQ(plan.sensor_coefficients.size(), kNumAccelCoefficients);
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const SensorCoefficientEstimate& p = plan.sensor_coefficients[k];
+    ASSERT_TRUE(p.identifiable) << p.name;
+    EXPECT_NEAR(p.value, truth_of(s, k), k == 1 ? 1e-9 : 1e-4) << p.name;
+    EXPECT_NEAR(p.std / record.sensor_coefficients[k].std, 1.0, 0.25) << p.name;
+  }
+  // One speed: the four named, as calibrate names them.
+  Scenario one = s;
+  one.test.rates_rad_s = {12.0};
+  one.centrifuge.rate_rad_s = 12.0;
+  const CalibrationResult p1 = predict_calibration(one, o);
+  for (AccelCoefficient k :
+       {AccelCoefficient::K0, AccelCoefficient::K2, AccelCoefficient::Kpp, AccelCoefficient::Koo})
+    EXPECT_FALSE(p1.sensor_coefficients[static_cast<std::size_t>(k)].identifiable);
+  ASSERT_EQ(p1.unidentifiable.size(), 1u);
+  EXPECT_NE(p1.unidentifiable[0].find("K0, K2, Kpp, Koo"), std::string::npos);
+  // Values at four gamma (the window mean): the aliasing of K3 onto the scale is said.
+  CalibrationOptions window = o;
+  window.reduce.method = ReduceOptions::Method::kWindowMean;
+  const CalibrationResult pw = predict_calibration(s, window);
+  bool said = false;
+  for (const std::string& w : pw.warnings)
+    said |= w.find("K3 is confounded with the scale") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 TEST(AccelerometerCalibration, TheGyrosRoutesAreRefusedNamingTheOption) {

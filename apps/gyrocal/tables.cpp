@@ -42,8 +42,8 @@ std::string result_table(const CalibrationResult& r) {
   out += fmt::format("{:<16} {:>30}  {}\n", "coefficient", "estimate ± std", "unit");
   // A sensor other than the gyro: its table (an accelerometer's K0 .. delta_o).
   for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
-    out += fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.identifiable ? c.value : NAN, c.std),
-                       c.unit);
+    out +=
+        fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.identifiable ? c.value : NAN, c.std), c.unit);
   for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k)
     out += fmt::format("{:<16} {:>30}  {}\n", kCoefficientNames[k],
                        value_std(r.coefficients[k].value, r.coefficients[k].std), kCoefficientUnits[k]);

@@ -473,6 +473,22 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
                       describe_position(reduction, static_cast<std::size_t>(i))));
   }
   refuse_repeated_positions(reduction);
+  // Values at fewer gammas than the harmonic content (the window mean at [test] gamma_deg): at 0, 90, 180
+  // and 270 deg cos^3 = cos, so the third harmonic folds onto the first and K3 is confounded with the scale
+  // at each g-level, and the radius with them (docs/accelerometer.md, "Keep the third harmonic").
+  if (options.sensor == SensorKind::kAccelerometer) {
+    std::size_t fewest = 0;
+    for (const Dwell& d : reduction.dwells)
+      if (!d.is_static && (fewest == 0 || d.gammas_rad.size() < fewest)) fewest = d.gammas_rad.size();
+    if (fewest > 0 && fewest < 7)
+      r.warnings.push_back(fmt::format(
+          "a spinning dwell is reduced to values at {} gamma only (the window mean at [test] gamma_deg): "
+          "they "
+          "alias the third harmonic onto the first (at 0, 90, 180, 270 deg cos^3 = cos), so K3 is confounded "
+          "with the scale K1 at each g-level and the radius with them; the harmonic reduction keeps all "
+          "seven numbers of a revolution (--reduction harmonic, docs/accelerometer.md).",
+          fewest));
+  }
   const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
   const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);

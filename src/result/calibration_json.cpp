@@ -27,10 +27,11 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   // A sensor other than the gyro: its own table's coefficients (docs/contract.md, "Accelerometers"): K1 as
   // fitted on the record's output, in its units per g.
   for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
-    coefficients[c.name] = {{"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
-                            {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
-                            {"unit", c.unit},
-                            {"identifiable", c.identifiable}};
+    coefficients[c.name] = {
+        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
+        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
+        {"unit", c.unit},
+        {"identifiable", c.identifiable}};
   for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k) {
     const CoefficientEstimate& c = r.coefficients[k];
     coefficients[std::string(kCoefficientNames[k])] = {
