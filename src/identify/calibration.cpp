@@ -457,7 +457,10 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
     const DesignRow& row = channels[static_cast<std::size_t>(i)].sensor_exact;
     if (static_cast<Eigen::Index>(row.size) != nc)
-      throw Error("internal: the model's channels are not the sensor's (identify/sensor_channels.hpp).");
+      throw Error(fmt::format(
+          "sensor.kind is \"{}\", but the model's channels given are the gyro's: this command does not yet "
+          "serve an accelerometer (calibrate and plan do; docs/accelerometer.md).",
+          to_string(options.sensor)));
     for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = row.regressors[static_cast<std::size_t>(j)];
     for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
     observations[i] = p.mean_deg_h - row.known;
@@ -1415,6 +1418,11 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   }
   if (options.test_misfit) apply_misfit_rule(reduction, channels, model, options, r);
   return r;
+}
+
+std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const CalibrationOptions& options) {
+  return model_channels(reduction, model, options);
 }
 
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,

@@ -208,6 +208,13 @@ Compensation parse_compensation(const std::string& text);
 CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                            const CentrifugeModel& model, const CalibrationOptions& options);
 
+/// The model's channels of `reduction` for the options' sensor, reduced by the operator of the record's
+/// output: the gyro's (reduce_model_channels) or another sensor's design rows (reduce_sensor_channels). What
+/// identify() takes; a caller reducing a record itself reduces it with reduction_plan(plan, options.sensor,
+/// options.reduce) (identify/sensor_channels.hpp).
+std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const CalibrationOptions& options);
+
 /// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
 /// `layout`: how the record is laid out (the configuration's [record], docs/records.md); nullopt for
 /// gyrocal's own format. A layout without all three angle columns is refused, naming the keys.
