@@ -24,6 +24,7 @@
 #include "gyrocal/identify/channels.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
@@ -183,7 +184,8 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
     py::gil_scoped_release release;
     // What calibrate_record does, with the rows from the arrays instead of a RecordReader.
     const CentrifugeModel model = scenario.model();
-    Reducer reducer(scenario.test, options.reduce, name, model.geometry().rate_rad_s);
+    Reducer reducer(reduction_plan(scenario.test, options.sensor, options.reduce), options.reduce, name,
+                    model.geometry().rate_rad_s);
     RecordSample s;
     for (py::ssize_t i = 0; i < time_s.size(); ++i) {
       s.time_s = time_s.data()[i];
@@ -195,8 +197,7 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
       reducer.push(s);
     }
     const Reduction reduction_result = reducer.finish();
-    const std::vector<PositionChannels> channels =
-        reduce_model_channels(reduction_result, model, options.reduce);
+    const std::vector<PositionChannels> channels = calibration_channels(reduction_result, model, options);
     j = calibration_to_json(identify(reduction_result, channels, model, options));
   }
   j["record"] = name;

@@ -53,11 +53,17 @@ void register_plan(CLI::App& app) {
     if (opt->json == "-") return;
     fmt::print("The configured test: {} positions, {} revolutions per dwell at {} Hz.\n", r.positions.size(),
                s.test.revolutions, s.test.sample_rate_hz);
-    fmt::print(
-        "Predicted from the configured noise (angle random walk {} deg/sqrt(h), bias instability {} deg/h, "
-        "rate random walk {} deg/h/sqrt(h)); estimates are the configured truth.\n\n",
-        s.noise.angle_random_walk_deg_rt_h, s.noise.bias_instability_deg_h,
-        s.noise.rate_random_walk_deg_h_rt_h);
+    if (s.sensor_kind == SensorKind::kAccelerometer)
+      fmt::print(
+          "Predicted from the configured noise (white {} ug/sqrt(Hz)); estimates are the configured "
+          "truth.\n\n",
+          s.accelerometer.noise.velocity_random_walk_ug_rt_hz);
+    else
+      fmt::print(
+          "Predicted from the configured noise (angle random walk {} deg/sqrt(h), bias instability {} deg/h, "
+          "rate random walk {} deg/h/sqrt(h)); estimates are the configured truth.\n\n",
+          s.noise.angle_random_walk_deg_rt_h, s.noise.bias_instability_deg_h,
+          s.noise.rate_random_walk_deg_h_rt_h);
     fmt::print("{}", result_table(r));
   });
 }

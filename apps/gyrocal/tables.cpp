@@ -40,7 +40,11 @@ std::string format_value_std(double value, double std_dev) {
 std::string result_table(const CalibrationResult& r) {
   std::string out = r.BriefReport() + "\n\n";
   out += fmt::format("{:<16} {:>30}  {}\n", "coefficient", "estimate ± std", "unit");
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  // A sensor other than the gyro: its table (an accelerometer's K0 .. delta_o).
+  for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+    out +=
+        fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.identifiable ? c.value : NAN, c.std), c.unit);
+  for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k)
     out += fmt::format("{:<16} {:>30}  {}\n", kCoefficientNames[k],
                        value_std(r.coefficients[k].value, r.coefficients[k].std), kCoefficientUnits[k]);
   if (r.gyro_model == GyroModel::kDriftRate) {  // docs/physics.md section 15

@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/dwell_reduction.hpp"
@@ -32,7 +33,7 @@ Reduction planned_reduction(const Scenario& s) {
     d.planned_rate_rad_s = m.rate_rad_s;
     d.planned_counter_rate_offset_rad_s = m.counter_rate_offset_rad_s;
     d.beta_rad = d.measured_beta_rad = m.beta_rad;
-    d.gammas_rad = d.is_static ? std::vector<double>{m.gamma_rad} : s.test.gamma_rad;
+    d.gammas_rad = d.is_static ? std::vector<double>{m.gamma_rad} : spinning_gammas(s.test);
     // The samples t_k = k / fs inside [start, end).
     const double k0 = std::ceil(m.start_s * fs - 1e-9), k1 = std::ceil(m.end_s * fs - 1e-9);
     d.first_time_s = k0 * dt;
@@ -621,9 +622,53 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
 
 }  // namespace
 
+namespace {
+
+/// predict_calibration for a sensor other than the gyro (docs/accelerometer.md, "Planning"): the planned
+/// dwells reduced as its record would be (an accelerometer's spinning dwells to their whole harmonic
+/// content), its design rows on every planned sample, noise-free outputs from its configured truth, the
+/// reduced values' covariance from its white noise, then the calibration's own identification.
+CalibrationResult predict_sensor_calibration(const Scenario& s, const CalibrationOptions& options) {
+  Scenario planned = s;
+  planned.test = reduction_plan(s.test, s.sensor_kind, options.reduce);
+  Reduction r = planned_reduction(planned);
+  const CentrifugeModel model = s.model();
+  const Sensor sensor = s.sensor();
+  const std::vector<PositionChannels> channels = reduce_sensor_channels(r, model, options.reduce, sensor);
+  const Accelerometer& a = std::get<Accelerometer>(sensor);
+  const Eigen::VectorXd u = a.products();
+  for (std::size_t i = 0; i < r.positions.size(); ++i) {
+    const DesignRow& row = channels[i].sensor_exact;
+    double e = row.known;
+    for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
+    r.positions[i].mean_deg_h = e;
+  }
+  // The white noise as the simulator draws it (simulate/accelerometer_noise.hpp): per sample N sqrt(fs) ug
+  // referred to the input, K1 times that in output units; the gyro's white term with that sample std.
+  GyroNoise white;
+  white.angle_random_walk_deg_rt_h =
+      a.noise.velocity_random_walk_ug_rt_hz * 1e-6 * std::abs(a.coefficients[AccelCoefficient::K1]) / 60.0;
+  set_predicted_std_errors(r, white, s.test.sample_rate_hz, options.reduce);
+  CalibrationOptions identify_options = options;
+  identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  CalibrationResult result = identify(r, channels, model, identify_options);
+  if (a.noise.bias_instability_ug > 0.0)
+    result.warnings.push_back(
+        "the predicted uncertainties count the accelerometer's white noise only: its bias instability adds "
+        "to "
+        "them.");
+  if (a.noise.velocity_random_walk_ug_rt_hz == 0.0)
+    result.warnings.push_back(
+        "the configured accelerometer noise is zero: the predicted uncertainties are zero.");
+  return result;
+}
+
+}  // namespace
+
 CalibrationResult predict_calibration(const Scenario& s, const CalibrationOptions& options) {
   // What calibrate would refuse, plan refuses too, by the same check (issue 11, item 6).
   check_test_feasible(s.test, options.reduce, s.centrifuge.rate_rad_s);
+  if (s.sensor_kind != SensorKind::kGyro) return predict_sensor_calibration(s, options);
   Reduction r = planned_reduction(s);
   const CentrifugeModel model = s.model();
   // A bounded number of model evaluations per dwell: the prediction's cost does not grow with the test.

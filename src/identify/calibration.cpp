@@ -13,6 +13,7 @@
 #include "gyrocal/identify/closed_form.hpp"
 #include "gyrocal/identify/identifiability.hpp"
 #include "gyrocal/identify/named_combinations.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -385,10 +386,266 @@ void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
                                 advice;
 }
 
+// ---------------------------------------------------------------------------------------------------------
+// A sensor other than the gyro (docs/accelerometer.md, "The pipeline"): its design rows, its products, its
+// coefficients by the delta method.
+
+/// The sensor value whose design rows identification takes: the design row and the step back from the
+/// products do not depend on the sensor's configured truth, so the default one serves.
+Sensor sensor_of(SensorKind kind) {
+  if (kind == SensorKind::kAccelerometer) return Accelerometer{};
+  return Gyro{};
+}
+
+/// The model's channels of the options' sensor, reduced by the operator of the record's output.
+std::vector<PositionChannels> model_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                             const CalibrationOptions& options) {
+  if (options.sensor == SensorKind::kGyro)
+    return reduce_model_channels(reduction, model, options.reduce, options.max_model_samples_per_dwell);
+  return reduce_sensor_channels(reduction, model, options.reduce, sensor_of(options.sensor),
+                                options.max_model_samples_per_dwell);
+}
+
+/// A combination of a sensor's coefficients that one speed leaves estimable where the coefficients are not
+/// (docs/accelerometer.md, "Test design"): weights on the products, in the products' order.
+struct SensorCombination {
+  std::string name, unit;
+  std::vector<double> weights;
+};
+
+/// The accelerometer's named degeneracy: at one speed a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position, so
+/// adding c to K2, Kpp, Koo and -(1 + Ar^2) c to K0 changes no output. What remains estimable: K2 - Kpp,
+/// K2 - Koo and K0 + (1 + Ar^2) K2.
+std::vector<SensorCombination> accelerometer_combinations(double ar) {
+  const auto at = [](AccelCoefficient c) { return static_cast<std::size_t>(c); };
+  std::vector<SensorCombination> out;
+  const auto add = [&](std::string name, std::initializer_list<std::pair<AccelCoefficient, double>> w) {
+    SensorCombination c{std::move(name), "ug/g^2", std::vector<double>(kNumAccelCoefficients, 0.0)};
+    for (const auto& [k, v] : w) c.weights[at(k)] = v;
+    out.push_back(std::move(c));
+  };
+  add("K2 - Kpp", {{AccelCoefficient::K2, 1.0}, {AccelCoefficient::Kpp, -1.0}});
+  add("K2 - Koo", {{AccelCoefficient::K2, 1.0}, {AccelCoefficient::Koo, -1.0}});
+  add(fmt::format("K0 + {:.6g} K2", 1.0 + ar * ar),
+      {{AccelCoefficient::K0, 1.0}, {AccelCoefficient::K2, 1.0 + ar * ar}});
+  out.back().unit = "ug";
+  return out;
+}
+
+/// The sensor's least squares: the products u of its design rows (observation = reduced output - reduced
+/// known part), weighted as the gyro's (generalised least squares on the dwells' covariance with the record's
+/// pooled level; uncertainties from each dwell's own level, a sandwich), then its coefficients by
+/// from_products, the delta method on the products' sandwich covariance, each std widened for the degrees of
+/// freedom of the scatter as the gyro's are. Extra columns (a self-calibration's machine errors) follow the
+/// products.
+void sensor_least_squares(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+                          const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
+                          ErrorColumnsSolution* extra_solution) {
+  const Sensor sensor = sensor_of(options.sensor);
+  const std::vector<std::string_view> unknown_names =
+      std::visit([](const auto& s) { return s.unknown_names(); }, sensor);
+  const std::span<const SensorParameter> table =
+      std::visit([](const auto& s) { return s.parameters(); }, sensor);
+  const auto m = static_cast<Eigen::Index>(reduction.positions.size());
+  const auto nc = static_cast<Eigen::Index>(unknown_names.size());
+  const auto n = nc + extra.columns.cols();
+  std::vector<std::string> names(unknown_names.begin(), unknown_names.end());
+  names.insert(names.end(), extra.names.begin(), extra.names.end());
+  Eigen::MatrixXd design(m, n);
+  Eigen::VectorXd observations(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
+    const DesignRow& row = channels[static_cast<std::size_t>(i)].sensor_exact;
+    if (static_cast<Eigen::Index>(row.size) != nc)
+      throw Error(fmt::format(
+          "sensor.kind is \"{}\", but the model's channels given are the gyro's: this command does not yet "
+          "serve an accelerometer (calibrate and plan do; docs/accelerometer.md).",
+          to_string(options.sensor)));
+    for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = row.regressors[static_cast<std::size_t>(j)];
+    for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
+    observations[i] = p.mean_deg_h - row.known;
+    if (!std::isfinite(p.mean_deg_h))
+      throw Error(
+          fmt::format("the reduced output of {} is not a finite number: the record's outputs there "
+                      "are too large to average; check the record's output column.",
+                      describe_position(reduction, static_cast<std::size_t>(i))));
+    if (!design.row(i).allFinite() || !std::isfinite(observations[i]))
+      throw Error(
+          fmt::format("the model's specific force at {} is not finite: the configured radius, rate or "
+                      "machine errors are too large to evaluate.",
+                      describe_position(reduction, static_cast<std::size_t>(i))));
+  }
+  refuse_repeated_positions(reduction);
+  // Values at fewer gammas than the harmonic content (the window mean at [test] gamma_deg): at 0, 90, 180
+  // and 270 deg cos^3 = cos, so the third harmonic folds onto the first and K3 is confounded with the scale
+  // at each g-level, and the radius with them (docs/accelerometer.md, "Keep the third harmonic").
+  if (options.sensor == SensorKind::kAccelerometer) {
+    std::size_t fewest = 0;
+    for (const Dwell& d : reduction.dwells)
+      if (!d.is_static && (fewest == 0 || d.gammas_rad.size() < fewest)) fewest = d.gammas_rad.size();
+    if (fewest > 0 && fewest < 7)
+      r.warnings.push_back(fmt::format(
+          "a spinning dwell is reduced to values at {} gamma only (the window mean at [test] gamma_deg): "
+          "they "
+          "alias the third harmonic onto the first (at 0, 90, 180, 270 deg cos^3 = cos), so K3 is confounded "
+          "with the scale K1 at each g-level and the radius with them; the harmonic reduction keeps all "
+          "seven numbers of a revolution (--reduction harmonic, docs/accelerometer.md).",
+          fewest));
+  }
+  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
+  if (llt.info() != Eigen::Success) refuse_covariance(reduction);
+  LeastSquaresOptions lso = options.least_squares;
+  lso.rank_tolerance = std::max(lso.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  lso.estimable_tolerance = std::max(lso.estimable_tolerance, options.estimable_tolerance);
+  LeastSquaresProblem problem;
+  problem.design = llt.matrixL().solve(design);
+  problem.observations = llt.matrixL().solve(observations);
+  problem.weights = Eigen::VectorXd::Ones(m);
+  problem.names = names;
+  const LeastSquaresSolution sol = solve_least_squares(problem, lso);
+  r.rank = sol.rank;
+  r.unknowns = static_cast<int>(n);
+  r.condition_number = sol.effective_condition_number;
+  r.chi2 = sol.chi2;
+  r.dof = sol.dof;
+  const Eigen::MatrixXd gain =
+      sol.covariance * problem.design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
+  const Eigen::MatrixXd sandwich = gain * covariance * gain.transpose();
+  const auto student = [&](const Eigen::VectorXd& c, const std::string& name) {
+    double nu = 0.0;
+    const double factor = student_factor(reduction, covariance, gain.transpose() * c, &nu);
+    warn_few_dof(nu, name, r);
+    return factor;
+  };
+  // The products, then the coefficients (delta method): each coefficient's std is sqrt(J C J') widened by the
+  // Student factor of its own linear function of the positions, J's row by a central difference of
+  // from_products (exact to rounding for the ratios it takes).
+  const Eigen::VectorXd u = sol.estimate.head(nc);
+  const Eigen::MatrixXd cu = sandwich.topLeftCorner(nc, nc);
+  std::vector<bool> identifiable(static_cast<std::size_t>(nc));
+  for (Eigen::Index j = 0; j < nc; ++j)
+    identifiable[static_cast<std::size_t>(j)] = sol.identifiable[static_cast<std::size_t>(j)];
+  const auto step_back = [&](const Eigen::VectorXd& products) {
+    return std::visit([&](const auto& s) { return s.from_products(products, cu, identifiable); }, sensor);
+  };
+  const ParameterEstimates pe = step_back(u);
+  const auto np = pe.values.size();
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(np, n);
+  for (Eigen::Index j = 0; j < nc; ++j) {
+    const double h = 1e-6 * std::max(std::abs(u[j]), 1e-3);
+    Eigen::VectorXd up = u, down = u;
+    up[j] += h;
+    down[j] -= h;
+    jacobian.col(j) = (step_back(up).values - step_back(down).values) / (2.0 * h);
+  }
+  r.sensor_products.assign(u.data(), u.data() + u.size());
+  r.sensor_coefficients.clear();
+  for (Eigen::Index k = 0; k < np; ++k) {
+    const SensorParameter& par = table[static_cast<std::size_t>(k)];
+    SensorCoefficientEstimate e;
+    e.name = std::string(par.name);
+    e.unit = std::string(par.unit);
+    e.identifiable = pe.identifiable[static_cast<std::size_t>(k)];
+    if (e.identifiable) {
+      e.value = pe.values[k];
+      e.std = std::sqrt(pe.covariance(k, k)) * student(jacobian.row(k).transpose(), e.name);
+    }
+    r.sensor_coefficients.push_back(std::move(e));
+  }
+  if (extra_solution != nullptr) {
+    ErrorColumnsSolution& e = *extra_solution;
+    const auto k = extra.columns.cols();
+    e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
+    e.std = e.value;
+    e.identifiable.assign(static_cast<std::size_t>(k), false);
+    e.covariance = sandwich;
+    e.null_space = sol.null_space;
+    e.names = sol.names;
+    for (Eigen::Index j = 0; j < k; ++j) {
+      if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
+      e.identifiable[static_cast<std::size_t>(j)] = true;
+      e.value[j] = sol.estimate[nc + j];
+      e.std[j] = std::sqrt(sandwich(nc + j, nc + j)) *
+                 student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
+    }
+  }
+  const Eigen::VectorXd residuals = observations - design * sol.estimate;
+  r.residuals_deg_h.assign(residuals.data(), residuals.data() + residuals.size());
+  for (const std::string& w : sol.warnings) {
+    if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
+      continue;
+    r.warnings.push_back("least squares: " + w);
+  }
+  if (sol.null_space.cols() == 0) return;
+  // The unidentifiable directions in the coefficients' names (a product K1*Kx moves as Kx at K1 fixed).
+  std::vector<std::string> coefficient_names;
+  for (Eigen::Index j = 0; j < nc; ++j)
+    coefficient_names.emplace_back(table[static_cast<std::size_t>(j)].name);
+  coefficient_names.insert(coefficient_names.end(), extra.names.begin(), extra.names.end());
+  std::string listed;
+  for (Eigen::Index d = 0; d < sol.null_space.cols(); ++d) {
+    Eigen::VectorXd dir = sol.null_space.col(d);
+    const double largest = dir.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < dir.size(); ++i)
+      if (std::abs(dir[i]) < 1e-3 * largest) dir[i] = 0.0;
+    // The accelerometer's one-speed direction, written as docs/accelerometer.md writes it.
+    const auto K = [](AccelCoefficient c) { return static_cast<Eigen::Index>(c); };
+    std::string text;
+    if (options.sensor == SensorKind::kAccelerometer && dir[K(AccelCoefficient::K2)] != 0.0 &&
+        dir[K(AccelCoefficient::Kpp)] != 0.0 && dir[K(AccelCoefficient::Koo)] != 0.0 &&
+        dir[K(AccelCoefficient::K0)] != 0.0) {
+      const double s = 1.0 / dir[K(AccelCoefficient::K2)];
+      text = fmt::format(
+          "K0, K2, Kpp, Koo: adding c to K2, Kpp and Koo and {:.6g} c to K0 changes no output (at one speed "
+          "a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position; direction {})",
+          dir[K(AccelCoefficient::K0)] * s, describe_combination(dir, coefficient_names));
+    } else {
+      text = describe_combination(dir, coefficient_names);
+    }
+    r.unidentifiable.push_back(text);
+    listed += fmt::format("{}({}) {}", d ? "; " : "", d + 1, text);
+  }
+  // What remains estimable, by name, with its value and std (delta method as the coefficients').
+  if (options.sensor == SensorKind::kAccelerometer) {
+    const Eigen::Index k1 = static_cast<Eigen::Index>(AccelCoefficient::K1);
+    for (const SensorCombination& c : accelerometer_combinations(r.g_level)) {
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+      for (Eigen::Index j = 0; j < nc; ++j) g[j] = c.weights[static_cast<std::size_t>(j)];
+      const IdentifiableCombination ic = evaluate_combination(sol, g, lso, c.name);
+      if (!ic.identifiable || !sol.identifiable[static_cast<std::size_t>(k1)]) continue;
+      // c'K = (g'u) / K1: J = g / K1 - (g'u) / K1^2 e_K1.
+      const double k1v = u[k1];
+      Eigen::VectorXd jrow = g / k1v;
+      jrow[k1] -= ic.value / (k1v * k1v);
+      NamedEstimate ne;
+      ne.name = c.name;
+      ne.unit = c.unit;
+      ne.value = ic.value / k1v;
+      ne.std = std::sqrt(jrow.dot(sandwich * jrow)) * student(jrow, c.name);
+      ne.coefficients = c.weights;
+      r.combinations.push_back(std::move(ne));
+    }
+  }
+  const auto k = sol.null_space.cols();
+  r.warnings.push_back(fmt::format(
+      "{} direction{} of the coefficients cannot be identified from this plan: {}.{}", k, k > 1 ? "s" : "",
+      listed,
+      options.sensor == SensorKind::kAccelerometer
+          ? " A second non-zero speed or a static set (the main axis stopped, the platform indexed to each "
+            "gamma) separates them (docs/accelerometer.md)."
+          : ""));
+}
+
 void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                             const CentrifugeModel& model, const CalibrationOptions& options,
                             CalibrationResult& r, const ErrorColumns& extra = {},
                             ErrorColumnsSolution* extra_solution = nullptr) {
+  if (options.sensor != SensorKind::kGyro) {
+    sensor_least_squares(reduction, channels, options, r, extra, extra_solution);
+    return;
+  }
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
   const Unknowns unknowns = least_squares_unknowns(options.gyro_model);
   // The unknowns, in this one place: the ten coefficients, the rate terms of the gyro model
@@ -539,8 +796,7 @@ CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<Mach
 Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel& model,
                               const std::vector<MachineErrorParameter>& ps,
                               const std::vector<double>& values_si, const std::vector<std::size_t>& which,
-                              const std::array<double, kNumCoefficients>& c,
-                              const CalibrationOptions& options) {
+                              const std::vector<double>& c, const CalibrationOptions& options) {
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
   Eigen::MatrixXd out(m, static_cast<Eigen::Index>(which.size()));
   for (std::size_t a = 0; a < which.size(); ++a) {
@@ -549,16 +805,22 @@ Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel&
     std::vector<double> plus = values_si, minus = values_si;
     plus[which[a]] += h;
     minus[which[a]] -= h;
-    const auto up = reduce_model_channels(reduction, with_errors(model, ps, plus), options.reduce,
-                                          options.max_model_samples_per_dwell);
-    const auto down = reduce_model_channels(reduction, with_errors(model, ps, minus), options.reduce,
-                                            options.max_model_samples_per_dwell);
+    const auto up = model_channels(reduction, with_errors(model, ps, plus), options);
+    const auto down = model_channels(reduction, with_errors(model, ps, minus), options);
     for (Eigen::Index i = 0; i < m; ++i) {
       const PositionChannels& u = up[static_cast<std::size_t>(i)];
       const PositionChannels& d = down[static_cast<std::size_t>(i)];
-      double diff = u.omega_exact_deg_h - d.omega_exact_deg_h;
-      for (std::size_t k = 0; k < kNumCoefficients; ++k)
-        diff += c[k] * (u.regressors_exact[k] - d.regressors_exact[k]);
+      double diff = 0.0;
+      if (options.sensor == SensorKind::kGyro) {
+        diff = u.omega_exact_deg_h - d.omega_exact_deg_h;
+        for (std::size_t k = 0; k < kNumCoefficients; ++k)
+          diff += c[k] * (u.regressors_exact[k] - d.regressors_exact[k]);
+      } else {
+        // The sensor's reduced output at the products c: known + sum_j c_j r_j.
+        diff = u.sensor_exact.known - d.sensor_exact.known;
+        for (std::size_t k = 0; k < u.sensor_exact.size; ++k)
+          diff += c[k] * (u.sensor_exact.regressors[k] - d.sensor_exact.regressors[k]);
+      }
       out(i, static_cast<Eigen::Index>(a)) = diff / (2.0 * h) * f.unit_to_si;
     }
   }
@@ -642,11 +904,25 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
             : std::numeric_limits<double>::quiet_NaN();
     e.reason.clear();
   }
-  const std::array<double, kNumCoefficients> zero{};
+  // The unknowns the errors' columns follow: the gyro model's (identify/unknowns.hpp) or the sensor's
+  // products.
+  const std::size_t unknowns_count =
+      options.sensor == SensorKind::kGyro
+          ? least_squares_unknowns(options.gyro_model).size()
+          : std::visit([](const auto& s) { return s.num_unknowns(); }, sensor_of(options.sensor));
+  const std::vector<double> zero(std::max(unknowns_count, kNumCoefficients), 0.0);
   Eigen::MatrixXd all_columns = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(reduction.positions.size()),
                                                       static_cast<Eigen::Index>(k));
   {
-    const Eigen::MatrixXd cols = error_columns(reduction, model, ps, configured, active, zero, options);
+    // A sensor's output is all in its products (an accelerometer has no known part): its errors' columns
+    // start from the products of a plain fit at the configured machine, the gyro's from zero coefficients.
+    std::vector<double> start = zero;
+    if (options.sensor != SensorKind::kGyro) {
+      CalibrationResult plain = base;
+      least_squares_identify(reduction, channels, model, options, plain);
+      std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), start.begin());
+    }
+    const Eigen::MatrixXd cols = error_columns(reduction, model, ps, configured, active, start, options);
     for (std::size_t a = 0; a < active.size(); ++a)
       all_columns.col(static_cast<Eigen::Index>(active[a])) = cols.col(static_cast<Eigen::Index>(a));
   }
@@ -684,8 +960,8 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     CalibrationResult trial = base;
     ErrorColumnsSolution es;
     least_squares_identify(reduction, channels, model, options, trial, columns_of(active), &es);
-    // The errors' columns follow the gyro model's unknowns (identify/unknowns.hpp).
-    const auto nc = static_cast<Eigen::Index>(least_squares_unknowns(options.gyro_model).size());
+    // The errors' columns follow the gyro model's unknowns (identify/unknowns.hpp) or the sensor's.
+    const auto nc = static_cast<Eigen::Index>(unknowns_count);
     std::size_t drop = k;
     // The last-named unidentifiable error yields first: earlier names take precedence.
     for (std::size_t a = active.size(); a-- > 0 && drop == k;) {
@@ -730,7 +1006,12 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
   // Gauss-Newton on the exact model: at e_k, the reduced outputs are linear in the coefficients and, to first
   // order, in the errors' steps; each step solves both by the same weighted least squares as a calibration.
   std::vector<double> values = configured;
-  std::array<double, kNumCoefficients> coefficients{};
+  std::vector<double> coefficients = zero;
+  if (options.sensor != SensorKind::kGyro) {
+    CalibrationResult plain = base;
+    least_squares_identify(reduction, channels, model, options, plain);
+    std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), coefficients.begin());
+  }
   CalibrationResult r = base;
   ErrorColumnsSolution last;
   int iteration = 0;
@@ -751,9 +1032,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     }
     const CentrifugeModel current = with_errors(model, ps, values);
     const std::vector<PositionChannels> current_channels =
-        iteration == 1
-            ? channels
-            : reduce_model_channels(reduction, current, options.reduce, options.max_model_samples_per_dwell);
+        iteration == 1 ? channels : model_channels(reduction, current, options);
     if (iteration > 1) {
       const Eigen::MatrixXd cols =
           error_columns(reduction, current, ps, values, active, coefficients, options);
@@ -779,7 +1058,19 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     }
     // The coefficients enter the errors' columns (through the regressors): they must have settled too.
     bool settled = iteration > 1;
-    for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+    if (options.sensor != SensorKind::kGyro) {
+      // The sensor's products: settled when each moved by less than the convergence's fraction of its std.
+      const Eigen::MatrixXd& cov = last.covariance;
+      for (std::size_t c = 0; c < r.sensor_products.size(); ++c) {
+        const double v = r.sensor_products[c];
+        const double sd = std::sqrt(cov(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)));
+        if (!(std::abs(v - coefficients[c]) <= options.convergence * sd ||
+              std::abs(v - coefficients[c]) <= 1e-12))
+          settled = false;
+        coefficients[c] = v;
+      }
+    }
+    for (std::size_t c = 0; c < kNumCoefficients && options.sensor == SensorKind::kGyro; ++c) {
       const CoefficientEstimate& ce = r.coefficients[c];
       const double v = ce.identifiable ? ce.value : 0.0;
       if (ce.identifiable && !(std::abs(v - coefficients[c]) <= options.convergence * ce.std ||
@@ -790,7 +1081,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     converged = (converged && settled) || active.empty();
   }
   r.iterations = iteration;
-  const auto nc = static_cast<Eigen::Index>(least_squares_unknowns(options.gyro_model).size());
+  const auto nc = static_cast<Eigen::Index>(unknowns_count);
   for (std::size_t a = 0; a < active.size(); ++a) {
     const std::size_t j = active[a];
     const auto ai = static_cast<Eigen::Index>(a);
@@ -802,7 +1093,14 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     const auto corr = [&](Eigen::Index x, Eigen::Index y) {
       return cov(x, y) / std::sqrt(cov(x, x) * cov(y, y));
     };
-    for (std::size_t c = 0; c < kNumCoefficients; ++c)
+    if (options.sensor != SensorKind::kGyro) {
+      // With the sensor's products (K1*K0, K1, ...), as solved.
+      const std::vector<std::string_view> un =
+          std::visit([](const auto& s) { return s.unknown_names(); }, sensor_of(options.sensor));
+      for (std::size_t c = 0; c < un.size(); ++c)
+        e.correlations.emplace_back(std::string(un[c]), corr(nc + ai, static_cast<Eigen::Index>(c)));
+    }
+    for (std::size_t c = 0; c < kNumCoefficients && options.sensor == SensorKind::kGyro; ++c)
       e.correlations.emplace_back(std::string(kCoefficientNames[c]),
                                   r.coefficients[c].identifiable ? corr(nc + ai, static_cast<Eigen::Index>(c))
                                                                  : std::numeric_limits<double>::quiet_NaN());
@@ -850,6 +1148,7 @@ void scale_every_std(CalibrationResult& r, double scale) {
   for (NamedEstimate& c : r.combinations) c.std *= scale;
   for (NamedEstimate& c : r.alternatives) c.std *= scale;
   for (MachineErrorEstimate& e : r.machine_errors) e.std *= scale;
+  for (SensorCoefficientEstimate& c : r.sensor_coefficients) c.std *= scale;
 }
 
 /// The sentence that states a misfit: chi2 against its distribution, or a scale-factor error no gyro has.
@@ -872,7 +1171,11 @@ std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
                                         const CentrifugeModel& model, const CalibrationOptions& options,
                                         double g_level, const std::string& stated) {
   std::string tried;
-  for (const MisfitCause& cause : gyro_misfit_causes(options.output)) {
+  // The set-up mistakes of the table are the gyro's (a unit, a sign of its rate); an accelerometer's record
+  // is judged by chi2 and a flat top only.
+  const std::vector<MisfitCause> causes =
+      options.sensor == SensorKind::kGyro ? gyro_misfit_causes(options.output) : std::vector<MisfitCause>{};
+  for (const MisfitCause& cause : causes) {
     const std::optional<Reduction> fixed = cause.transform(reduction);
     if (!fixed) continue;
     tried += (tried.empty() ? "" : ", ") + cause.name;
@@ -992,6 +1295,21 @@ bool CalibrationOptions::IsValid(std::string* error) const {
     if (error) *error = "output.scale must be finite and non-zero";
     return false;
   }
+  if (sensor != SensorKind::kGyro) {
+    const std::string_view kind = to_string(sensor);
+    const auto refuse = [&](const std::string& what) {
+      if (error)
+        *error = fmt::format(
+            "{} is the gyro's; sensor.kind is \"{}\", whose calibration is least squares "
+            "with full compensation (docs/accelerometer.md)",
+            what, kind);
+      return false;
+    };
+    if (method == Method::kClosedForm) return refuse("--method closed-form (the 16-position closed forms)");
+    if (compensation != Compensation::kFull)
+      return refuse(fmt::format("--compensation {}", to_string(compensation)));
+    if (gyro_model != GyroModel::kDrift) return refuse("--gyro-model drift+rate (the gyro's rate terms)");
+  }
   if (!(max_uncertainty_ratio > 1.0)) {
     if (error) *error = "max_uncertainty_ratio must exceed 1";
     return false;
@@ -1046,6 +1364,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   r.method = options.method;
   r.compensation = options.compensation;
   r.gyro_model = options.gyro_model;
+  r.sensor = options.sensor;
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
   r.data_quality.rows_read = reduction.samples_read;
@@ -1088,7 +1407,7 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   } else {
     least_squares_identify(reduction, channels, model, options, r);
     // The closed form's second expressions are a useful cross-check whenever the plan holds the 16 positions.
-    if (!sixteen_positions(reduction.positions).empty()) {
+    if (options.sensor == SensorKind::kGyro && !sixteen_positions(reduction.positions).empty()) {
       CalibrationResult cf;
       cf.g_level = r.g_level;
       CalibrationOptions drift_only = options;
@@ -1101,6 +1420,11 @@ CalibrationResult identify(const Reduction& reduction, const std::vector<Positio
   return r;
 }
 
+std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const CalibrationOptions& options) {
+  return model_channels(reduction, model, options);
+}
+
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
                                    const TestSpec& plan, const CalibrationOptions& options,
                                    const std::optional<RecordLayout>& layout) {
@@ -1110,12 +1434,17 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
   CalibrationOptions o = options;
   if (layout) o.output.scale = layout->output_scale_per_deg_h;
   // The output's range is kept for the misfit's causes (identify/misfit.hpp: a flat top).
-  const Reduction reduction = reduce_record(reader, plan, options.reduce, model.geometry().rate_rad_s,
-                                            [&o](std::span<const RecordSample> rows) {
-                                              for (const RecordSample& s : rows)
-                                                o.output.range.push(s.output);
-                                            });
-  const std::vector<PositionChannels> channels = reduce_model_channels(reduction, model, options.reduce);
+  // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_channels.hpp).
+  const Reduction reduction =
+      reduce_record(reader, reduction_plan(plan, options.sensor, options.reduce), options.reduce,
+                    model.geometry().rate_rad_s, [&o](std::span<const RecordSample> rows) {
+                      for (const RecordSample& s : rows) o.output.range.push(s.output);
+                    });
+  // K1 is fitted on the record's output as read. The [record] output_scale_per_g of an accelerometer's layout
+  // (being added with the record mapping) multiplies it here into the rig's own units per g.
+  const std::vector<PositionChannels> channels = options.sensor == SensorKind::kGyro
+                                                     ? reduce_model_channels(reduction, model, options.reduce)
+                                                     : model_channels(reduction, model, options);
   return identify(reduction, channels, model, o);
 }
 

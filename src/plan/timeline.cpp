@@ -135,18 +135,19 @@ class Builder {
     const std::size_t n_offset = test_.counter_rate_offsets_rad_s.size();
     const std::size_t n_beta = test_.beta_rad.size();
     const std::size_t n_gamma = test_.gamma_rad.size();
+    std::size_t first = 0;  // the first position of each (rate, offset, beta)
     for (std::size_t i = 0; i < test_.rates_rad_s.size(); ++i) {
       const double rate = test_.rates_rad_s[i];
       for (std::size_t o = 0; o < n_offset; ++o) {
         const double offset = test_.counter_rate_offsets_rad_s[o];
         for (std::size_t j = 0; j < n_beta; ++j) {
           const double beta = test_.beta_rad[j];
-          const std::size_t first = ((i * n_offset + o) * n_beta + j) * n_gamma;
           if (rate != 0.0 || offset != 0.0) {
             transition(rate, offset, beta);
             add(SegmentKind::kSettle, test_.settle_s);
             // Whole revolutions of gamma, which turns at rate - offset (docs/physics.md section 15).
             measure(SegmentKind::kDwell, revolutions_s(rate - offset), positions[first], 0.0);
+            first += spinning_gammas(test_).size();
             continue;
           }
           for (std::size_t k = 0; k < n_gamma; ++k) {
@@ -155,6 +156,7 @@ class Builder {
             add(SegmentKind::kSettle, test_.settle_s);
             measure(SegmentKind::kHold, timeline_.hold_s, positions[first + k], test_.gamma_rad[k]);
           }
+          first += n_gamma;
         }
       }
     }

@@ -490,7 +490,7 @@ struct Reducer::State {
     const double rate = r.match.planned_rate_rad_s, offset = r.match.planned_counter_rate_offset_rad_s;
     r.planned_duration =
         r.match.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate - offset);
-    r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad,
+    r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan),
                   r.match.is_static, 1, r.planned_duration, true, heading_sweep_rad_s(rate, offset));
   }
 
@@ -815,7 +815,7 @@ struct Reducer::State {
     // The channels take the plan's beta (and a static hold's gamma): an encoder's mean reading at rest is
     // biased by up to half a count (docs/calibration.md).
     d.beta_rad = r.match.beta_rad;
-    d.gammas_rad = d.is_static ? std::vector<double>{r.match.gamma_rad} : plan.gamma_rad;
+    d.gammas_rad = d.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan);
     d.first_time_s = r.acc->first_time_s();
     d.last_time_s = r.acc->last_time_s();
     d.samples = r.n;

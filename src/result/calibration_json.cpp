@@ -24,7 +24,15 @@ nlohmann::ordered_json named_estimate_to_json(const NamedEstimate& c) {
 nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   nlohmann::ordered_json j;
   nlohmann::ordered_json coefficients = nlohmann::ordered_json::object();
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  // A sensor other than the gyro: its own table's coefficients (docs/contract.md, "Accelerometers"): K1 as
+  // fitted on the record's output, in its units per g.
+  for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+    coefficients[c.name] = {
+        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
+        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
+        {"unit", c.unit},
+        {"identifiable", c.identifiable}};
+  for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k) {
     const CoefficientEstimate& c = r.coefficients[k];
     coefficients[std::string(kCoefficientNames[k])] = {
         {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
@@ -66,7 +74,10 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   }
   j["method"] = to_string(r.method);
   j["compensation"] = to_string(r.compensation);
-  j["gyro_model"] = r.gyro_model == GyroModel::kDrift ? "drift" : "drift+rate";
+  if (r.sensor == SensorKind::kGyro)
+    j["gyro_model"] = r.gyro_model == GyroModel::kDrift ? "drift" : "drift+rate";
+  else
+    j["sensor"] = std::string(to_string(r.sensor));
   j["g_level"] = r.g_level;
   j["warnings"] = r.warnings;
   j["rank"] = r.rank;

@@ -12,6 +12,7 @@
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/sensor/sensor.hpp"
 #include "gyrocal/solve/least_squares.hpp"
 
 namespace gyrocal {
@@ -24,6 +25,10 @@ struct CalibrationOptions {
   Compensation compensation = Compensation::kFull;  ///< default: every configured machine error
   /// default: the ten drift coefficients; drift+rate adds the rate errors (docs/physics.md section 15).
   GyroModel gyro_model = GyroModel::kDrift;
+  /// Which sensor the record's output is ([sensor] kind). An accelerometer is identified through its design
+  /// rows (identify/sensor_channels.hpp) by least squares with full compensation only; the closed forms, the
+  /// seed's and no compensation, and drift+rate are the gyro's and are refused (IsValid names the option).
+  SensorKind sensor = SensorKind::kGyro;
   ReduceOptions reduce;               ///< how dwells are reduced
   LeastSquaresOptions least_squares;  ///< the solver's options
   /// Reduced positions whose standard error is below this (a noise-free record) are weighted with it,
@@ -136,8 +141,26 @@ struct DataQuality {
   std::vector<Rejected> rejected;
 };
 
+/// One coefficient of a sensor's parameter table as estimated (a sensor other than the gyro, whose results
+/// stay in CalibrationResult::coefficients): value and std in the table's unit, NaN when not identifiable.
+struct SensorCoefficientEstimate {
+  std::string name;  ///< as in the table and the JSON ("K0", "delta_p")
+  std::string unit;  ///< the table's ("ug", "output/g", "urad")
+  double value = std::numeric_limits<double>::quiet_NaN();
+  double std = std::numeric_limits<double>::quiet_NaN();
+  bool identifiable = false;
+};
+
 struct CalibrationResult {
   Method method = Method::kLeastSquares;
+  SensorKind sensor =
+      SensorKind::kGyro;  ///< whose coefficients: the gyro's (coefficients, rate_terms) or not
+  /// A sensor other than the gyro: its coefficients in its table's order (K0, K1, K2, ... for an
+  /// accelerometer), stepped back from the products by the delta method on the sandwich covariance. Empty for
+  /// the gyro.
+  std::vector<SensorCoefficientEstimate> sensor_coefficients;
+  /// A sensor other than the gyro: the products as solved (K1*K0, K1, K1*K2, ...; 0 where not identifiable).
+  std::vector<double> sensor_products;
   Compensation compensation = Compensation::kFull;
   GyroModel gyro_model = GyroModel::kDrift;
   double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
@@ -184,6 +207,13 @@ Compensation parse_compensation(const std::string& text);
 /// Identify from a reduction and its model channels (identify/channels.hpp).
 CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                            const CentrifugeModel& model, const CalibrationOptions& options);
+
+/// The model's channels of `reduction` for the options' sensor, reduced by the operator of the record's
+/// output: the gyro's (reduce_model_channels) or another sensor's design rows (reduce_sensor_channels). What
+/// identify() takes; a caller reducing a record itself reduces it with reduction_plan(plan, options.sensor,
+/// options.reduce) (identify/sensor_channels.hpp).
+std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const CalibrationOptions& options);
 
 /// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
 /// `layout`: how the record is laid out (the configuration's [record], docs/records.md); nullopt for

@@ -8,6 +8,7 @@
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/sensor/sensor_model.hpp"
 
 namespace gyrocal {
 
@@ -29,6 +30,10 @@ struct PositionChannels {
   double omega_S_exact_deg_h = 0.0;
   std::array<double, kNumCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
   std::array<double, kNumCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
+  /// A sensor other than the gyro (identify/sensor_channels.hpp): its design row (known part and the
+  /// regressors of its products) at the exact inputs, reduced by the same operator as its output. The gyro's
+  /// fields above are then zero. Size 0 for the gyro.
+  DesignRow sensor_exact;
 
   /// The omega_I the compensation assumes, deg/h.
   double omega_deg_h(Compensation c) const {

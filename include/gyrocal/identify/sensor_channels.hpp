@@ -1,0 +1,38 @@
+#pragma once
+// The model's side of each reduced position for a sensor other than the gyro (docs/accelerometer.md, "The
+// pipeline"): the sensor's design row (sensor/sensor_model.hpp: the known part of its output and the
+// regressors of its products) evaluated at the exact inputs on each dwell's samples and reduced by the very
+// operator that reduced the sensor's output, so that reduce(E) = reduce(known) + sum_j u_j reduce(r_j) holds
+// exactly whatever harmonics the machine's errors add. The gyro keeps identify/channels.hpp's 25 columns.
+#include <cstddef>
+#include <vector>
+
+#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/plan/test_spec.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/sensor/sensor.hpp"
+
+namespace gyrocal {
+
+/// The arm angles, rad, at which a spinning dwell is reduced so that its values carry the harmonic fit's
+/// whole content up to `harmonic_order`: 2 * order + 1 evenly spaced angles from 0 (the values at them and
+/// the fit's 2 * order + 1 harmonic numbers are one invertible linear map of each other, so the values'
+/// covariance from the fit is of full rank). Order 3: seven angles, 360/7 deg apart.
+std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
+
+/// The plan a sensor's record is reduced with: `plan` itself for the gyro; for an accelerometer, each
+/// spinning dwell reduced to harmonic_content_gammas_rad (TestSpec::spinning_gamma_rad) whatever [test]
+/// gamma_deg lists, since values at the seed's four gammas fold the third harmonic onto the first and lose
+/// K3 and the radius (docs/accelerometer.md). Static holds keep gamma_deg.
+TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options);
+
+/// Channels of every position of `reduction`, in its order, for `sensor` on `model`: PositionChannels::
+/// sensor_exact holds the reduced design row (the gyro's fields zero). Every sample of a dwell is evaluated
+/// (its stretches as the output has them; a planned dwell's evenly spaced instants), or every k-th one as
+/// ReduceOptions::model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_channels).
+std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                     const ReduceOptions& options, const Sensor& sensor,
+                                                     std::size_t max_samples_per_dwell = 0);
+
+}  // namespace gyrocal

@@ -1,0 +1,100 @@
+#include "gyrocal/identify/sensor_channels.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gyrocal/core/parallel.hpp"
+#include "gyrocal/core/units.hpp"
+
+namespace gyrocal {
+
+std::vector<double> harmonic_content_gammas_rad(int harmonic_order) {
+  const int n = 2 * std::max(harmonic_order, 0) + 1;
+  std::vector<double> out;
+  for (int k = 0; k < n; ++k) out.push_back(2.0 * kPi * k / n);
+  return out;
+}
+
+TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options) {
+  TestSpec out = plan;
+  if (sensor == SensorKind::kAccelerometer && options.method == ReduceOptions::Method::kHarmonicFit)
+    out.spinning_gamma_rad = harmonic_content_gammas_rad(options.harmonic_order);
+  return out;
+}
+
+std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
+                                                     const ReduceOptions& options, const Sensor& sensor,
+                                                     std::size_t max_samples_per_dwell) {
+  const DesignRow probe = sensor_design_row(sensor, exact_inputs(model, JointState{}));
+  const int columns = 1 + static_cast<int>(probe.size);
+  std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
+  parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
+    const Dwell& d = reduction.dwells[di];
+    // The reducer's operator, the heading's sweep at a counter rate offset included (as the gyro's channels).
+    const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
+    DwellAccumulator acc(options, d.gammas_rad, d.is_static, columns, d.planned_duration_s, false, sweep);
+    std::vector<double> v(static_cast<std::size_t>(columns));
+    // The joints as identify/channels.cpp's evaluate_channels takes them: on the dwell's constant-rate lines
+    // fitted to the encoders, beta as planned. (When the channels follow the encoders' measured rate sample
+    // by sample, this is the one other place to change.)
+    const auto add_sample = [&](double t, double main_rad, double counter_rad) {
+      JointState j;
+      j.main_angle_rad = main_rad;
+      j.main_rate_rad_s = d.main.rate_rad_s;
+      j.counter_angle_rad = counter_rad;
+      j.counter_rate_rad_s = d.counter.rate_rad_s;
+      j.position_angle_rad = d.beta_rad;
+      const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
+      v[0] = row.known;
+      for (std::size_t k = 0; k < row.size; ++k) v[k + 1] = row.regressors[k];
+      acc.add(t, -counter_rad, v.data());
+    };
+    std::size_t stride = 1;
+    const bool sweeps = d.planned_counter_rate_offset_rad_s != 0.0 && d.planned_rate_rad_s != 0.0;
+    if (!sweeps && options.model_samples_per_revolution > 0 && d.samples > 1 &&
+        (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit)) {
+      const double gamma_rate =
+          d.planned_counter_rate_offset_rad_s == 0.0 ? d.main.rate_rad_s : -d.counter.rate_rad_s;
+      const double per_period = d.is_static ? static_cast<double>(d.samples) / 64.0
+                                            : 2.0 * kPi / std::abs(gamma_rate) / d.sample_interval_s /
+                                                  static_cast<double>(options.model_samples_per_revolution);
+      stride = static_cast<std::size_t>(std::max(1.0, std::floor(per_period)));
+      if (max_samples_per_dwell > 0)
+        stride = std::max(stride, (d.samples + max_samples_per_dwell - 1) / max_samples_per_dwell);
+    }
+    if (d.stretches.empty()) {
+      const auto at = [&](std::size_t i) {
+        const double t = d.time_of_sample(i);
+        add_sample(t, d.main.at(t, d.first_time_s), d.counter.at(t, d.first_time_s));
+      };
+      for (std::size_t i = 0; i + 1 < d.samples; i += stride) at(i);
+      if (d.samples > 0) at(d.samples - 1);
+    } else {
+      for (const TimeStretch& s : d.stretches) {
+        const auto at = [&](std::size_t i) {
+          const double dt = static_cast<double>(i) * s.interval_s;
+          add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt,
+                     s.counter_at_first_rad + d.counter.rate_rad_s * dt);
+        };
+        for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
+        if (s.count > 0) at(s.count - 1);
+      }
+    }
+    for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
+  });
+  std::vector<PositionChannels> out;
+  for (const ReducedPosition& p : reduction.positions) {
+    const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];
+    const auto at = [&](int c) {
+      return cols[static_cast<std::size_t>(c)].value[static_cast<std::size_t>(p.gamma_slot)];
+    };
+    PositionChannels ch;
+    ch.sensor_exact.known = at(0);
+    ch.sensor_exact.size = probe.size;
+    for (std::size_t k = 0; k < probe.size; ++k) ch.sensor_exact.regressors[k] = at(static_cast<int>(k) + 1);
+    out.push_back(ch);
+  }
+  return out;
+}
+
+}  // namespace gyrocal
