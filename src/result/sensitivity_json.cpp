@@ -15,8 +15,19 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
                         {"value", row.value},
                         {"unit", row.term.unit},
                         {"typical", row.typical}};
+    // A sensor other than the gyro: least squares, compensations none and full only (no closed forms).
+    const bool gyro = r.sensor == SensorKind::kGyro;
     for (std::size_t c = 0; c < 3; ++c) {
       const char* comp = kCompensationNames[c];
+      if (!gyro) {
+        if (c == 1) continue;
+        j["least_squares"][comp] = nlohmann::json::object();
+        for (const std::string& name : r.least_squares_names)
+          if (const auto it = row.least_squares[c].find(name); it != row.least_squares[c].end())
+            j["least_squares"][comp][name] = it->second;
+        j["least_squares_matters"][comp] = row.least_squares_matters[c];
+        continue;
+      }
       j["shift"][comp] = nlohmann::json::object();
       for (const std::string& name : r.closed_form_names)
         if (const auto it = row.closed_form[c].find(name); it != row.closed_form[c].end())
@@ -39,9 +50,12 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
     rows.push_back(std::move(j));
   }
   nlohmann::json out = {{"rows", rows}, {"threshold", r.threshold}};
-  out["noise_std"] = nlohmann::json::object();
-  for (const std::string& name : r.closed_form_names)
-    out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  if (r.sensor != SensorKind::kGyro) out["sensor"] = std::string(to_string(r.sensor));
+  if (r.sensor == SensorKind::kGyro) {
+    out["noise_std"] = nlohmann::json::object();
+    for (const std::string& name : r.closed_form_names)
+      out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  }
   out["least_squares_noise_std"] = nlohmann::json::object();
   for (const std::string& name : r.least_squares_names)
     out["least_squares_noise_std"][name] = r.least_squares_noise_std.at(name);
@@ -49,6 +63,11 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
   out["units"] = r.units;
   // docs/physics.md section 15: the gyro model least squares fitted, and the rate errors it could not
   // identify with the reason (the others' shifts are in least_squares, by name).
+  if (r.sensor != SensorKind::kGyro) {
+    // An accelerometer's coefficients the plan leaves unidentifiable (no shift, no noise std).
+    out["not_identifiable"] = r.not_identifiable;
+    return out;
+  }
   out["gyro_model"] = to_string(r.gyro_model);
   if (r.gyro_model == GyroModel::kDriftRate) out["not_identifiable"] = r.not_identifiable;
   return out;
