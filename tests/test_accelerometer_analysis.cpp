@@ -10,11 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/result/montecarlo_json.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -135,6 +137,54 @@ TEST(AccelerometerSensitivity, JsonNamesTheCoefficientsAndOnlyTheCompensationsTh
   EXPECT_FALSE(row.contains("shift"));  // the gyro's closed forms
   EXPECT_EQ(j.at("units").at("K3"), "ug/g^3");
   EXPECT_GT(j.at("least_squares_noise_std").at("K0").get<double>(), 0.0);
+}
+
+const EstimateDistribution& estimate_of(const MonteCarloResult& r, const std::string& name) {
+  for (const EstimateDistribution& e : r.estimates)
+    if (e.name == name) return e;
+  throw std::runtime_error("no estimate " + name);
+}
+
+TEST(AccelerometerMonteCarlo, PredictedStdIsWhatSimulatedTrialsGive) {
+  // One source, the radius error (5 um standard uncertainty), no noise. Trial k draws the same radius error
+  // in both modes (RandomSource(seed, k), sources first), so the samples mode's errors (each trial a
+  // simulated record, reduced and calibrated) are the fast mode's linear model trial by trial: the two
+  // stds over the same 24 trials agree to the linearisation (1e-3 here, the radius error's second order
+  // and the planned against the record's reduction), whatever the draws. The linear model's std over those
+  // trials is its predicted std times the draws' own spread, so the predicted std is the trials'. K1 and
+  // K3 take the radius error (the sensitivity study above); the budget gives it all of their variance.
+  Scenario s = small_accelerometer();
+  s.errors = CentrifugeErrors{};
+  s.uncertainty = CentrifugeErrors{};
+  s.uncertainty.radius_error_m = 5e-6;
+  MonteCarloOptions o;
+  o.trials = 24;
+  o.seed = 7;
+  const MonteCarloResult fast = monte_carlo(s, o);
+  o.mode = MonteCarloMode::kSamples;
+  const MonteCarloResult samples = monte_carlo(s, o);
+  EXPECT_EQ(fast.sensor, SensorKind::kAccelerometer);
+  ASSERT_EQ(fast.sources.size(), 2u);  // noise, radius_error
+  for (const char* name : {"K1", "K3"}) {
+    const EstimateDistribution& f = estimate_of(fast, name);
+    const EstimateDistribution& t = estimate_of(samples, name);
+    EXPECT_NEAR(t.std / f.std, 1.0, 1e-3) << name;
+    EXPECT_NEAR(f.budget[1], 1.0, 1e-9) << name;
+    EXPECT_GT(f.predicted_std, 0.0) << name;
+    // The draws' spread over 24 trials: within 4 sigma (1 / sqrt(46) each) of the prediction.
+    EXPECT_NEAR(t.std / f.predicted_std, 1.0, 4.0 / std::sqrt(46.0)) << name;
+  }
+  // K1's predicted std is the study's K1 shift per metre times 5 um: the radius enters K1 as it does there.
+  Scenario one = s;
+  one.errors.radius_error_m = 5e-6;
+  const SensitivityResult study = sensitivity_study(one);
+  EXPECT_NEAR(estimate_of(fast, "K1").predicted_std,
+              std::abs(row_of(study, "radius_error").least_squares[kNone].at("K1")),
+              1e-3 * estimate_of(fast, "K1").predicted_std);
+  const nlohmann::json j = montecarlo_to_json(fast);
+  EXPECT_EQ(j.at("sensor"), "accelerometer");
+  EXPECT_EQ(j.at("sources").at(0).at("unit"), "ug/sqrt(Hz)");
+  EXPECT_EQ(j.at("coefficients").at("delta_o").at("unit"), "urad");
 }
 
 }  // namespace
