@@ -348,12 +348,22 @@ void positions(const json& result, Page& page, std::string& out) {
   json labels = json::array(), center = json::array(), low = json::array(), high = json::array(),
        tips = json::array();
   bool any_residual = false;
+  // The output's unit: deg/h for a gyro; an accelerometer's output (g in gyrocal's own record) shown in
+  // millionths, ug (docs/accelerometer.md), its spinning dwells' seven values per dwell being their harmonic
+  // content.
+  const json* sensor_j = find(result, "sensor");
+  const bool accelerometer =
+      sensor_j && sensor_j->is_string() && sensor_j->get<std::string>() == "accelerometer";
+  const std::string unit = accelerometer ? "\xC2\xB5g" : "deg/h";
+  const double scale = accelerometer ? 1e6 : 1.0;
+  const auto scaled = [scale](std::optional<double> v) { return v ? std::optional<double>(*v * scale) : v; };
   for (std::size_t k = 0; k < p.size(); ++k) {
     const std::string where = fmt::format("positions[{}]", k);
     expect(p[k], json::value_t::object, where);
     const json& q = p[k];
-    const auto index = number(q, "index", where), residual = number(q, "residual_deg_h", where),
-               std_err = number(q, "std_err_deg_h", where), mean = number(q, "mean_deg_h", where);
+    const auto index = number(q, "index", where), residual = scaled(number(q, "residual_deg_h", where)),
+               std_err = scaled(number(q, "std_err_deg_h", where)),
+               mean = scaled(number(q, "mean_deg_h", where));
     const int d = decimals_for(std_err);
     rows.push_back({num_cell(num(index)), num_cell(num(number(q, "beta_deg", where))),
                     num_cell(num(number(q, "gamma_deg", where))),
@@ -365,11 +375,11 @@ void positions(const json& result, Page& page, std::string& out) {
     center.push_back(opt_json(residual));
     low.push_back(residual && std_err ? json(*residual - *std_err) : json(nullptr));
     high.push_back(residual && std_err ? json(*residual + *std_err) : json(nullptr));
-    tips.push_back(fmt::format("position {}: residual {} \xC2\xB1 {} deg/h", num(index), fixed(residual, d),
-                               num(std_err, 2)));
+    tips.push_back(fmt::format("position {}: residual {} \xC2\xB1 {} {}", num(index), fixed(residual, d),
+                               num(std_err, 2), unit));
   }
-  out += table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, deg/h",
-                "standard error, deg/h", "samples", "residual, deg/h"},
+  out += table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, " + unit,
+                "standard error, " + unit, "samples", "residual, " + unit},
                rows);
   if (!any_residual) {
     out += "<p class=\"note\">The result gives no residuals, so none are plotted.</p>\n";
@@ -383,12 +393,17 @@ void positions(const json& result, Page& page, std::string& out) {
                             .center_label = "residual",
                             .band_label = "\xC2\xB1 1 standard error",
                             .xlabel = "position",
-                            .ylabel = "residual, deg/h"};
+                            .ylabel = "residual, " + unit};
   out += page.plot(chart.to_json(), 320, "residual of every reduced position with its standard error");
   out +=
       "<p class=\"note\">Measured mean output minus the fitted model at each position; bars span \xC2\xB1 "
       "one "
       "standard error of the mean.</p>\n";
+  if (accelerometer)
+    out +=
+        "<p class=\"note\">An accelerometer's spinning dwell is reduced to its whole harmonic content up to "
+        "order 3: its positions are the values at seven evenly spaced \xCE\xB3, so the residuals of one "
+        "dwell are its harmonic residuals (docs/accelerometer.md).</p>\n";
 }
 
 /// The rate errors of the gyro model drift+rate are least squares' alone (docs/physics.md section 15): the

@@ -20,12 +20,13 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
     for (std::size_t c = 0; c < 3; ++c) {
       const char* comp = kCompensationNames[c];
       if (!gyro) {
+        // Its one method's shifts are the study's: "shift" and "matters", as the gyro's closed forms'.
         if (c == 1) continue;
-        j["least_squares"][comp] = nlohmann::json::object();
+        j["shift"][comp] = nlohmann::json::object();
         for (const std::string& name : r.least_squares_names)
           if (const auto it = row.least_squares[c].find(name); it != row.least_squares[c].end())
-            j["least_squares"][comp][name] = it->second;
-        j["least_squares_matters"][comp] = row.least_squares_matters[c];
+            j["shift"][comp][name] = it->second;
+        j["matters"][comp] = row.least_squares_matters[c];
         continue;
       }
       j["shift"][comp] = nlohmann::json::object();
@@ -51,10 +52,16 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
   }
   nlohmann::json out = {{"rows", rows}, {"threshold", r.threshold}};
   if (r.sensor != SensorKind::kGyro) out["sensor"] = std::string(to_string(r.sensor));
-  if (r.sensor == SensorKind::kGyro) {
-    out["noise_std"] = nlohmann::json::object();
-    for (const std::string& name : r.closed_form_names)
-      out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  out["noise_std"] = nlohmann::json::object();
+  for (const std::string& name : r.closed_form_names)
+    out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  if (r.sensor != SensorKind::kGyro) {
+    // An accelerometer: its least squares' noise std is the study's, its units its table's, and the
+    // coefficients the plan leaves unidentifiable are named (no shift, no noise std).
+    out["noise_std"] = r.least_squares_noise_std;
+    out["units"] = r.units;
+    out["not_identifiable"] = r.not_identifiable;
+    return out;
   }
   out["least_squares_noise_std"] = nlohmann::json::object();
   for (const std::string& name : r.least_squares_names)
@@ -63,11 +70,6 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
   out["units"] = r.units;
   // docs/physics.md section 15: the gyro model least squares fitted, and the rate errors it could not
   // identify with the reason (the others' shifts are in least_squares, by name).
-  if (r.sensor != SensorKind::kGyro) {
-    // An accelerometer's coefficients the plan leaves unidentifiable (no shift, no noise std).
-    out["not_identifiable"] = r.not_identifiable;
-    return out;
-  }
   out["gyro_model"] = to_string(r.gyro_model);
   if (r.gyro_model == GyroModel::kDriftRate) out["not_identifiable"] = r.not_identifiable;
   return out;
