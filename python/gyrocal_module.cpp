@@ -23,6 +23,7 @@
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
@@ -117,6 +118,11 @@ py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double
   return py::make_tuple(omega, force);
 }
 
+/// The output column of the scenario's sensor in gyrocal's own record: gyro_deg_h or accel_g.
+std::string output_column(const Scenario& scenario) {
+  return std::string(std::visit([](const auto& s) { return s.native_column; }, scenario.sensor()));
+}
+
 py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
   std::vector<double> columns[5];
   {
@@ -133,7 +139,8 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
   }
   py::dict out;
   for (std::size_t c = 0; c < kRecordColumns.size(); ++c) {
-    const std::string key(kRecordColumns[c]);
+    // The output column named as the sensor's native record names it (gyro_deg_h, accel_g).
+    const std::string key(c == 4 ? output_column(scenario) : kRecordColumns[c]);
     out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
   }
   return out;
@@ -165,13 +172,18 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
   CalibrationOptions options =
       python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
-  check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
+  std::vector<std::string> column_names(kRecordColumns.begin(), kRecordColumns.end());
+  column_names[4] = output_column(scenario);
+  check_columns(columns, column_names, name);
   nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;
     // What calibrate_record does, with the rows from the arrays instead of a RecordReader.
     const CentrifugeModel model = scenario.model();
-    Reducer reducer(scenario.test, options.reduce, name, model.geometry().rate_rad_s);
+    // A sensor's record reduced as calibrate reduces it (an accelerometer's spinning dwells to their whole
+    // harmonic content), its channels the sensor's (identify/sensor_channels.hpp).
+    Reducer reducer(reduction_plan(scenario.test, options.sensor, options.reduce), options.reduce, name,
+                    model.geometry().rate_rad_s);
     RecordSample s;
     for (py::ssize_t i = 0; i < time_s.size(); ++i) {
       s.time_s = time_s.data()[i];
@@ -184,7 +196,9 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
     }
     const Reduction reduction_result = reducer.finish();
     const std::vector<PositionChannels> channels =
-        reduce_model_channels(reduction_result, model, options.reduce);
+        options.sensor == SensorKind::kGyro
+            ? reduce_model_channels(reduction_result, model, options.reduce)
+            : reduce_sensor_channels(reduction_result, model, options.reduce, scenario.sensor());
     j = calibration_to_json(identify(reduction_result, channels, model, options));
   }
   j["record"] = name;
@@ -249,6 +263,7 @@ PYBIND11_MODULE(_gyrocal, m) {
 
   m.def("_exact_inputs", &exact_inputs_py, py::arg("scenario"), py::arg("time_s"), py::arg("beta_deg"));
   m.def("_simulate", &simulate_py, py::arg("scenario"), py::arg("seed"));
+  m.def("_output_column", &output_column, py::arg("scenario"));
   m.def("_calibrate_path", &calibrate_path_py);
   m.def("_calibrate_arrays", &calibrate_arrays_py);
   m.def("_noise_path", &noise_path_py);

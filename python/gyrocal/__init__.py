@@ -57,7 +57,7 @@ _MAX_SEED = 2**64 - 1
 
 def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
-    record's columns (RECORD_COLUMNS). seed=None takes the scenario's [test] seed, as without --seed; any other
+    record's columns (RECORD_COLUMNS; an accelerometer's output column is accel_g). seed=None takes the scenario's [test] seed, as without --seed; any other
     seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
     if seed is not None:
         try:
@@ -81,7 +81,9 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     one name ([] estimates none). Each of reduction, gyro_model and estimate left None takes the scenario's
     [calibration] value, as the command line does without the option; the scenario's [reduce] options apply
     always. The options are built by the command line's own function, so the result is its result. The
-    coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors)."""
+    coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors); an
+    accelerometer's scenario ([sensor] kind) gives its eleven in its table's order (K0 K1 K2 K3 Kip Kio Kpo
+    Kpp Koo delta_p delta_o), from a record whose output column is accel_g."""
     if isinstance(estimate, str):
         estimate = [estimate]
     if estimate is not None:
@@ -91,7 +93,9 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     options = (method, compensation, reduction, estimate, gyro_model)
     if _is_path(rec):
         return _gyrocal._calibrate_path(os.fspath(rec), scenario, *options)
-    columns = [_column(rec, name) for name in RECORD_COLUMNS]
+    # The output column is the scenario's sensor's (gyro_deg_h, or accel_g for an accelerometer).
+    names = RECORD_COLUMNS[:4] + (_gyrocal._output_column(scenario),)
+    columns = [_column(rec, name) for name in names]
     return _gyrocal._calibrate_arrays(*columns, scenario, *options, _ARRAYS_NAME)
 
 
