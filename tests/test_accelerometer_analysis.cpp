@@ -140,6 +140,29 @@ TEST(AccelerometerSensitivity, JsonNamesTheCoefficientsAndOnlyTheCompensationsTh
   EXPECT_GT(j.at("noise_std").at("K0").get<double>(), 0.0);
 }
 
+const EstimateDistribution& estimate_of(const MonteCarloResult& r, const std::string& name);
+
+TEST(AccelerometerSensitivity, OneSpeedNamesTheFourItCannotSeparateAndStudiesWhatRemains) {
+  // At one speed a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position: K0, K2, Kpp, Koo have no shift and no
+  // distribution of their own (named, with the reason); K2 - Kpp, K2 - Koo and K0 + (1 + Ar^2) K2 do.
+  Scenario s = small_accelerometer(true);
+  s.test.rates_rad_s = {9.9};
+  s.centrifuge.rate_rad_s = 9.9;
+  s.uncertainty = CentrifugeErrors{};
+  s.uncertainty.radius_error_m = 5e-6;
+  const SensitivityResult study = sensitivity_study(s);
+  std::vector<std::string> named;
+  for (const auto& [name, reason] : study.not_identifiable) named.push_back(name);
+  EXPECT_EQ(named, (std::vector<std::string>{"K0", "K2", "Koo", "Kpp"}));
+  EXPECT_TRUE(study.rows.front().least_squares[kNone].count("K2 - Kpp"));
+  EXPECT_FALSE(study.rows.front().least_squares[kNone].count("K2"));
+  MonteCarloOptions o;
+  o.trials = 100;
+  const MonteCarloResult mc = monte_carlo(s, o);
+  EXPECT_EQ(mc.not_identifiable.size(), 4u);
+  EXPECT_GT(estimate_of(mc, "K2 - Koo").predicted_std, 0.0);
+}
+
 const EstimateDistribution& estimate_of(const MonteCarloResult& r, const std::string& name) {
   for (const EstimateDistribution& e : r.estimates)
     if (e.name == name) return e;

@@ -861,6 +861,10 @@ TEST(ReportPages, AnAccelerometersResultsShowItsCoefficientsUnitsAndRadius) {
   // Sensitivity: one heat map per compensation it has (none: the error not told; full: told).
   const std::string sens = read_file(p.html.at("sensitivity"));
   EXPECT_EQ(plots_of_kind(plot_descriptions(sens), "heatmap"), 2u);
+  EXPECT_EQ(headings(sens), (std::vector<std::string>{"Provenance", "The study",
+                                                      "Least squares: shift of every coefficient per machine "
+                                                      "error"}));
+  EXPECT_EQ(sens.find("closed form"), std::string::npos);
   EXPECT_NE(sens.find("delta_p"), std::string::npos);
   // Monte Carlo: a histogram per coefficient, the budget naming the radius error.
   const std::string mc = read_file(p.html.at("montecarlo"));

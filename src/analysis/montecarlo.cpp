@@ -157,6 +157,14 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (std::size_t k = 0; k < kNumRateTerms; ++k)
       if (!configured.rate_terms[k].identifiable)
         m.not_identifiable.emplace_back(std::string(kRateTermNames[k]), configured.rate_terms[k].reason);
+  // An accelerometer's coefficient the plan cannot identify (one speed: K0, K2, Kpp, Koo) has no
+  // distribution; the combinations that remain are among the estimates.
+  for (const SensorCoefficientEstimate& c : configured.sensor_coefficients)
+    if (!c.identifiable)
+      m.not_identifiable.emplace_back(
+          c.name,
+          "the plan does not identify it; the combinations that remain are estimated "
+          "(docs/accelerometer.md, \"Test design\").");
   // Compensation "self" (docs/self_calibration.md): a machine error the plan cannot estimate stays at zero in
   // every trial, and its effect moves the estimates (their mean error); it is named with the reason, never
   // left to a mean error nobody explains.

@@ -211,8 +211,8 @@ SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const Sensi
   for (const SensorCoefficientEstimate& c : runs[0][1].sensor_coefficients)
     if (!c.identifiable)
       result.not_identifiable[c.name] =
-          "the plan does not identify it (calibrate names the combinations that remain: "
-          "docs/accelerometer.md)";
+          "the plan does not identify it; the combinations that remain are studied (docs/accelerometer.md, "
+          "\"Test design\").";
   const bool noisy = scenario.accelerometer.noise.velocity_random_walk_ug_rt_hz > 0;
   for (std::size_t i = 0; i < terms.size(); ++i) {
     SensitivityRow& row = result.rows[i];

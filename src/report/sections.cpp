@@ -557,7 +557,7 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
             "amount in the cell's tooltip. Colour: the shift in units of the estimate's noise standard "
             "uncertainty \xCF\x83 (red positive, blue negative, logarithmic); a cell near white is far below "
             "the "
-            "noise, a saturated one far above it. The three maps share one scale.</p>\n"
+            "noise, a saturated one far above it. The maps share one scale.</p>\n"
           : "<p class=\"note\">Each machine error alone, at the magnitude shown, shifts each estimate by the "
             "amount in the cell's tooltip (in the estimate's unit). Colour: the shift on a logarithmic scale "
             "over four decades below the largest (red positive, blue negative); the maps share one "
@@ -1008,6 +1008,12 @@ bool has_provenance(const json& r) {
 
 // --- the page of a sensitivity study (`gyrocal sensitivity --json`) ---------------------------------
 
+/// True for a study of an accelerometer ("sensor": "accelerometer"): least squares alone, none and full.
+bool is_accelerometer(const json& s) {
+  const json* k = find(s, "sensor");
+  return k && k->is_string() && k->get<std::string>() == "accelerometer";
+}
+
 /// The study's settings and the noise standard uncertainty of every estimate, the scale of the heat maps.
 void sensitivity_settings(const json& s, Page&, std::string& out) {
   std::vector<std::vector<Cell>> rows;
@@ -1020,6 +1026,24 @@ void sensitivity_settings(const json& s, Page&, std::string& out) {
   if (const json* g = find(s, "gyro_model"))
     rows.push_back({text_cell("gyro model of least squares"), text_cell(scalar_text(*g))});
   out += table({"", ""}, rows, "compact");
+  if (is_accelerometer(s)) {
+    // An accelerometer's study: least squares alone, the error not told and told (docs/accelerometer.md).
+    out +=
+        "<p class=\"note\">Which machine error moves which coefficient of the accelerometer: each machine "
+        "error of the configuration alone, at its configured magnitude (or a typical one where the "
+        "configuration has zero), shifts each coefficient of a noise-free least-squares calibration by the "
+        "exact amount shown, in the coefficient's unit, with the error <em>none</em> (not told the "
+        "calibration) and <em>full</em> (told) (docs/accelerometer.md).</p>\n";
+    std::vector<std::vector<Cell>> sigma_rows;
+    if (const json* sigma = find(s, "noise_std"); sigma && sigma->is_object()) {
+      for (const auto& name : ordered_keys(*sigma))
+        sigma_rows.push_back({text_cell(name), num_cell(num(number(*sigma, name, "noise_std"), 3)),
+                              text_cell(estimate_unit(s, s, name))});
+      out += "<h3>Noise standard uncertainty of each estimate</h3>\n";
+      out += table({"estimate", "\xCF\x83", "unit"}, sigma_rows, "compact");
+    }
+    return;
+  }
   out +=
       "<p class=\"note\">The seed paper's study (Wang &amp; Meng 2017; docs/physics.md section 10): each "
       "machine "
@@ -1101,7 +1125,9 @@ const Section kSensitivitySections[] = {
     {"study", "study", "The study", sensitivity_settings,
      [](const json& s) { return has(s, "threshold") || has(s, "noise_std"); }},
     {"sensitivity", "sensitivity", "Closed forms: shift of every estimate per machine error",
-     sensitivity_maps, [](const json& s) { return has(s, "rows"); }},
+     sensitivity_maps, [](const json& s) { return has(s, "rows") && !is_accelerometer(s); }},
+    {"sensitivity", "sensitivity", "Least squares: shift of every coefficient per machine error",
+     sensitivity_maps, [](const json& s) { return has(s, "rows") && is_accelerometer(s); }},
     {"least_squares", "least-squares", "Least squares: the estimates each machine error shifts",
      sensitivity_least_squares, has_least_squares_matters},
 };
