@@ -178,7 +178,9 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
   CalibrationOptions options =
       python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
   const std::vector<const Column*> columns = {&time_s, &main_deg, &counter_deg, &position_deg, &gyro_deg_h};
-  check_columns(columns, {kRecordColumns.begin(), kRecordColumns.end()}, name);
+  std::vector<std::string> column_names(kRecordColumns.begin(), kRecordColumns.end());
+  column_names[4] = native_output_column(scenario.sensor_kind);
+  check_columns(columns, column_names, name);
   nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;

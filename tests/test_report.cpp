@@ -697,17 +697,19 @@ struct ResultPages {
   std::map<std::string, Outcome> report;       // `gyrocal report`'s run per kind
 };
 
-ResultPages make_result_pages(const std::string& name) {
+ResultPages make_result_pages(const std::string& name,
+                              const std::string& toml = gyrocal::test::short_test_toml(),
+                              const std::string& calibrate_options = "") {
   ResultPages p;
   p.folder = fs::absolute(name);
   fs::remove_all(p.folder);
   fs::create_directories(p.folder);
   const fs::path config = p.folder / "short.toml", record = p.folder / "record.csv";
-  write_file(config, gyrocal::test::short_test_toml());
+  write_file(config, toml);
   const std::string cli = std::string(GYROCAL_CLI), cfg = " --config " + shell_quoted(config);
   EXPECT_EQ(run(cli + " simulate --out " + shell_quoted(record) + cfg, p.folder).status, 0);
   const std::map<std::string, std::string> commands = {
-      {"calibration", " calibrate " + shell_quoted(record) + cfg},
+      {"calibration", " calibrate " + shell_quoted(record) + cfg + calibrate_options},
       {"sensitivity", " sensitivity" + cfg},
       {"montecarlo", " montecarlo --trials 2000" + cfg}};
   for (const auto& [kind, command] : commands) {
@@ -824,12 +826,57 @@ TEST(ReportPages, EachResultOfTheCommandLineRendersAsItsOwnPage) {
   EXPECT_FALSE(fs::exists(p.folder / "inputs.html"));
 }
 
+// --- issue 19: an accelerometer's results ---------------------------------------------------------------
+
+/// A short two-speed accelerometer test (static holds, 6 and 12 rad/s; docs/accelerometer.md) with the
+/// radius error's standard uncertainty for the Monte Carlo budget.
+std::string accelerometer_toml() {
+  gyrocal::Scenario s = gyrocal::default_scenario();
+  s.sensor_kind = gyrocal::SensorKind::kAccelerometer;
+  s.test.rates_rad_s = {0.0, 6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;
+  s.test.revolutions = 8;
+  s.test.sample_rate_hz = 50.0;
+  s.test.static_hold_s = 2.0;
+  s.uncertainty.radius_error_m = 5e-6;
+  return gyrocal::scenario_to_toml(s);
+}
+
+ResultPages accelerometer_pages(const std::string& name) {
+  return make_result_pages(name, accelerometer_toml(), " --estimate radius_error,radius_stretch");
+}
+
+TEST(ReportPages, AnAccelerometersResultsShowItsCoefficientsUnitsAndRadius) {
+  const ResultPages p = accelerometer_pages("report_pages_accelerometer");
+  for (const auto& [kind, outcome] : p.report) ASSERT_EQ(outcome.status, 0) << kind << ": " << outcome.err;
+  // Calibration: the eleven coefficients in the table's units, the radius error and stretch estimated from
+  // its own data, the positions' residuals in ug (the spinning dwells' harmonic content).
+  const std::string cal = read_file(p.html.at("calibration"));
+  for (const char* cell :
+       {"<td>K0</td>", "<td>K3</td>", "<td>delta_o</td>", "<td>ug/g^3</td>", "<td>urad</td>",
+        "<td>output/g</td>", "radius_error", "radius_stretch", "residual, \xC2\xB5g", "harmonic content"})
+    EXPECT_NE(cal.find(cell), std::string::npos) << cell;
+  EXPECT_EQ(cal.find("<td>dF</td>"), std::string::npos);
+  EXPECT_EQ(cal.find("residual, deg/h"), std::string::npos);
+  // Sensitivity: one heat map per compensation it has (none: the error not told; full: told).
+  const std::string sens = read_file(p.html.at("sensitivity"));
+  EXPECT_EQ(plots_of_kind(plot_descriptions(sens), "heatmap"), 2u);
+  EXPECT_EQ(headings(sens), (std::vector<std::string>{"Provenance", "The study",
+                                                      "Least squares: shift of every coefficient per machine "
+                                                      "error"}));
+  EXPECT_EQ(sens.find("closed form"), std::string::npos);
+  EXPECT_NE(sens.find("delta_p"), std::string::npos);
+  // Monte Carlo: a histogram per coefficient, the budget naming the radius error.
+  const std::string mc = read_file(p.html.at("montecarlo"));
+  const json mc_json = json::parse(read_file(p.json.at("montecarlo")));
+  EXPECT_EQ(mc_json.at("sensor"), "accelerometer");
+  EXPECT_EQ(plots_of_kind(plot_descriptions(mc), "histogram"), mc_json["coefficients"].size());
+  EXPECT_NE(mc.find("radius_error"), std::string::npos);
+}
+
 // Each page in a real browser: no error, every plot drawn; a 1400 x 3000 screenshot of each stays in the
 // build tree (tests/report_pages_browser/*.png) to be looked at.
-TEST(ReportBrowser, ChromiumDrawsEveryResultPage) {
-  expect_chromium();
-  if (HasFatalFailure()) return;
-  const ResultPages p = make_result_pages("report_pages_browser");
+void expect_every_page_drawn(const ResultPages& p) {
   TempDir dir;
   for (const auto& [kind, html] : p.html) {
     ASSERT_EQ(p.report.at(kind).status, 0) << kind << ": " << p.report.at(kind).err;
@@ -847,6 +894,19 @@ TEST(ReportBrowser, ChromiumDrawsEveryResultPage) {
     EXPECT_EQ(shot.status, 0) << shot.err;
     EXPECT_GT(read_file(png).size(), 50000u) << png << " looks empty";
   }
+}
+
+TEST(ReportBrowser, ChromiumDrawsEveryResultPage) {
+  expect_chromium();
+  if (HasFatalFailure()) return;
+  expect_every_page_drawn(make_result_pages("report_pages_browser"));
+}
+
+// An accelerometer's calibration, sensitivity and Monte Carlo pages (issue 19), drawn the same way.
+TEST(ReportBrowser, ChromiumDrawsAnAccelerometersPages) {
+  expect_chromium();
+  if (HasFatalFailure()) return;
+  expect_every_page_drawn(accelerometer_pages("report_pages_accelerometer_browser"));
 }
 
 }  // namespace

@@ -17,12 +17,14 @@ namespace {
 
 std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
   std::string s = fmt::format(
-      "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, gyro model {}, which knows the "
+      "{} trials ({} mode, seed {}) in {:.2f} s: {} with compensation {}, {}, which knows the "
       "configured errors only.\nError = estimate - truth. Predicted: the linearised model (mean = noise-free "
       "error at the configured errors). z std: the std over the trials of error / the std the calibration "
       "states ({}).\n\n",
       r.trials, to_string(r.mode), r.seed, seconds, to_string(r.method),
-      r.self ? std::string("self") : to_string(r.compensation), to_string(r.gyro_model),
+      r.self ? std::string("self") : to_string(r.compensation),
+      r.sensor == SensorKind::kGyro ? fmt::format("gyro model {}", to_string(r.gyro_model))
+                                    : fmt::format("sensor {}", to_string(r.sensor)),
       r.mode == MonteCarloMode::kSamples ? "each trial's own" : "the configured machine's calibration's");
   std::size_t width = 16;  // the rate errors' names are longer than the coefficients'
   for (const EstimateDistribution& e : r.estimates) width = std::max(width, e.name.size() + 2);

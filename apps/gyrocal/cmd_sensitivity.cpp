@@ -158,6 +158,51 @@ std::string sensitivity_table(const SensitivityResult& r) {
   return s;
 }
 
+/// A sensor other than the gyro (docs/accelerometer.md): least squares, the error not told (none) and told
+/// (full). Per machine error, the coefficients it shifts by at least the threshold, each with its shift in
+/// the coefficient's own unit and in noise sigmas, the largest first.
+std::string sensor_sensitivity_table(const SensitivityResult& r) {
+  const std::size_t width = label_width(r), indent = width + 22 + 2;
+  std::string s = fmt::format(
+      "Each machine error alone, {} (least squares): shift = estimate(error) - estimate(no error), exact\n"
+      "(noise-free). Listed: the estimates shifted by at least {} sigma, as shift in its unit [shift / "
+      "sigma],\n"
+      "the largest first (sigma = the estimate's predicted noise std); - = none. * = typical magnitude "
+      "(zero\n"
+      "in the configuration). @ = a harmonic's phase, deg.\n",
+      to_string(r.sensor), r.threshold);
+  std::vector<std::string> sigmas;
+  for (const std::string& name : r.least_squares_names)
+    sigmas.push_back(fmt::format("{} {:.2g} {}", name, r.least_squares_noise_std.at(name), r.units.at(name)));
+  s += "\n" + wrapped("sigma: ", 7, sigmas, ", ");
+  for (const auto& [name, reason] : r.not_identifiable)
+    s += fmt::format("{}: not identifiable: {}\n", name, reason);
+  for (const std::size_t c : {std::size_t{0}, std::size_t{2}}) {
+    s += fmt::format("\ncompensation {} (the error {} the calibration)\n{:<{}}{:>22}  {}\n",
+                     kCompensationNames[c], c == 0 ? "not told" : "told", "machine error", width, "magnitude",
+                     "estimates shifted: shift [shift / sigma]");
+    for (const SensitivityRow& row : r.rows) {
+      const auto& matters = row.least_squares_matters[c];
+      std::vector<std::pair<double, std::string>> shifted;
+      for (const std::string& name : matters) {
+        const double d = row.least_squares[c].at(name);
+        const double sigma = r.least_squares_noise_std.at(name);
+        const double z = sigma > 0 ? d / sigma : 0.0;
+        shifted.emplace_back(sigma > 0 ? std::fabs(z) : std::fabs(d),
+                             sigma > 0 ? fmt::format("{} {:.3g} [{:.3g}]", name, d, z)
+                                       : fmt::format("{} {:.3g} (no sigma)", name, d));
+      }
+      std::stable_sort(shifted.begin(), shifted.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::vector<std::string> items;
+      for (auto& item : shifted) items.push_back(std::move(item.second));
+      if (items.empty()) items.emplace_back("-");
+      s += wrapped(fmt::format("{:<{}}{:>22}  ", row_label(row), width, magnitude(row)), indent, items, ", ");
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 void register_sensitivity(CLI::App& app) {
@@ -198,7 +243,9 @@ void register_sensitivity(CLI::App& app) {
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
       write_result(opt->json, std::move(j), "sensitivity", opt->force);
     }
-    if (opt->json != "-") fmt::print("{}", sensitivity_table(result));
+    if (opt->json != "-")
+      fmt::print("{}", result.sensor == SensorKind::kGyro ? sensitivity_table(result)
+                                                          : sensor_sensitivity_table(result));
   });
 }
 

@@ -105,7 +105,9 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     one name ([] estimates none). Each of reduction, gyro_model and estimate left None takes the scenario's
     [calibration] value, as the command line does without the option; the scenario's [reduce] options apply
     always. The options are built by the command line's own function, so the result is its result. The
-    coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors)."""
+    coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors); an
+    accelerometer's scenario ([sensor] kind) gives its eleven in its table's order (K0 K1 K2 K3 Kip Kio Kpo
+    Kpp Koo delta_p delta_o), from a record whose output column is accel_g."""
     if isinstance(estimate, str):
         estimate = [estimate]
     if estimate is not None:

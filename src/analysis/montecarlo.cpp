@@ -14,9 +14,11 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include "gyrocal/analysis/estimates.hpp"
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/random.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -24,51 +26,17 @@ namespace gyrocal {
 namespace {
 
 /// The estimates of a calibration, as errors: (value - true value) per name, in `names` order; an estimate
-/// missing from `r` is NaN. With the gyro model drift+rate, the identifiable rate errors are estimates too,
-/// measured from `rate_truth` (docs/physics.md section 15). Fills names, units, truth when `names` is empty;
-/// `stated_std` (when given) gets the standard uncertainty the calibration states for each, NaN where
-/// missing.
-std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoefficients& truth,
-                                    const GyroRateErrors& rate_truth, std::vector<std::string>& names,
-                                    std::vector<std::string>* units, std::vector<double>* true_values,
+/// missing from `r` is NaN. The estimates and their true values are analysis/estimates.hpp's, for any sensor
+/// (with the gyro model drift+rate, the identifiable rate errors too, docs/physics.md section 15). Fills
+/// names, units, truth when `names` is empty; `stated_std` (when given) gets the standard uncertainty the
+/// calibration states for each, NaN where missing.
+std::vector<double> estimate_errors(const CalibrationResult& r, const Scenario& truth,
+                                    std::vector<std::string>& names, std::vector<std::string>* units,
+                                    std::vector<double>* true_values,
                                     std::vector<double>* stated_std = nullptr) {
-  struct Entry {
-    std::string name;
-    double value = 0.0, truth = 0.0, std = 0.0;
-    std::string unit;
-  };
-  std::vector<Entry> entries;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
-    if (r.coefficients[k].identifiable)
-      entries.push_back({std::string(kCoefficientNames[k]), r.coefficients[k].value, truth.values[k],
-                         r.coefficients[k].std, std::string(kCoefficientUnits[k])});
-  if (r.gyro_model == GyroModel::kDriftRate) {
-    const double rate_truths[kNumRateTerms] = {rate_truth.scale_factor_error_ppm,
-                                               rate_truth.input_axis_misalignment_O_arcsec,
-                                               rate_truth.input_axis_misalignment_S_arcsec};
-    for (std::size_t k = 0; k < kNumRateTerms; ++k)
-      if (r.rate_terms[k].identifiable)
-        entries.push_back({std::string(kRateTermNames[k]), r.rate_terms[k].value, rate_truths[k],
-                           r.rate_terms[k].std, std::string(kRateTermUnits[k])});
-  }
-  if (r.method == Method::kClosedForm) {
-    // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
-    const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
-                                                      {"dO_1g", Coefficient::dO},
-                                                      {"dS_1g", Coefficient::dS},
-                                                      {"dIS_b", Coefficient::dIS}};
-    for (const NamedEstimate& e : r.alternatives)
-      for (const auto& [n, c] : of)
-        if (e.name == n) entries.push_back({e.name, e.value, truth[c], e.std, e.unit});
-  }
-  for (const NamedEstimate& e : r.combinations) {
-    double t = 0.0;
-    for (std::size_t k = 0; k < e.coefficients.size() && k < kNumCoefficients; ++k)
-      t += e.coefficients[k] * truth.values[k];
-    entries.push_back({e.name, e.value, t, e.std, e.unit});
-  }
+  const std::vector<FlatEstimate> entries = flatten_estimates(r, truth);
   if (names.empty()) {
-    for (const Entry& e : entries) {
+    for (const FlatEstimate& e : entries) {
       names.push_back(e.name);
       if (units) units->push_back(e.unit);
       if (true_values) true_values->push_back(e.truth);
@@ -77,7 +45,7 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const DriftCoeff
   std::vector<double> out(names.size(), std::numeric_limits<double>::quiet_NaN());
   if (stated_std) stated_std->assign(names.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < names.size(); ++i)
-    for (const Entry& e : entries)
+    for (const FlatEstimate& e : entries)
       if (e.name == names[i]) {
         out[i] = e.value - e.truth;
         if (stated_std) (*stated_std)[i] = e.std;
@@ -143,14 +111,36 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   for (const auto& [term, u] : nonzero_error_terms(scenario.uncertainty)) m.sources.push_back({term, u});
   const ReduceOptions& ro = options.calibration.reduce;
 
-  // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
-  Reduction r0 = planned_reduction(scenario);
+  const bool gyro = scenario.sensor_kind == SensorKind::kGyro;
+  m.calibration.sensor = scenario.sensor_kind;
+  if (!gyro && options.self)
+    throw Error(
+        "Monte Carlo: compensation self is the gyro's; for an accelerometer, --estimate in calibrate and "
+        "plan "
+        "estimates machine errors from its data (docs/accelerometer.md).");
   const CentrifugeModel model0 = m.told.model();
-  const std::vector<PositionChannels> ch0 = reduce_model_channels(r0, model0, ro);
-  // The outputs are the true machine's (the told one differs under "self").
-  set_noise_free_outputs(r0, options.self ? reduce_model_channels(r0, scenario.model(), ro) : ch0,
-                         scenario.gyro, scenario.gyro_rate);
-  set_predicted_std_errors(r0, scenario.noise, scenario.test.sample_rate_hz, ro);
+  // The planned test of `s`'s machine with its outputs and std errors, and (`with_channels`) the channels of
+  // `told` on its dwells: the gyro's (predict.hpp), or another sensor's reduced as its record would be
+  // (estimates.hpp). `told_is_true`: `told` is `s`'s own machine, whose channels give the outputs too.
+  const auto planned = [&](const Scenario& s, const CentrifugeModel& told, bool with_channels,
+                           bool told_is_true) {
+    if (!gyro) return planned_sensor_test(s, told, ro);
+    PlannedSensorTest p;
+    p.reduction = planned_reduction(s);
+    const std::vector<PositionChannels> truth =
+        told_is_true ? std::vector<PositionChannels>{} : reduce_model_channels(p.reduction, s.model(), ro);
+    if (with_channels || told_is_true) p.channels = reduce_model_channels(p.reduction, told, ro);
+    set_noise_free_outputs(p.reduction, told_is_true ? p.channels : truth, scenario.gyro, scenario.gyro_rate);
+    set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz, ro);
+    return p;
+  };
+  const GyroNoise noise = output_noise(scenario);
+
+  // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
+  // (The outputs are the true machine's: the told one differs under "self".)
+  PlannedSensorTest p0 = planned(scenario, model0, true, !options.self);
+  const Reduction& r0 = p0.reduction;
+  const std::vector<PositionChannels>& ch0 = p0.channels;
   const auto np = static_cast<Eigen::Index>(r0.positions.size());
   m.positions = static_cast<int>(np);
 
@@ -161,13 +151,20 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     return identify(r, ch0, model0, m.calibration);
   };
   const CalibrationResult configured = identify_at(Eigen::VectorXd::Zero(np));
-  m.bias = estimate_errors(configured, scenario.gyro, scenario.gyro_rate, m.names, &m.units, &m.truth,
-                           &m.stated_std);
+  m.bias = estimate_errors(configured, scenario, m.names, &m.units, &m.truth, &m.stated_std);
   // docs/physics.md section 15: a rate error the plan cannot identify has no distribution; it is said why.
   if (configured.gyro_model == GyroModel::kDriftRate)
     for (std::size_t k = 0; k < kNumRateTerms; ++k)
       if (!configured.rate_terms[k].identifiable)
         m.not_identifiable.emplace_back(std::string(kRateTermNames[k]), configured.rate_terms[k].reason);
+  // An accelerometer's coefficient the plan cannot identify (one speed: K0, K2, Kpp, Koo) has no
+  // distribution; the combinations that remain are among the estimates.
+  for (const SensorCoefficientEstimate& c : configured.sensor_coefficients)
+    if (!c.identifiable)
+      m.not_identifiable.emplace_back(
+          c.name,
+          "the plan does not identify it; the combinations that remain are estimated "
+          "(docs/accelerometer.md, \"Test design\").");
   // Compensation "self" (docs/self_calibration.md): a machine error the plan cannot estimate stays at zero in
   // every trial, and its effect moves the estimates (their mean error); it is named with the reason, never
   // left to a mean error nobody explains.
@@ -182,11 +179,21 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   Eigen::MatrixXd map(ne, np);
   // Affine in W: the unknowns are linear in the reduced outputs (identify/unknowns.hpp); the misalignments'
   // division by (1 + e) bends it by e's change per deg/h of output, parts per million of theirs.
+  // Another sensor's coefficients are ratios of its products (an accelerometer's Kx = u_x / K1): M is their
+  // derivative, by a central difference of 1e-4 g (times K1) of each output, exact to ~1e-8 of itself.
+  const double step = gyro ? 1.0 : 1e-4 * std::abs(scenario.accelerometer.coefficients[AccelCoefficient::K1]);
   for (Eigen::Index k = 0; k < np; ++k) {
-    const std::vector<double> e = estimate_errors(identify_at(Eigen::VectorXd::Unit(np, k)), scenario.gyro,
-                                                  scenario.gyro_rate, m.names, nullptr, nullptr);
+    const std::vector<double> e = estimate_errors(identify_at(step * Eigen::VectorXd::Unit(np, k)), scenario,
+                                                  m.names, nullptr, nullptr);
+    if (gyro) {
+      for (Eigen::Index i = 0; i < ne; ++i)
+        map(i, k) = e[static_cast<std::size_t>(i)] - m.bias[static_cast<std::size_t>(i)];
+      continue;
+    }
+    const std::vector<double> d = estimate_errors(identify_at(-step * Eigen::VectorXd::Unit(np, k)), scenario,
+                                                  m.names, nullptr, nullptr);
     for (Eigen::Index i = 0; i < ne; ++i)
-      map(i, k) = e[static_cast<std::size_t>(i)] - m.bias[static_cast<std::size_t>(i)];
+      map(i, k) = (e[static_cast<std::size_t>(i)] - d[static_cast<std::size_t>(i)]) / (2.0 * step);
   }
 
   // Each source's effect on the estimates at one standard uncertainty, (E(e0 + u) - E(e0 - u)) / 2, exact to
@@ -203,11 +210,11 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (int k = 0; k < 2; ++k) {
       Scenario drawn = scenario;
       m.sources[s].term.add_to(drawn.errors, (k == 0 ? 1.0 : -1.0) * m.sources[s].std_si);
-      Reduction r = planned_reduction(drawn);
+      // The drawn machine's outputs; the channels of the configured machine on its encoder lines.
+      PlannedSensorTest p = planned(drawn, model0, false, false);
+      const Reduction& r = p.reduction;
       if (static_cast<Eigen::Index>(r.positions.size()) != np)
         throw Error("Monte Carlo: a drawn machine changes the plan.");
-      set_noise_free_outputs(r, reduce_model_channels(r, drawn.model(), ro), scenario.gyro,
-                             scenario.gyro_rate);
       if (same_encoder_lines(r, r0)) {
         Eigen::VectorXd dw(np);
         for (Eigen::Index i = 0; i < np; ++i)
@@ -215,10 +222,9 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
                   r0.positions[static_cast<std::size_t>(i)].mean_deg_h;
         side[k] = map * dw;
       } else {
-        set_predicted_std_errors(r, scenario.noise, scenario.test.sample_rate_hz, ro);
-        const std::vector<double> e =
-            estimate_errors(identify(r, reduce_model_channels(r, model0, ro), model0, m.calibration),
-                            scenario.gyro, scenario.gyro_rate, m.names, nullptr, nullptr);
+        if (p.channels.empty()) p.channels = reduce_model_channels(r, model0, ro);
+        const std::vector<double> e = estimate_errors(identify(r, p.channels, model0, m.calibration),
+                                                      scenario, m.names, nullptr, nullptr);
         side[k] = Eigen::Map<const Eigen::VectorXd>(e.data(), ne) -
                   Eigen::Map<const Eigen::VectorXd>(m.bias.data(), ne);
       }
@@ -229,7 +235,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   // The gyro's noise through the reduction as a factor L of its covariance, n = L xi: white noise, bias
   // instability and rate random walk, within and across dwells (predict.hpp, docs/noise.md).
   const Eigen::MatrixXd noise_covariance =
-      predicted_noise_position_covariance(r0, ro, scenario.noise, scenario.test.sample_rate_hz);
+      predicted_noise_position_covariance(r0, ro, noise, scenario.test.sample_rate_hz);
   Eigen::MatrixXd chol = Eigen::MatrixXd::Zero(np, np);
   if (!noise_covariance.isZero(0.0)) {
     const Eigen::LLT<Eigen::MatrixXd> llt(noise_covariance);
@@ -289,17 +295,21 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     Scenario s = m.scenario;
     for (std::size_t c = 0; c < ns; ++c)
       m.sources[c].term.add_to(s.errors, m.sources[c].std_si * rng.normal());
-    Reducer reducer(s.test, m.calibration.reduce, "Monte Carlo trial", s.centrifuge.rate_rad_s);
+    // Reduced as calibrate reduces the sensor's record (an accelerometer's spinning dwells to their whole
+    // harmonic content).
+    Reducer reducer(reduction_plan(s.test, s.sensor_kind, m.calibration.reduce), m.calibration.reduce,
+                    "Monte Carlo trial", s.centrifuge.rate_rad_s);
     SimulationOptions so;
     so.seed = rng.next_u64();
     simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
     const Reduction r = reducer.finish();
-    const auto channels = reduce_model_channels(r, model0, m.calibration.reduce);
+    const auto channels = s.sensor_kind == SensorKind::kGyro
+                              ? reduce_model_channels(r, model0, m.calibration.reduce)
+                              : reduce_sensor_channels(r, model0, m.calibration.reduce, s.sensor());
     std::vector<std::string> names = m.names;
     std::vector<double> stated;
-    const std::vector<double> e =
-        estimate_errors(identify(r, channels, model0, m.calibration), m.scenario.gyro, m.scenario.gyro_rate,
-                        names, nullptr, nullptr, &stated);
+    const std::vector<double> e = estimate_errors(identify(r, channels, model0, m.calibration), m.scenario,
+                                                  names, nullptr, nullptr, &stated);
     std::copy(e.begin(), e.end(), out);
     for (std::size_t i = 0; i < ne; ++i)
       out[ne + i] = stated[i] > 0.0 ? e[i] / stated[i] : std::numeric_limits<double>::quiet_NaN();
@@ -379,9 +389,15 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
   result.compensation = m.calibration.compensation;
   result.gyro_model = m.calibration.gyro_model;
   result.not_identifiable = m.not_identifiable;
+  result.sensor = m.scenario.sensor_kind;
   result.sources.push_back("noise");
-  result.source_std.push_back(m.scenario.noise.angle_random_walk_deg_rt_h);
-  result.source_units.push_back("deg/sqrt(h)");
+  if (result.sensor == SensorKind::kGyro) {
+    result.source_std.push_back(m.scenario.noise.angle_random_walk_deg_rt_h);
+    result.source_units.push_back("deg/sqrt(h)");
+  } else {
+    result.source_std.push_back(m.scenario.accelerometer.noise.velocity_random_walk_ug_rt_hz);
+    result.source_units.push_back("ug/sqrt(Hz)");
+  }
   for (const MonteCarloSource& s : m.sources) {
     result.sources.push_back(s.term.label());
     result.source_std.push_back(s.std_si / s.term.unit_to_si);

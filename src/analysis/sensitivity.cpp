@@ -12,8 +12,10 @@
 
 #include <fmt/format.h>
 
+#include "gyrocal/analysis/estimates.hpp"
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 
 namespace gyrocal {
@@ -82,30 +84,15 @@ void field_terms(int fi, const CentrifugeErrors& errors, bool all,
   }
 }
 
-/// Estimate name -> (value, std) of a calibration: closed form's primary, alternatives and combinations, or
-/// least squares' identifiable coefficients and combinations. A combination's value is given less its true
-/// value for the combination actually estimated (NamedEstimate::coefficients): least squares' estimable
-/// combination moves with the machine's errors (they change the regressors), and its shift must not count
-/// that change of definition.
+/// Estimate name -> (value, std) of a calibration (analysis/estimates.hpp's flat list, for any sensor). A
+/// combination's value is given less its true value for the combination actually estimated
+/// (NamedEstimate::coefficients): least squares' estimable combination moves with the machine's errors (they
+/// change the regressors), and its shift must not count that change of definition.
 std::vector<std::pair<std::string, std::pair<double, double>>> estimates(const CalibrationResult& r,
-                                                                         const DriftCoefficients& truth) {
+                                                                         const Scenario& truth) {
   std::vector<std::pair<std::string, std::pair<double, double>>> out;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
-    if (r.coefficients[k].identifiable)
-      out.push_back({std::string(kCoefficientNames[k]), {r.coefficients[k].value, r.coefficients[k].std}});
-  // docs/physics.md section 15: the rate errors, in ppm and arcsec, where the plan identifies them.
-  if (r.gyro_model == GyroModel::kDriftRate)
-    for (std::size_t k = 0; k < kNumRateTerms; ++k)
-      if (r.rate_terms[k].identifiable)
-        out.push_back({std::string(kRateTermNames[k]), {r.rate_terms[k].value, r.rate_terms[k].std}});
-  if (r.method == Method::kClosedForm)
-    for (const NamedEstimate& e : r.alternatives) out.push_back({e.name, {e.value, e.std}});
-  for (const NamedEstimate& e : r.combinations) {
-    double true_value = 0.0;
-    for (std::size_t k = 0; k < e.coefficients.size() && k < kNumCoefficients; ++k)
-      true_value += e.coefficients[k] * truth.values[k];
-    out.push_back({e.name, {e.value - true_value, e.std}});
-  }
+  for (const FlatEstimate& e : flatten_estimates(r, truth))
+    out.push_back({e.name, {e.combination ? e.value - e.truth : e.value, e.std}});
   return out;
 }
 
@@ -169,6 +156,89 @@ int spinning_rates(const TestSpec& test) {
   return n;
 }
 
+/// The study for a sensor other than the gyro (docs/accelerometer.md, "Sensitivity, Monte Carlo and
+/// report"): least squares only (its calibration has no closed forms and no seed compensation). Per error,
+/// compensation "none": the record of the machine with the error, reduced on its own planned encoder lines,
+/// calibrated with the channels of the machine without it (the error not told); "full": with the channels of
+/// the machine with it (told). Shifts against the base case (no error) in the coefficients' own units.
+SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const SensitivityOptions& options) {
+  Scenario base = scenario;
+  base.errors = CentrifugeErrors{};
+  const CentrifugeModel base_model = base.model();
+  CalibrationOptions o = options.calibration;
+  o.sensor = scenario.sensor_kind;
+  o.method = Method::kLeastSquares;
+  o.compensation = Compensation::kFull;
+  o.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
+  // The outputs are noise-free: chi2 says nothing (as in predict_calibration).
+  o.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  const std::vector<std::pair<MachineErrorTerm, double>> terms = sensitivity_terms(scenario.errors);
+  SensitivityResult result;
+  result.sensor = scenario.sensor_kind;
+  result.threshold = options.threshold;
+  result.rows.resize(terms.size());
+  // Item 0 the base case, items 1.. the rows: [0] the error not told, [1] told.
+  std::vector<std::array<CalibrationResult, 2>> runs(terms.size() + 1);
+  std::atomic<std::size_t> done{0};
+  parallel_for(
+      terms.size() + 1, options.threads,
+      [&](std::size_t i) {
+        Scenario s = base;
+        if (i > 0) {
+          const auto& [term, value] = terms[i - 1];
+          term.add_to(s.errors, value != 0.0 ? value : term.typical_si);
+        }
+        const CentrifugeModel told = s.model();
+        PlannedSensorTest p = planned_sensor_test(s, told, o.reduce);
+        runs[i][1] = identify(p.reduction, p.channels, told, o);
+        runs[i][0] = i == 0 ? runs[i][1]
+                            : identify(p.reduction,
+                                       reduce_sensor_channels(p.reduction, base_model, o.reduce, s.sensor(),
+                                                              kMaxModelSamplesPerDwell),
+                                       base_model, o);
+        ++done;
+      },
+      [&] {
+        if (options.progress)
+          options.progress(static_cast<double>(done.load()) / static_cast<double>(runs.size()));
+      });
+  if (options.progress) options.progress(1.0);
+  for (const FlatEstimate& e : flatten_estimates(runs[0][1], scenario)) {
+    result.least_squares_names.push_back(e.name);
+    result.least_squares_noise_std[e.name] = e.std;
+    result.units[e.name] = e.unit;
+  }
+  for (const SensorCoefficientEstimate& c : runs[0][1].sensor_coefficients)
+    if (!c.identifiable)
+      result.not_identifiable[c.name] =
+          "the plan does not identify it; the combinations that remain are studied (docs/accelerometer.md, "
+          "\"Test design\").";
+  const bool noisy = scenario.accelerometer.noise.velocity_random_walk_ug_rt_hz > 0;
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    SensitivityRow& row = result.rows[i];
+    const auto& [term, value] = terms[i];
+    row.term = term;
+    row.typical = value == 0.0;
+    row.value = (row.typical ? term.typical_si : value) / term.unit_to_si;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::size_t c = k == 0 ? 0 : 2;  // compensation none, full
+      const auto base_estimates = estimates(runs[0][k], scenario);
+      for (const auto& [name, vs] : estimates(runs[i + 1][k], scenario))
+        for (const auto& [name0, vs0] : base_estimates) {
+          if (name0 != name) continue;
+          const double d = vs.first - vs0.first;
+          row.least_squares[c][name] = d;
+          const auto it = result.least_squares_noise_std.find(name);
+          const double sigma = noisy && it != result.least_squares_noise_std.end() && it->second > 0
+                                   ? it->second
+                                   : 1e-6 / options.threshold;
+          if (std::abs(d) > options.threshold * sigma) row.least_squares_matters[c].push_back(name);
+        }
+    }
+  }
+  return result;
+}
+
 }  // namespace
 
 void MachineErrorTerm::add_to(CentrifugeErrors& errors, double amount_si) const {
@@ -207,6 +277,7 @@ std::vector<std::pair<MachineErrorTerm, double>> sensitivity_terms(const Centrif
 
 SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options) {
   if (!(options.threshold > 0.0)) throw Error("sensitivity: the threshold must be positive.");
+  if (scenario.sensor_kind != SensorKind::kGyro) return sensor_sensitivity_study(scenario, options);
   Scenario base = scenario;
   base.errors = CentrifugeErrors{};
   if (sixteen_positions(planned_reduction(base).positions).empty())
@@ -248,7 +319,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
     const CalibrationResult& r0 = runs[0][static_cast<std::size_t>(m)][2];
     auto& names = m == 0 ? result.closed_form_names : result.least_squares_names;
     auto& noise = m == 0 ? result.closed_form_noise_std : result.least_squares_noise_std;
-    for (const auto& [name, vs] : estimates(r0, scenario.gyro)) {
+    for (const auto& [name, vs] : estimates(r0, scenario)) {
       names.push_back(name);
       noise[name] = vs.second;
     }
@@ -266,8 +337,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
   }
 
   if (result.has_self)
-    for (const auto& [name, vs] : estimates(self_runs[0], scenario.gyro))
-      result.self_noise_std[name] = vs.second;
+    for (const auto& [name, vs] : estimates(self_runs[0], scenario)) result.self_noise_std[name] = vs.second;
 
   const bool noisy = scenario.noise.angle_random_walk_deg_rt_h > 0;
   for (std::size_t i = 0; i < terms.size(); ++i) {
@@ -281,8 +351,8 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
       for (std::size_t c = 0; c < 3; ++c) {
         ShiftMap& shift = m == 0 ? row.closed_form[c] : row.least_squares[c];
         auto& matters = m == 0 ? row.closed_form_matters[c] : row.least_squares_matters[c];
-        const auto base_estimates = estimates(runs[0][static_cast<std::size_t>(m)][c], scenario.gyro);
-        const auto row_estimates = estimates(runs[i + 1][static_cast<std::size_t>(m)][c], scenario.gyro);
+        const auto base_estimates = estimates(runs[0][static_cast<std::size_t>(m)][c], scenario);
+        const auto row_estimates = estimates(runs[i + 1][static_cast<std::size_t>(m)][c], scenario);
         for (const auto& [name, vs] : row_estimates) {
           for (const auto& [name0, vs0] : base_estimates) {
             if (name0 != name) continue;
@@ -299,8 +369,8 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
       }
     }
     if (!result.has_self) continue;
-    const auto base_self = estimates(self_runs[0], scenario.gyro);
-    for (const auto& [name, vs] : estimates(self_runs[i + 1], scenario.gyro))
+    const auto base_self = estimates(self_runs[0], scenario);
+    for (const auto& [name, vs] : estimates(self_runs[i + 1], scenario))
       for (const auto& [name0, vs0] : base_self) {
         if (name0 != name) continue;
         const double d = vs.first - vs0.first;

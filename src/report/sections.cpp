@@ -348,12 +348,22 @@ void positions(const json& result, Page& page, std::string& out) {
   json labels = json::array(), center = json::array(), low = json::array(), high = json::array(),
        tips = json::array();
   bool any_residual = false;
+  // The output's unit: deg/h for a gyro; an accelerometer's output (g in gyrocal's own record) shown in
+  // millionths, ug (docs/accelerometer.md), its spinning dwells' seven values per dwell being their harmonic
+  // content.
+  const json* sensor_j = find(result, "sensor");
+  const bool accelerometer =
+      sensor_j && sensor_j->is_string() && sensor_j->get<std::string>() == "accelerometer";
+  const std::string unit = accelerometer ? "\xC2\xB5g" : "deg/h";
+  const double scale = accelerometer ? 1e6 : 1.0;
+  const auto scaled = [scale](std::optional<double> v) { return v ? std::optional<double>(*v * scale) : v; };
   for (std::size_t k = 0; k < p.size(); ++k) {
     const std::string where = fmt::format("positions[{}]", k);
     expect(p[k], json::value_t::object, where);
     const json& q = p[k];
-    const auto index = number(q, "index", where), residual = number(q, "residual_deg_h", where),
-               std_err = number(q, "std_err_deg_h", where), mean = number(q, "mean_deg_h", where);
+    const auto index = number(q, "index", where), residual = scaled(number(q, "residual_deg_h", where)),
+               std_err = scaled(number(q, "std_err_deg_h", where)),
+               mean = scaled(number(q, "mean_deg_h", where));
     const int d = decimals_for(std_err);
     rows.push_back({num_cell(num(index)), num_cell(num(number(q, "beta_deg", where))),
                     num_cell(num(number(q, "gamma_deg", where))),
@@ -365,11 +375,11 @@ void positions(const json& result, Page& page, std::string& out) {
     center.push_back(opt_json(residual));
     low.push_back(residual && std_err ? json(*residual - *std_err) : json(nullptr));
     high.push_back(residual && std_err ? json(*residual + *std_err) : json(nullptr));
-    tips.push_back(fmt::format("position {}: residual {} \xC2\xB1 {} deg/h", num(index), fixed(residual, d),
-                               num(std_err, 2)));
+    tips.push_back(fmt::format("position {}: residual {} \xC2\xB1 {} {}", num(index), fixed(residual, d),
+                               num(std_err, 2), unit));
   }
-  out += table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, deg/h",
-                "standard error, deg/h", "samples", "residual, deg/h"},
+  out += table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, " + unit,
+                "standard error, " + unit, "samples", "residual, " + unit},
                rows);
   if (!any_residual) {
     out += "<p class=\"note\">The result gives no residuals, so none are plotted.</p>\n";
@@ -383,12 +393,17 @@ void positions(const json& result, Page& page, std::string& out) {
                             .center_label = "residual",
                             .band_label = "\xC2\xB1 1 standard error",
                             .xlabel = "position",
-                            .ylabel = "residual, deg/h"};
+                            .ylabel = "residual, " + unit};
   out += page.plot(chart.to_json(), 320, "residual of every reduced position with its standard error");
   out +=
       "<p class=\"note\">Measured mean output minus the fitted model at each position; bars span \xC2\xB1 "
       "one "
       "standard error of the mean.</p>\n";
+  if (accelerometer)
+    out +=
+        "<p class=\"note\">An accelerometer's spinning dwell is reduced to its whole harmonic content up to "
+        "order 3: its positions are the values at seven evenly spaced \xCE\xB3, so the residuals of one "
+        "dwell are its harmonic residuals (docs/accelerometer.md).</p>\n";
 }
 
 /// The rate errors of the gyro model drift+rate are least squares' alone (docs/physics.md section 15): the
@@ -542,7 +557,7 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
             "amount in the cell's tooltip. Colour: the shift in units of the estimate's noise standard "
             "uncertainty \xCF\x83 (red positive, blue negative, logarithmic); a cell near white is far below "
             "the "
-            "noise, a saturated one far above it. The three maps share one scale.</p>\n"
+            "noise, a saturated one far above it. The maps share one scale.</p>\n"
           : "<p class=\"note\">Each machine error alone, at the magnitude shown, shifts each estimate by the "
             "amount in the cell's tooltip (in the estimate's unit). Colour: the shift on a logarithmic scale "
             "over four decades below the largest (red positive, blue negative); the maps share one "
@@ -993,6 +1008,12 @@ bool has_provenance(const json& r) {
 
 // --- the page of a sensitivity study (`gyrocal sensitivity --json`) ---------------------------------
 
+/// True for a study of an accelerometer ("sensor": "accelerometer"): least squares alone, none and full.
+bool is_accelerometer(const json& s) {
+  const json* k = find(s, "sensor");
+  return k && k->is_string() && k->get<std::string>() == "accelerometer";
+}
+
 /// The study's settings and the noise standard uncertainty of every estimate, the scale of the heat maps.
 void sensitivity_settings(const json& s, Page&, std::string& out) {
   std::vector<std::vector<Cell>> rows;
@@ -1005,6 +1026,24 @@ void sensitivity_settings(const json& s, Page&, std::string& out) {
   if (const json* g = find(s, "gyro_model"))
     rows.push_back({text_cell("gyro model of least squares"), text_cell(scalar_text(*g))});
   out += table({"", ""}, rows, "compact");
+  if (is_accelerometer(s)) {
+    // An accelerometer's study: least squares alone, the error not told and told (docs/accelerometer.md).
+    out +=
+        "<p class=\"note\">Which machine error moves which coefficient of the accelerometer: each machine "
+        "error of the configuration alone, at its configured magnitude (or a typical one where the "
+        "configuration has zero), shifts each coefficient of a noise-free least-squares calibration by the "
+        "exact amount shown, in the coefficient's unit, with the error <em>none</em> (not told the "
+        "calibration) and <em>full</em> (told) (docs/accelerometer.md).</p>\n";
+    std::vector<std::vector<Cell>> sigma_rows;
+    if (const json* sigma = find(s, "noise_std"); sigma && sigma->is_object()) {
+      for (const auto& name : ordered_keys(*sigma))
+        sigma_rows.push_back({text_cell(name), num_cell(num(number(*sigma, name, "noise_std"), 3)),
+                              text_cell(estimate_unit(s, s, name))});
+      out += "<h3>Noise standard uncertainty of each estimate</h3>\n";
+      out += table({"estimate", "\xCF\x83", "unit"}, sigma_rows, "compact");
+    }
+    return;
+  }
   out +=
       "<p class=\"note\">The seed paper's study (Wang &amp; Meng 2017; docs/physics.md section 10): each "
       "machine "
@@ -1086,7 +1125,9 @@ const Section kSensitivitySections[] = {
     {"study", "study", "The study", sensitivity_settings,
      [](const json& s) { return has(s, "threshold") || has(s, "noise_std"); }},
     {"sensitivity", "sensitivity", "Closed forms: shift of every estimate per machine error",
-     sensitivity_maps, [](const json& s) { return has(s, "rows"); }},
+     sensitivity_maps, [](const json& s) { return has(s, "rows") && !is_accelerometer(s); }},
+    {"sensitivity", "sensitivity", "Least squares: shift of every coefficient per machine error",
+     sensitivity_maps, [](const json& s) { return has(s, "rows") && is_accelerometer(s); }},
     {"least_squares", "least-squares", "Least squares: the estimates each machine error shifts",
      sensitivity_least_squares, has_least_squares_matters},
 };

@@ -37,7 +37,11 @@ nlohmann::json montecarlo_to_json(const MonteCarloResult& r) {
     j["budget"][e.name] = budget;
   }
   // docs/physics.md section 15: the gyro model, and the rate errors the plan cannot identify with the reason.
-  j["gyro_model"] = to_string(r.gyro_model);
+  // An accelerometer's result names its sensor instead (its coefficients in their units).
+  if (r.sensor == SensorKind::kGyro)
+    j["gyro_model"] = to_string(r.gyro_model);
+  else
+    j["sensor"] = std::string(to_string(r.sensor));
   if (r.gyro_model == GyroModel::kDriftRate || !r.not_identifiable.empty()) {
     j["not_identifiable"] = nlohmann::json::object();
     for (const auto& [name, reason] : r.not_identifiable) j["not_identifiable"][name] = reason;

@@ -15,8 +15,20 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
                         {"value", row.value},
                         {"unit", row.term.unit},
                         {"typical", row.typical}};
+    // A sensor other than the gyro: least squares, compensations none and full only (no closed forms).
+    const bool gyro = r.sensor == SensorKind::kGyro;
     for (std::size_t c = 0; c < 3; ++c) {
       const char* comp = kCompensationNames[c];
+      if (!gyro) {
+        // Its one method's shifts are the study's: "shift" and "matters", as the gyro's closed forms'.
+        if (c == 1) continue;
+        j["shift"][comp] = nlohmann::json::object();
+        for (const std::string& name : r.least_squares_names)
+          if (const auto it = row.least_squares[c].find(name); it != row.least_squares[c].end())
+            j["shift"][comp][name] = it->second;
+        j["matters"][comp] = row.least_squares_matters[c];
+        continue;
+      }
       j["shift"][comp] = nlohmann::json::object();
       for (const std::string& name : r.closed_form_names)
         if (const auto it = row.closed_form[c].find(name); it != row.closed_form[c].end())
@@ -39,9 +51,18 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
     rows.push_back(std::move(j));
   }
   nlohmann::json out = {{"rows", rows}, {"threshold", r.threshold}};
+  if (r.sensor != SensorKind::kGyro) out["sensor"] = std::string(to_string(r.sensor));
   out["noise_std"] = nlohmann::json::object();
   for (const std::string& name : r.closed_form_names)
     out["noise_std"][name] = r.closed_form_noise_std.at(name);
+  if (r.sensor != SensorKind::kGyro) {
+    // An accelerometer: its least squares' noise std is the study's, its units its table's, and the
+    // coefficients the plan leaves unidentifiable are named (no shift, no noise std).
+    out["noise_std"] = r.least_squares_noise_std;
+    out["units"] = r.units;
+    out["not_identifiable"] = r.not_identifiable;
+    return out;
+  }
   out["least_squares_noise_std"] = nlohmann::json::object();
   for (const std::string& name : r.least_squares_names)
     out["least_squares_noise_std"][name] = r.least_squares_noise_std.at(name);

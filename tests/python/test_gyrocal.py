@@ -447,3 +447,55 @@ def test_estimate_gives_machine_errors(small):
     assert entry["unit"] == "arcsec"
     assert entry["identifiable"] is False
     assert "second non-zero speed" in entry["reason"]
+
+
+# --- an accelerometer (issue 19; docs/accelerometer.md) ---------------------------------------------------------
+
+ACCELEROMETER = """
+[sensor]
+kind = "accelerometer"
+
+[test]
+rates_rad_s = [0.0, 6.0, 12.0]
+revolutions = 4
+sample_rate_hz = 50.0
+static_hold_s = 2.0
+seed = 5
+
+[uncertainty]
+radius_error_m = 5e-6
+"""
+
+ACCELEROMETER_ORDER = ["K0", "K1", "K2", "K3", "Kip", "Kio", "Kpo", "Kpp", "Koo", "delta_p", "delta_o"]
+
+
+def test_an_accelerometer_simulates_and_calibrates_as_the_command_line(tmp_path):
+    # Two speeds and a static set: all eleven identifiable. The record's output column is accel_g, the
+    # coefficients come in the accelerometer's table order and units, from a path and from arrays alike.
+    config = tmp_path / "accel.toml"
+    config.write_text(ACCELEROMETER)
+    sc = gyrocal.Scenario.load(str(config))
+    record = tmp_path / "rec.csv"
+    run_cli("simulate", "--config", config, "--out", record)
+    header, expected_rows = read_record_csv(record)
+    rec = gyrocal.simulate(sc)
+    assert list(rec) == header == list(gyrocal.RECORD_COLUMNS[:4]) + ["accel_g"]
+    for name in header:
+        assert same_bits(rec[name], expected_rows[name]), name
+
+    expected = cli_result(run_cli("calibrate", record, "--config", config, "--estimate", "radius_error",
+                                  "--json", "-").stdout)
+    assert list(expected["coefficients"]) == ACCELEROMETER_ORDER
+    assert expected["sensor"] == "accelerometer"
+    from_path = gyrocal.calibrate(str(record), sc, estimate="radius_error")
+    assert from_path == expected
+    from_arrays = gyrocal.calibrate(rec, sc, estimate="radius_error")
+    name = expected.pop("record")
+    assert from_arrays.pop("record") == "<arrays>"
+    expected["warnings"] = [w.replace(name, "<arrays>") for w in expected["warnings"]]
+    assert from_arrays == expected
+    # Not vacuous: every coefficient identified, K1 near its truth of 1, the radius error estimated.
+    assert all(c["identifiable"] for c in from_arrays["coefficients"].values())
+    assert abs(from_arrays["coefficients"]["K1"]["value"] - 1.0) < 1e-4
+    assert [e["error"] for e in from_arrays["machine_errors"]] == ["radius_error"]
+    assert from_arrays["coefficients"]["delta_p"]["unit"] == "urad"

@@ -81,8 +81,11 @@ struct MonteCarloModel {
 };
 
 /// Linearise the scenario (about 2 evaluations of the exact model over the plan per source, in parallel; 4
-/// and 2 calibrations for a source that moves the encoder lines).
-/// Throws Error for options the calibration refuses.
+/// and 2 calibrations for a source that moves the encoder lines). A scenario of another sensor (an
+/// accelerometer) is linearised the same way on its planned test (analysis/estimates.hpp); its coefficients
+/// are ratios of the products, so M is their derivative (a central difference) and the fast mode is the delta
+/// method's first order. Throws Error for options the calibration refuses (compensation self for an
+/// accelerometer).
 MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOptions& options);
 
 struct EstimateDistribution {
@@ -106,6 +109,9 @@ struct EstimateDistribution {
 };
 
 struct MonteCarloResult {
+  /// Whose estimates: the gyro's, or an accelerometer's coefficients in their units (docs/accelerometer.md;
+  /// its noise source is its white noise, ug/sqrt(Hz), and bias instability).
+  SensorKind sensor = SensorKind::kGyro;
   long long trials = 0;
   MonteCarloMode mode = MonteCarloMode::kFast;
   std::uint64_t seed = 0;

@@ -87,6 +87,10 @@ inline const std::vector<std::string> kSelfCalibratedErrors = {
     "counter_perpendicularity_x", "counter_perpendicularity_y", "counter_rate_mismatch"};
 
 struct SensitivityResult {
+  /// Whose estimates. A sensor other than the gyro (an accelerometer) has least squares only, with
+  /// compensations none (the error not told) and full (told): closed_form_names is empty, and of each row's
+  /// least_squares only [0] and [2] are filled, in the coefficients' own units (docs/accelerometer.md).
+  SensorKind sensor = SensorKind::kGyro;
   std::vector<SensitivityRow> rows;
   std::vector<std::string> closed_form_names;    ///< in display order
   std::vector<std::string> least_squares_names;  ///< in display order
@@ -101,7 +105,8 @@ struct SensitivityResult {
   /// The gyro model least squares identified (SensitivityOptions::calibration.gyro_model).
   GyroModel gyro_model = GyroModel::kDrift;
   /// With drift+rate: each rate error (kRateTermNames) the plan leaves unidentifiable, with the reason
-  /// (CoefficientEstimate::reason). It has no shift and no noise std: a number there would mean nothing.
+  /// (CoefficientEstimate::reason); for an accelerometer, each coefficient the plan leaves unidentifiable. It
+  /// has no shift and no noise std: a number there would mean nothing.
   std::map<std::string, std::string> not_identifiable;
 };
 
@@ -110,6 +115,8 @@ struct SensitivityResult {
 /// (the compensation told that error), and, with two non-zero speeds, "self" (SensitivityRow::self). Least
 /// squares fits options.calibration.gyro_model.
 /// Throws Error if the plan lacks the 16 positions of docs/physics.md section 7 (the closed forms need them).
+/// A scenario of another sensor (an accelerometer: [sensor] kind) is studied by least squares alone, the
+/// error not told and told (SensitivityResult::sensor), on any plan.
 SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityOptions& options = {});
 
 }  // namespace gyrocal

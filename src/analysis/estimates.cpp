@@ -1,0 +1,130 @@
+#include "gyrocal/analysis/estimates.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/plan/positions.hpp"
+
+namespace gyrocal {
+
+std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Scenario& truth) {
+  std::vector<FlatEstimate> out;
+  // The true values of the sensor's table, in its order: what a combination's weights apply to.
+  std::vector<double> table_truth;
+  if (r.sensor == SensorKind::kGyro) {
+    table_truth.assign(truth.gyro.values.begin(), truth.gyro.values.end());
+    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+      if (r.coefficients[k].identifiable)
+        out.push_back({std::string(kCoefficientNames[k]), std::string(kCoefficientUnits[k]),
+                       r.coefficients[k].value, r.coefficients[k].std, truth.gyro.values[k]});
+    // docs/physics.md section 15: the rate errors, in ppm and arcsec, where the plan identifies them.
+    if (r.gyro_model == GyroModel::kDriftRate) {
+      const double rate_truths[kNumRateTerms] = {truth.gyro_rate.scale_factor_error_ppm,
+                                                 truth.gyro_rate.input_axis_misalignment_O_arcsec,
+                                                 truth.gyro_rate.input_axis_misalignment_S_arcsec};
+      for (std::size_t k = 0; k < kNumRateTerms; ++k)
+        if (r.rate_terms[k].identifiable)
+          out.push_back({std::string(kRateTermNames[k]), std::string(kRateTermUnits[k]),
+                         r.rate_terms[k].value, r.rate_terms[k].std, rate_truths[k]});
+    }
+    if (r.method == Method::kClosedForm) {
+      // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
+      const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
+                                                        {"dO_1g", Coefficient::dO},
+                                                        {"dS_1g", Coefficient::dS},
+                                                        {"dIS_b", Coefficient::dIS}};
+      for (const NamedEstimate& e : r.alternatives)
+        for (const auto& [n, c] : of)
+          if (e.name == n) out.push_back({e.name, e.unit, e.value, e.std, truth.gyro[c]});
+    }
+  } else {
+    // A sensor other than the gyro: its table (CalibrationResult::sensor_coefficients) and its truth.
+    const Sensor sensor = truth.sensor();
+    if (const auto* a = std::get_if<Accelerometer>(&sensor))
+      table_truth.assign(a->coefficients.values.begin(), a->coefficients.values.end());
+    table_truth.resize(r.sensor_coefficients.size(), 0.0);
+    for (std::size_t k = 0; k < r.sensor_coefficients.size(); ++k) {
+      const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+      if (c.identifiable) out.push_back({c.name, c.unit, c.value, c.std, table_truth[k]});
+    }
+  }
+  for (const NamedEstimate& e : r.combinations) {
+    double t = 0.0;
+    for (std::size_t k = 0; k < e.coefficients.size() && k < table_truth.size(); ++k)
+      t += e.coefficients[k] * table_truth[k];
+    out.push_back({e.name, e.unit, e.value, e.std, t, true});
+  }
+  return out;
+}
+
+GyroNoise output_noise(const Scenario& s) {
+  if (s.sensor_kind == SensorKind::kGyro) return s.noise;
+  GyroNoise g;
+  const double scale = 1e-6 * std::abs(s.accelerometer.coefficients[AccelCoefficient::K1]);
+  g.angle_random_walk_deg_rt_h = s.accelerometer.noise.velocity_random_walk_ug_rt_hz / 60.0 * scale;
+  g.bias_instability_deg_h = s.accelerometer.noise.bias_instability_ug * scale;
+  return g;
+}
+
+namespace {
+
+/// The planned reduction of `s`'s test with each spinning dwell reduced to spinning_gammas(test) (what a
+/// record's reduction gives; planned_reduction reduces a spinning dwell to gamma_rad where it does not
+/// already follow spinning_gammas).
+Reduction planned_spinning_reduction(const Scenario& s) {
+  Reduction out = planned_reduction(s);
+  const std::vector<double>& spinning = spinning_gammas(s.test);
+  bool changed = false;
+  for (Dwell& d : out.dwells) {
+    if (d.is_static || d.gammas_rad == spinning) continue;
+    changed = true;
+    d.gammas_rad = spinning;
+    d.gyro.value.assign(spinning.size(), 0.0);
+    d.gyro.std_err.assign(spinning.size(), 0.0);
+    d.gyro.samples.assign(spinning.size(), d.samples);
+  }
+  if (!changed) return out;
+  out.positions.clear();
+  for (const Position& p : test_positions(s.test))
+    for (std::size_t di = 0; di < out.dwells.size(); ++di) {
+      const Dwell& d = out.dwells[di];
+      if (d.planned_rate_rad_s != p.rate_rad_s || d.beta_rad != p.beta_rad ||
+          d.planned_counter_rate_offset_rad_s != p.counter_rate_offset_rad_s)
+        continue;
+      if (d.is_static && d.gammas_rad[0] != p.gamma_rad) continue;
+      out.positions.push_back(reduced_position(p, d, static_cast<int>(di)));
+      break;
+    }
+  return out;
+}
+
+}  // namespace
+
+PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& told,
+                                      const ReduceOptions& options) {
+  Scenario planned = s;
+  planned.test = reduction_plan(s.test, s.sensor_kind, options);
+  PlannedSensorTest p;
+  p.reduction = planned_spinning_reduction(planned);
+  const Sensor sensor = s.sensor();
+  // The sensor's truth on the true machine: known + sum_j u_j r_j, u its products.
+  const std::vector<PositionChannels> truth =
+      reduce_sensor_channels(p.reduction, s.model(), options, sensor, kMaxModelSamplesPerDwell);
+  Eigen::VectorXd u;
+  if (const auto* a = std::get_if<Accelerometer>(&sensor)) u = a->products();
+  for (std::size_t i = 0; i < p.reduction.positions.size(); ++i) {
+    const DesignRow& row = truth[i].sensor_exact;
+    double e = row.known;
+    for (std::size_t k = 0; k < row.size && static_cast<Eigen::Index>(k) < u.size(); ++k)
+      e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
+    p.reduction.positions[i].mean_deg_h = e;
+  }
+  set_predicted_std_errors(p.reduction, output_noise(s), s.test.sample_rate_hz, options);
+  p.channels = reduce_sensor_channels(p.reduction, told, options, sensor, kMaxModelSamplesPerDwell);
+  return p;
+}
+
+}  // namespace gyrocal
