@@ -1,10 +1,12 @@
 // Reduction of a record that is not clean (docs/physics.md section 14): spikes anywhere in the record, and
 // too few revolutions for the scatter between them to be a measurement.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/plan/timeline.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/rig_record.hpp"
@@ -221,6 +224,48 @@ TEST(Spikes, AStaticHoldRejectsASpikeToo) {
                   0.1 * ref.result.coefficients[k].std)
           << kCoefficientNames[k];
     }
+}
+
+/// Gaussian noise of unit variance from a fixed seed (Box-Muller on std::mt19937_64: the same on every
+/// platform).
+std::vector<double> unit_noise(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 engine(seed);
+  std::vector<double> z(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u1 = (static_cast<double>(engine() >> 11) + 0.5) * 0x1p-53;
+    const double u2 = static_cast<double>(engine() >> 11) * 0x1p-53;
+    z[i] = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+  }
+  return z;
+}
+
+// The rule settles most blocks from bounds of the median and the MAD (a histogram) without computing them
+// (docs/calibration.md, "Spikes"); a sample just beyond the threshold must still be found, one just within it
+// must not. Noise 0.01 deg/h on harmonics of tens of deg/h, 127 samples a revolution (blocks of two).
+TEST(Spikes, ASampleJustBeyondTheThresholdIsFoundOneWithinIsNot) {
+  const int per_rev = 127, revolutions = 12;
+  const std::size_t n = static_cast<std::size_t>(per_rev * revolutions);
+  const double sigma = 0.01, step = 2.0 * kPi / per_rev, dt = 0.005;
+  const std::vector<double> z = unit_noise(n, 17);
+  const auto run = [&](std::size_t at, double spike_sigmas) {
+    DwellAccumulator acc(ReduceOptions{}, {0.0, kPi / 2, kPi, 1.5 * kPi}, false, 1,
+                         dt * static_cast<double>(n), true);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double g = step * static_cast<double>(i);
+      double v = 30.0 * std::cos(g) - 12.0 * std::sin(2.0 * g) + 5.0 + sigma * z[i];
+      if (i == at) v += spike_sigmas * sigma;
+      acc.add(dt * static_cast<double>(i), g, &v);
+    }
+    return acc.finish(0).outliers;
+  };
+  EXPECT_EQ(run(n, 0.0), 0u);  // no spike: nothing lost
+  // 9 sigma (the MAD of 254 samples is within ~15 % of sigma): an outlier, in the first, a middle and the
+  // last block (tested by finish()); 4 sigma: none.
+  for (std::size_t at : {std::size_t{40}, n / 2 + 3, n - 5}) {
+    const double noise_there = z[at];
+    EXPECT_EQ(run(at, 9.0 - noise_there), 1u) << at;
+    EXPECT_EQ(run(at, 4.0 - noise_there), 0u) << at;
+  }
 }
 
 /// The spread of (estimate - truth) / std over seeds, for every identifiable coefficient and combination.

@@ -36,6 +36,34 @@ void harmonic_basis(double gamma_rad, int order, double* out) {
   }
 }
 
+namespace {
+
+template <int N>
+void add_outer_fixed(double* __restrict normal, const double* __restrict b) {
+  for (int j = 0; j < N; ++j) {
+    const double bj = b[j];
+    for (int i = j; i < N; ++i) normal[i + j * N] += b[i] * bj;
+  }
+}
+
+}  // namespace
+
+void add_outer_product(double* normal, const double* b, int n) {
+  switch (n) {
+    case 7:
+      return add_outer_fixed<7>(normal, b);
+    case 8:
+      return add_outer_fixed<8>(normal, b);
+    case 10:
+      return add_outer_fixed<10>(normal, b);
+    default:
+      for (int j = 0; j < n; ++j) {
+        const double bj = b[j];
+        for (int i = j; i < n; ++i) normal[i + j * n] += b[i] * bj;
+      }
+  }
+}
+
 // ---- RevolutionSums ---------------------------------------------------------------------------------------
 
 void RevolutionSums::add(double ti, const Eigen::VectorXd& vi) {
@@ -174,16 +202,16 @@ void HarmonicFit::basis(double gamma_rad, double t_scaled, double* out) const {
 }
 
 void HarmonicFit::add(double t_scaled, double gamma_rad, const double* values) {
-  ++samples_;
-  // The hot loop of a calibration: raw column-major storage, lower triangles only.
   double b[32];
   basis(gamma_rad, t_scaled, b);
+  add_basis(t_scaled, b, values);
+}
+
+void HarmonicFit::add_basis(double t_scaled, const double* b, const double* values) {
+  ++samples_;
+  // The hot loop of a calibration: raw column-major storage, lower triangles only.
   const int n = basis_size();
-  double* __restrict normal = normal_.data();
-  for (int j = 0; j < n; ++j) {
-    const double bj = b[j];
-    for (int i = j; i < n; ++i) normal[i + j * n] += b[i] * bj;
-  }
+  add_outer_product(normal_.data(), b, n);
   double* __restrict rhs = rhs_.data();
   for (int c = 0; c < columns_; ++c) {
     const double v = values[c];
@@ -191,11 +219,7 @@ void HarmonicFit::add(double t_scaled, double gamma_rad, const double* values) {
   }
   if (!with_periods_) return;
   const int nr = 2 * order_ + 1;
-  double* __restrict rev_n = rev_normal_.data();
-  for (int j = 0; j < nr; ++j) {
-    const double bj = b[j];
-    for (int i = j; i < nr; ++i) rev_n[i + j * nr] += b[i] * bj;
-  }
+  add_outer_product(rev_normal_.data(), b, nr);
   double* __restrict rev_rhs = rev_rhs_.data();
   for (int i = 0; i < nr; ++i) rev_rhs[i] += b[i] * values[0];
   ++rev_samples_;

@@ -182,7 +182,10 @@ class DwellAccumulator {
     double t, gamma, value;
     bool after_break;
   };
-  void accumulate(double time_s, double gamma_rad, const double* values, bool after_break);
+  /// basis: the outlier rule's detection basis at the sample (its first terms are a harmonic fit's basis), or
+  /// null.
+  void accumulate(double time_s, double gamma_rad, const double* values, bool after_break,
+                  const double* basis = nullptr);
   void test_block();
   void flush();
   int revolution_of(double gamma_rad) const;
@@ -224,6 +227,11 @@ class DwellAccumulator {
   Eigen::MatrixXd ref_normal_;
   Eigen::VectorXd ref_rhs_;
   double last_scale_ = 0.0;
+  // A block whose outliers were settled without its scale (none can lie beyond the threshold: test_block)
+  // keeps its residuals and absolute values, so that its scale is computed only if a short block needs it.
+  bool last_scale_pending_ = false;
+  std::vector<double> last_residuals_, last_abs_values_;
+  double last_scale();
   std::size_t outliers_ = 0;
   std::vector<double> scratch_basis_;  // the block's detection basis, sample by sample
 };

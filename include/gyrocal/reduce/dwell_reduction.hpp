@@ -25,6 +25,11 @@ struct DwellValues;    // reduce/dwell_accumulator.hpp
 /// method, the outlier rule's.
 void harmonic_basis(double gamma_rad, int order, double* out);
 
+/// normal += b b' on the lower triangle of an n x n column-major matrix: the normal equations' update of one
+/// sample, the hot loop of a calibration. Each element's sum is the one a plain double loop forms (the same
+/// products, added in the same order); the usual sizes (harmonic order 3: 7, 8, 10) are unrolled.
+void add_outer_product(double* normal, const double* b, int n);
+
 /// Per-revolution (or per-batch) values of column 0 at every gamma of a dwell, as sums for straight-line fits
 /// in time and their cross products: their scatter is the level of the reduced values' covariance
 /// (docs/calibration.md).
@@ -86,6 +91,9 @@ class HarmonicFit {
  public:
   HarmonicFit(std::vector<double> gammas_rad, int order, bool linear_drift, int columns, bool with_periods);
   void add(double t_scaled, double gamma_rad, const double* values);
+  /// add() with the basis at the sample already evaluated: b = basis(gamma_rad, t_scaled), basis_size()
+  /// values (the outlier rule evaluates it for its own fit, whose first terms are these: DwellAccumulator).
+  void add_basis(double t_scaled, const double* b, const double* values);
   /// `samples` samples at once, given by their sums: `normal` = sum b b' (basis_size() square, the lower
   /// triangle is read) and `rhs` = sum b v' (basis_size() x columns), b = basis(gamma, t_scaled) (identify/
   /// channels.hpp: the model's channels summed in closed form). No periods.
