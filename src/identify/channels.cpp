@@ -34,16 +34,9 @@ std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samp
   return at_least;  // not reached for >= 14 samples per revolution (reduce/feasibility.hpp)
 }
 
-/// The channels (kColumns values) of dwell d with the main axis at main_rad and the counter platform at
-/// counter_rad: the joints on the dwell's constant-rate lines fitted to the encoders (the measured rates);
-/// beta as planned (reduce/reducer.cpp: an encoder's mean at rest is biased by up to half a count).
-void evaluate_channels(const CentrifugeModel& model, const Dwell& d, double main_rad, double counter_rad,
-                       double* v) {
-  JointState j;
-  j.main_angle_rad = main_rad;
-  j.main_rate_rad_s = d.main.rate_rad_s;
-  j.counter_angle_rad = counter_rad;
-  j.counter_rate_rad_s = d.counter.rate_rad_s;
+/// The channels (kColumns values) of dwell d at joint state j; beta as planned (reduce/reducer.cpp: an
+/// encoder's mean at rest is biased by up to half a count).
+void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState j, double* v) {
   j.position_angle_rad = d.beta_rad;
   const GyroInputs exact = exact_inputs(model, j);
   const double offset = d.planned_counter_rate_offset_rad_s;
@@ -59,6 +52,18 @@ void evaluate_channels(const CentrifugeModel& model, const Dwell& d, double main
     v[kFirstRegressor + k] = re[k];
     v[kFirstRegressor + kNumCoefficients + k] = rn[k];
   }
+}
+
+/// The channels of dwell d with the main axis at main_rad and the counter platform at counter_rad, the
+/// joints on the dwell's constant-rate lines fitted to the encoders (the measured mean rates).
+void evaluate_channels(const CentrifugeModel& model, const Dwell& d, double main_rad, double counter_rad,
+                       double* v) {
+  JointState j;
+  j.main_angle_rad = main_rad;
+  j.main_rate_rad_s = d.main.rate_rad_s;
+  j.counter_angle_rad = counter_rad;
+  j.counter_rate_rad_s = d.counter.rate_rad_s;
+  evaluate_channels(model, d, j, v);
 }
 
 /// x reduced to [-pi, pi) with 2 pi split in two parts, so that an angle of thousands of revolutions keeps
@@ -241,6 +246,18 @@ class FourierChannels {
 
 namespace {
 
+/// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
+/// (docs/calibration.md, "The rate the channels follow"): where the spline departs from the line beyond the
+/// readings' scatter (its F-test), the encoder resolves the change (quanta_resolved), and what the line then
+/// misses of the specific force at the arm's radius R, the centripetal force's change 2 |w| dw R, the
+/// tangential acceleration R dw/dt and the direction's w^2 R dtheta, exceeds kMeasuredRateFloorG.
+bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d) {
+  const MeasuredMotion& m = d.measured;
+  if (m.empty() || !m.resolved || !m.quanta_resolved || m.stretch_phase.size() != d.stretches.size())
+    return false;
+  return measured_rate_effect_g(model, d) > kMeasuredRateFloorG;
+}
+
 /// The Fourier route for one dwell (FourierChannels) into `acc`, when its check holds, column by column: the
 /// channels' coefficients in the outer quarter of the band (max(|n|, |m|) > 3H/4) sum to at most
 ///   e x (coefficients in that quarter) / (2H + 1),
@@ -363,6 +380,34 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
 
 }  // namespace
 
+JointState measured_joints(const Dwell& d, std::size_t si, std::size_t i) {
+  const TimeStretch& s = d.stretches[si];
+  const MeasuredMotion& m = d.measured;
+  const double k = static_cast<double>(i);
+  const MeasuredState x = m.at(m.stretch_phase[si], s.first_time_s + k * m.grid_interval_s);
+  // The spline's abscissa advances by the planned interval a sample, the stretch's clock by its mean one.
+  const double scale = s.interval_s > 0.0 ? m.grid_interval_s / s.interval_s : 1.0;
+  const double dt = k * s.interval_s;
+  const double deviation = x.angle_rad - (s.main_at_first_rad + d.main.rate_rad_s * dt);
+  JointState j;
+  j.main_angle_rad = x.angle_rad;
+  j.main_rate_rad_s = x.rate_rad_s * scale;
+  j.main_accel_rad_s2 = x.accel_rad_s2 * scale * scale;
+  j.counter_angle_rad = s.counter_at_first_rad + d.counter.rate_rad_s * dt - deviation;
+  j.counter_rate_rad_s = d.counter.rate_rad_s - (j.main_rate_rad_s - d.main.rate_rad_s);
+  j.counter_accel_rad_s2 = -j.main_accel_rad_s2;
+  j.position_angle_rad = d.beta_rad;
+  return j;
+}
+
+double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d) {
+  const MeasuredMotion& m = d.measured;
+  const double radius = std::abs(model.geometry().radius_m + model.errors().radius_error_m);
+  const double w = std::abs(d.main.rate_rad_s);
+  return (2.0 * w * m.max_rate_deviation_rad_s + m.max_accel_rad_s2 + w * w * m.max_angle_deviation_rad) *
+         radius / kStandardGravityMS2;
+}
+
 std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                     const ReduceOptions& options,
                                                     std::size_t max_samples_per_dwell, ChannelRoute route,
@@ -379,6 +424,10 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     const auto evaluate = [&](double main_rad, double counter_rad, double* row) {
       evaluate_channels(model, d, main_rad, counter_rad, row);
     };
+    // A record's dwell whose arm departs from its line (a drive's ripple): every sample on the measured
+    // motion.
+    const bool follow = follows_measured_rate(model, d);
+    chosen[di].measured_rate = follow;
     // A planned dwell (no stretches: evenly spaced samples on the lines) summed on every sample or for a
     // prediction: in closed form, at a cost independent of its length (identify/planned_channels.hpp).
     if (route == ChannelRoute::kExact && d.stretches.empty() &&
@@ -388,7 +437,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     // Exact (every sample, the default): the same numbers by closed forms when the check holds.
     const bool exact_requested = options.model_samples_per_revolution == 0 &&
                                  (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
-    if (exact_requested && route == ChannelRoute::kExact &&
+    if (!follow && exact_requested && route == ChannelRoute::kExact &&
         reduce_by_fourier(model, d, options, acc, chosen[di])) {
       for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
       return;
@@ -434,11 +483,18 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       if (d.samples > 0) at(d.samples - 1);
     } else {
       // The dwell's own samples, stretch by stretch (gaps and dropped rows as the gyro output has them).
-      for (const TimeStretch& s : d.stretches) {
+      for (std::size_t si = 0; si < d.stretches.size(); ++si) {
+        const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
-          add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt,
-                     s.counter_at_first_rad + d.counter.rate_rad_s * dt);
+          const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
+          if (follow) {
+            // The operator's gamma stays the line's: only the joints the model is evaluated at move.
+            evaluate_channels(model, d, measured_joints(d, si, i), v);
+            acc.add(s.first_time_s + dt, -counter_line, v);
+          } else {
+            add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);
+          }
         };
         for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
         if (s.count > 0) at(s.count - 1);

@@ -177,6 +177,8 @@ struct Run {
   // (quantisation, jitter), to tell a wandering rate from it.
   double diff_yy = 0, diff_yt = 0, diff_tt = 0, diff_n = 0, prev_y = 0, prev_tt = 0;
   std::vector<StretchSums> stretches;
+  // The main axis' measured motion through the measured part (reduce/measured_rate.hpp): spinning dwells.
+  std::optional<MeasuredMotionFit> motion;
   double beta_sum = 0.0;
   std::size_t n = 0, gaps = 0;
   DwellQuality quality;
@@ -664,6 +666,14 @@ struct Reducer::State {
       r.phase_psi.emplace_back();
       r.phase_rel.emplace_back();
       r.stretches.push_back({u.t, u.t, 0, 0});
+      if (!r.match.is_static && r.match.planned_rate_rad_s != 0.0) {
+        const double gamma_rate =
+            std::abs(r.match.planned_rate_rad_s - r.match.planned_counter_rate_offset_rad_s);
+        r.motion.emplace(dt_planned, u.t, u.theta * kDegToRad, r.match.planned_rate_rad_s,
+                         kMeasuredKnotRevolutions * 2.0 * kPi / std::max(gamma_rate, 1e-9),
+                         r.planned_duration);
+        r.motion->begin_phase(u.t);
+      }
     } else if (gap || dropped) {
       if (r.stretches.size() >= static_cast<std::size_t>(options.max_stretches_per_dwell)) {
         end_run(fmt::format(
@@ -679,6 +689,7 @@ struct Reducer::State {
         r.phase_theta.emplace_back();
         r.phase_psi.emplace_back();
         r.phase_rel.emplace_back();
+        if (r.motion) r.motion->begin_phase(u.t);
       }
       r.stretches.push_back({u.t, u.t, 0, r.phase_theta.size() - 1});
     }
@@ -686,6 +697,9 @@ struct Reducer::State {
     if (st.count == 0) st.first = u.t;
     st.last = u.t;
     ++st.count;
+    // On the stretch's own grid: the stamps' jitter is the clock's reading error (docs/calibration.md).
+    if (r.motion)
+      r.motion->add(st.first + static_cast<double>(st.count - 1) * dt_planned, u.theta * kDegToRad);
     const double tt = u.t - r.t_first;
     const double planned_turn = r.match.planned_rate_rad_s * kRadToDeg * tt;
     const double y_theta = u.theta - r.theta_first - planned_turn;
@@ -876,6 +890,10 @@ struct Reducer::State {
       steps += st.count - 1;
     }
     d.sample_interval_s = steps > 0 ? span / static_cast<double>(steps) : dt_planned;
+    if (r.motion) {
+      d.measured = r.motion->finish();
+      for (const StretchSums& st : r.stretches) d.measured.stretch_phase.push_back(st.phase);
+    }
     const double beta_deg = d.beta_rad * kRadToDeg;
     const std::string what =
         d.is_static ? fmt::format("static hold at beta {:.4f} deg, gamma {:.4f} deg", beta_deg,

@@ -67,6 +67,7 @@ struct RigRow {
   double time_s = 0.0;
   double main_angle_deg = 0.0, counter_angle_deg = 0.0, position_angle_deg = 0.0;
   double output = 0.0;
+  JointState truth;  ///< the machine's true joints at the sample's instant (for tests of the model's side)
 };
 
 namespace rig_detail {
@@ -284,6 +285,7 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
           (std::floor(b / imp.position_count_deg) + (toggle(acquisition) ? 1.0 : 0.0));
     row.position_angle_deg = b + beta_read_offset;
     row.output = y;
+    row.truth = j;
     emit(row);
   }
 }

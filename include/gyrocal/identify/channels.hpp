@@ -68,7 +68,9 @@ enum class ChannelRoute {
 /// What was done for one dwell (reduce_model_channels' `routes`).
 struct DwellChannelsRoute {
   bool fourier = false;  ///< the closed forms were used
-  int harmonics = 0;     ///< H of the Fourier series tried last (0: not tried)
+  /// The joints followed the dwell's measured motion (Dwell::measured; every sample, no closed form).
+  bool measured_rate = false;
+  int harmonics = 0;  ///< H of the Fourier series tried last (0: not tried)
   /// Per channel column (omega exact, nominal, seed, 10 exact and 10 nominal regressors, omega_O, omega_S):
   /// the sum of |C_nm| over the outer quarter of the band (max(|n|, |m|) > 3H/4), and
   /// over all of it, in the column's unit.
@@ -77,6 +79,23 @@ struct DwellChannelsRoute {
   /// white_noise_gain); sqrt(samples x gain) bounds the operator's L1 norm sum_i |w_i|.
   std::vector<double> operator_gain;
 };
+
+/// Below this, in g, what a dwell's constant-rate line misses of the specific force (measured_rate_effect_g)
+/// is not worth following the measured motion: 1e-4 ug, the exactness asked of a noise-free accelerometer
+/// calibration, and far above the spline's rounding on a noise-free record.
+inline constexpr double kMeasuredRateFloorG = 1e-10;
+
+/// What dwell d's constant-rate line misses of the specific force at the arm's effective radius R, g, by the
+/// measured motion's largest departures from it (reduce/measured_rate.hpp): (2 |w| max|dw| + max|dw/dt| +
+/// w^2 max|dtheta|) R / g0. The centripetal force is first order in the rate: a ripple of 5e-5 at 12 g moves
+/// it by 1.2 mg.
+double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d);
+
+/// The joints the channels are evaluated at for the i-th sample of stretch `stretch` of a record's dwell d
+/// that follows its measured motion (d.measured, reduce/measured_rate.hpp): the main axis' angle, rate and
+/// acceleration from the spline; the counter platform turns back what the arm departs from its line (the
+/// heading stays on its line), beta as planned.
+JointState measured_joints(const Dwell& d, std::size_t stretch, std::size_t i);
 
 /// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
 /// the model evaluations of a spinning dwell (above) where a stride is configured; 0 (a calibration)

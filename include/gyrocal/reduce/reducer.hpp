@@ -14,6 +14,7 @@
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/record/record.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
+#include "gyrocal/reduce/measured_rate.hpp"
 
 namespace gyrocal {
 
@@ -73,6 +74,10 @@ struct Dwell {
   /// evaluated and reduced like the gyro output. Empty: `samples` evenly spaced instants (time_of_sample)
   /// on the lines `main` and `counter` (a planned dwell, analysis/predict).
   std::vector<TimeStretch> stretches;
+  /// The main axis' motion as its encoder measured it through the measured part (a spinning dwell of a
+  /// record; empty otherwise): what the channels follow where it departs from the line `main`
+  /// (identify/channels.hpp, docs/calibration.md).
+  MeasuredMotion measured;
   DwellQuality quality;
 
   /// The i-th of `samples` evenly spaced instants of the measured part (a dwell without stretches).

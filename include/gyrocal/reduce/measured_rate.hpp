@@ -1,0 +1,108 @@
+#pragma once
+// The main axis' motion as its encoder measures it through a dwell (docs/calibration.md, "The rate the
+// channels follow"): a smoothing cubic spline of the main angle against the sample grid, fitted streaming, so
+// that the model's channels can be evaluated at the angle, rate and angular acceleration the arm really had
+// at each sample (a drive's rate ripple moves an accelerometer's centripetal input at first order) rather
+// than on the dwell's constant-rate line. Physics-free: angles in rad, times in s.
+#include <cstddef>
+#include <vector>
+
+namespace gyrocal {
+
+/// The main axis at one instant, from the measured motion.
+struct MeasuredState {
+  double angle_rad = 0.0;     ///< theta, unwrapped on the dwell's reference
+  double rate_rad_s = 0.0;    ///< d theta / dt
+  double accel_rad_s2 = 0.0;  ///< d2 theta / dt2
+};
+
+/// One phase (the samples between two gaps: the encoder's phase is measured afresh after a gap) as a uniform
+/// cubic B-spline: theta(x) = reference(x) + sum_k c_k B_k((x - first_knot) / knot_interval).
+struct MeasuredPhase {
+  double first_knot_s = 0.0;
+  std::vector<double> coefficients;  ///< rad
+  /// The phase's own least-squares line of the same deviations: dev(x) = line_at + line_rate (x -
+  /// first_knot).
+  double line_at_rad = 0.0, line_rate_rad_s = 0.0;
+};
+
+/// A dwell's measured main-axis motion (empty `phases`: none was fitted, e.g. a static hold or a planned
+/// dwell). The fit's abscissa x of the i-th sample of a stretch is the stretch's first time stamp plus i
+/// sample intervals of the plan: the stamps' jitter and rounding are the clock's reading error, not the
+/// sampling instant (docs/calibration.md), so they do not enter the fit.
+struct MeasuredMotion {
+  double knot_interval_s = 0.0;  ///< h, s
+  double grid_interval_s = 0.0;  ///< the planned sample interval the abscissa advances by per sample, s
+  double origin_s = 0.0;         ///< reference(x) = origin_rad + reference_rate (x - origin_s)
+  double origin_rad = 0.0;
+  double reference_rate_rad_s = 0.0;
+  std::vector<MeasuredPhase> phases;
+  std::vector<std::size_t>
+      stretch_phase;  ///< per TimeStretch of the dwell: its phase (filled by the reducer)
+
+  std::size_t samples = 0;
+  /// RMS of the readings about the spline (quantisation, jitter of the angle), rad.
+  double residual_rad = 0.0;
+  /// Standard errors the readings' scatter leaves on the measured angle and rate at an interior point of the
+  /// longest phase (the spline's own noise; the rate's is what it adds to a centripetal force), rad, rad/s.
+  double angle_noise_rad = 0.0, rate_noise_rad_s = 0.0;
+  /// The largest |deviation| of the spline from its phase's straight line (angle, rate, acceleration): what a
+  /// constant-rate model misses.
+  double max_angle_deviation_rad = 0.0, max_rate_deviation_rad_s = 0.0, max_accel_rad_s2 = 0.0;
+  /// The F-test of the spline against the lines: the drop of the residual sum of squares in units of the
+  /// scatter, its degrees of freedom, and whether it exceeds dof + 8 sqrt(2 dof) (a ripple is resolved; white
+  /// noise alone passes that with probability below 1e-10).
+  double chi2 = 0.0, dof = 0.0;
+  bool resolved = false;
+  /// The largest |second difference| of successive readings on the grid, rad: at least one count of a
+  /// quantised encoder (the readings are whole counts, a smooth motion's second difference is far below one),
+  /// otherwise the scatter's extremes.
+  double count_bound_rad = 0.0;
+  /// The spline departs from the line by more than 0.6 x count_bound: a quantised encoder read at a rate
+  /// nearly commensurate with its count makes its rounding error a slow sawtooth of at most half a count,
+  /// which the F-test alone would take for a motion (a false alarm found at one rate in twenty).
+  bool quanta_resolved = false;
+
+  bool empty() const { return phases.empty(); }
+  /// The main axis at abscissa x in phase p (clamped to the phase's knots).
+  MeasuredState at(std::size_t phase, double x_s) const;
+};
+
+/// Streaming fit of MeasuredMotion: begin_phase() at the measured part's first sample and after every gap,
+/// add() every sample, finish() once. Memory: 5 numbers per knot.
+class MeasuredMotionFit {
+ public:
+  /// The knot interval: h = max(knot_interval_s, 16 sample intervals), shortened so that the planned span
+  /// (the measured part's planned duration; 0: none) holds a whole number of intervals. theta is fitted as
+  /// its deviation from reference(x). The reducer takes half a revolution of gamma
+  /// (kMeasuredKnotRevolutions): the readings' scatter near the revolution's harmonics, which a reduced value
+  /// picks up through the centripetal force, is what the measured rate must not carry (a cubic B-spline's
+  /// response vanishes at multiples of 1/h), while a rate change over a few revolutions is followed.
+  MeasuredMotionFit(double grid_interval_s, double origin_s, double origin_rad, double reference_rate_rad_s,
+                    double knot_interval_s, double span_s = 0.0);
+  void begin_phase(double x_s);
+  void add(double x_s, double theta_rad);
+  std::size_t phase() const { return phases_.empty() ? 0 : phases_.size() - 1; }
+  MeasuredMotion finish() const;
+
+ private:
+  struct Phase {
+    double first_knot = 0.0;
+    std::vector<double> band;  // 4 per knot: M(k, k + m), m = 0..3
+    std::vector<double> rhs;
+    double n = 0, sx = 0, sxx = 0, sy = 0, sxy = 0, syy = 0;
+    double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  // the last two samples
+  };
+  MeasuredMotion out_;
+  std::vector<Phase> phases_;
+};
+
+/// The spline's knot interval in revolutions of gamma (MeasuredMotionFit): half a revolution puts the
+/// B-splines' first zero of response at the revolution's second harmonic and follows a ripple of four
+/// revolutions' period to ~1 %; a whole revolution (zero at the first harmonic) followed a 0.37 Hz ripple at
+/// 1.6 revolutions a second too coarsely (tests/test_measured_rate.cpp: 5e-5 g reduced with exact encoders,
+/// against 4e-6 g at half a revolution and 2e-7 g at a quarter, whose noise with 2^16-count encoders was
+/// three times the half's).
+inline constexpr double kMeasuredKnotRevolutions = 0.5;
+
+}  // namespace gyrocal
