@@ -333,5 +333,41 @@ TEST(AccelerometerCalibrationCli, SimulateThenCalibrateGivesTheTableAndRefusesTh
   std::filesystem::remove_all(dir);
 }
 
+TEST(AccelerometerCalibrationCli, DemoRecoversTheTruthAndTheRadiusFromTheSensor) {
+  // `gyrocal demo --sensor accelerometer`: its record, result and report; each estimate within 5 sigma of the
+  // truth it prints beside (the simulated truth, an independent route), and the arm's 20 um radius error and
+  // 1e-7 m/(rad/s)^2 stretch (demo_accelerometer_scenario) measured by the sensor within 5 sigma.
+  const auto dir = test::fresh_test_folder("ademo");
+  const test::CliOutcome o = test::run_cli("demo --sensor accelerometer --out " + (dir / "d").string(), dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.out.find("the radius from the sensor"), std::string::npos) << o.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "d" / "record.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "d" / "report.html"));
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir / "d" / "result.json"));
+  EXPECT_EQ(j.at("sensor"), "accelerometer");
+  const Scenario s = demo_accelerometer_scenario();
+  for (const nlohmann::json& run : j.at("comparison")) {
+    for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+      const std::string name(kAccelerometerParameters[k].name);
+      const nlohmann::json& c = run.at("coefficients").at(name);
+      EXPECT_NEAR(c.at("value").get<double>(), s.accelerometer.coefficients.values[k],
+                  5.0 * c.at("std").get<double>())
+          << run.at("label") << " " << name;
+      EXPECT_EQ(j.at("truth").at(name).get<double>(), s.accelerometer.coefficients.values[k]);
+    }
+  }
+  const nlohmann::json& radius = j.at("radius_from_the_sensor");
+  ASSERT_EQ(radius.size(), 2u);
+  const double truth[2] = {s.errors.radius_error_m, s.errors.radius_stretch_m_per_rad2_s2};
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(radius[i].at("value").get<double>(), truth[i], 5.0 * radius[i].at("std").get<double>())
+        << radius[i].dump();
+    EXPECT_LT(radius[i].at("std").get<double>(), 0.1 * truth[i]) << radius[i].dump();
+  }
+  EXPECT_TRUE(j.contains("sensitivity"));
+  EXPECT_TRUE(j.contains("montecarlo"));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace gyrocal

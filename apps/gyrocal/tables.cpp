@@ -105,6 +105,28 @@ std::string result_table(const CalibrationResult& r) {
   return out;
 }
 
+std::string sensor_comparison_table(const std::vector<std::string>& labels,
+                                    const std::vector<CalibrationResult>& results,
+                                    std::span<const SensorParameter> parameters,
+                                    std::span<const double> truth) {
+  constexpr int kWidth = 30;
+  std::string out = fmt::format("{:<18}{:>12}", "", "truth");
+  for (const std::string& l : labels) out += fmt::format("{:>{}}", l, kWidth);
+  out += "\n";
+  for (std::size_t k = 0; k < parameters.size(); ++k) {
+    out += fmt::format("{:<18}{:>12.6g}", fmt::format("{} [{}]", parameters[k].name, parameters[k].unit),
+                       k < truth.size() ? truth[k] : NAN);
+    for (const CalibrationResult& r : results) {
+      std::string cell = "—";
+      for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+        if (c.name == parameters[k].name && c.identifiable) cell = format_value_std(c.value, c.std);
+      out += fmt::format("{:>{}}", cell, kWidth);
+    }
+    out += "\n";
+  }
+  return out;
+}
+
 std::string comparison_table(const std::vector<std::string>& labels,
                              const std::vector<CalibrationResult>& results, const DriftCoefficients* truth) {
   constexpr int kWidth = 24;

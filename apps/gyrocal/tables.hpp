@@ -1,11 +1,13 @@
 #pragma once
 // Text tables of results for the terminal. Formatting only.
+#include <span>
 #include <string>
 #include <vector>
 
 #include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/model/gyro.hpp"
+#include "gyrocal/sensor/sensor_model.hpp"
 
 namespace gyrocal::cli {
 
@@ -20,6 +22,13 @@ std::string result_table(const CalibrationResult& result);
 /// Several results side by side, with the truth in the first column when given.
 std::string comparison_table(const std::vector<std::string>& labels,
                              const std::vector<CalibrationResult>& results, const DriftCoefficients* truth);
+
+/// A sensor's coefficients (a table other than the gyro's: an accelerometer's K0 .. delta_o) for several
+/// results side by side, the truth (in the table's units and order) in the first column.
+std::string sensor_comparison_table(const std::vector<std::string>& labels,
+                                    const std::vector<CalibrationResult>& results,
+                                    std::span<const SensorParameter> parameters,
+                                    std::span<const double> truth);
 
 /// The Allan deviation with its bounds and dominant term, then the fitted terms with their uncertainties.
 std::string noise_table(const RecordNoise& result);

@@ -1432,7 +1432,10 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
   RecordReader reader(record_path, layout);
   reader.require_angles();  // a record of the output alone, or a layout's angle column missing
   CalibrationOptions o = options;
-  if (layout) o.output.scale = layout->output_scale_per_deg_h;
+  if (layout) {
+    o.output.scale_key = std::string(layout->output_scale_key());
+    o.output.scale = layout->output_scale();
+  }
   // The output's range is kept for the misfit's causes (identify/misfit.hpp: a flat top).
   // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_channels.hpp).
   const Reduction reduction =
@@ -1440,12 +1443,20 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
                     model.geometry().rate_rad_s, [&o](std::span<const RecordSample> rows) {
                       for (const RecordSample& s : rows) o.output.range.push(s.output);
                     });
-  // K1 is fitted on the record's output as read. The [record] output_scale_per_g of an accelerometer's layout
-  // (being added with the record mapping) multiplies it here into the rig's own units per g.
   const std::vector<PositionChannels> channels = options.sensor == SensorKind::kGyro
                                                      ? reduce_model_channels(reduction, model, options.reduce)
                                                      : model_channels(reduction, model, options);
-  return identify(reduction, channels, model, o);
+  CalibrationResult result = identify(reduction, channels, model, o);
+  // K1 is fitted on the record's output as read, in g. A rig's channel read through [record]
+  // output_scale_per_g (output units per g) has its scale factor in those units: K1 = scale x the fitted
+  // ratio (docs/contract.md); the other coefficients are ratios to K1 and do not change.
+  const double scale = output_scale_per_g(layout);
+  for (SensorCoefficientEstimate& c : result.sensor_coefficients) {
+    if (c.name != "K1") continue;
+    c.value *= scale;
+    c.std *= std::abs(scale);
+  }
+  return result;
 }
 
 std::string CalibrationResult::BriefReport() const {

@@ -244,8 +244,6 @@ class FourierChannels {
 
 }  // namespace
 
-namespace {
-
 /// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
 /// (docs/calibration.md, "The rate the channels follow"): where the spline departs from the line beyond the
 /// readings' scatter (its F-test), the encoder resolves the change (quanta_resolved), and what the line then
@@ -258,6 +256,7 @@ bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d) {
   return measured_rate_effect_g(model, d) > kMeasuredRateFloorG;
 }
 
+namespace {
 /// The Fourier route for one dwell (FourierChannels) into `acc`, when its check holds, column by column: the
 /// channels' coefficients in the outer quarter of the band (max(|n|, |m|) > 3H/4) sum to at most
 ///   e x (coefficients in that quarter) / (2H + 1),

@@ -34,9 +34,18 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, columns, d.planned_duration_s, false, sweep);
     std::vector<double> v(static_cast<std::size_t>(columns));
-    // The joints as identify/channels.cpp's evaluate_channels takes them: on the dwell's constant-rate lines
-    // fitted to the encoders, beta as planned. (When the channels follow the encoders' measured rate sample
-    // by sample, this is the one other place to change.)
+    // The joints as identify/channels.cpp takes them: on the dwell's constant-rate lines fitted to the
+    // encoders, beta as planned; or, where the drive's rate ripples (follows_measured_rate), the arm's
+    // measured motion (measured_joints: its angle, rate and angular acceleration at the sample), while the
+    // operator's gamma stays the line's. An accelerometer reads the centripetal force, first order in the
+    // rate.
+    const bool follow = follows_measured_rate(model, d);
+    const auto add_joints = [&](double t, const JointState& j, double gamma_rad) {
+      const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
+      v[0] = row.known;
+      for (std::size_t k = 0; k < row.size; ++k) v[k + 1] = row.regressors[k];
+      acc.add(t, gamma_rad, v.data());
+    };
     const auto add_sample = [&](double t, double main_rad, double counter_rad) {
       JointState j;
       j.main_angle_rad = main_rad;
@@ -44,10 +53,7 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       j.counter_angle_rad = counter_rad;
       j.counter_rate_rad_s = d.counter.rate_rad_s;
       j.position_angle_rad = d.beta_rad;
-      const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
-      v[0] = row.known;
-      for (std::size_t k = 0; k < row.size; ++k) v[k + 1] = row.regressors[k];
-      acc.add(t, -counter_rad, v.data());
+      add_joints(t, j, -counter_rad);
     };
     std::size_t stride = 1;
     const bool sweeps = d.planned_counter_rate_offset_rad_s != 0.0 && d.planned_rate_rad_s != 0.0;
@@ -70,11 +76,15 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       for (std::size_t i = 0; i + 1 < d.samples; i += stride) at(i);
       if (d.samples > 0) at(d.samples - 1);
     } else {
-      for (const TimeStretch& s : d.stretches) {
+      for (std::size_t si = 0; si < d.stretches.size(); ++si) {
+        const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
-          add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt,
-                     s.counter_at_first_rad + d.counter.rate_rad_s * dt);
+          const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
+          if (follow)
+            add_joints(s.first_time_s + dt, measured_joints(d, si, i), -counter_line);
+          else
+            add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);
         };
         for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
         if (s.count > 0) at(s.count - 1);

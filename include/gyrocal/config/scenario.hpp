@@ -68,4 +68,9 @@ Scenario default_accelerometer_scenario();
 /// machine error in [uncertainty] (docs/physics.md gives none; only the Monte Carlo budget uses them).
 Scenario demo_scenario();
 
+/// What `gyrocal demo --sensor accelerometer` runs: the default accelerometer scenario on an arm 20 um longer
+/// than nominal that stretches by 1e-7 m/(rad/s)^2, with the demo's [uncertainty] (10% of each machine error;
+/// the radius error known to 5 um, the stretch to 20%).
+Scenario demo_accelerometer_scenario();
+
 }  // namespace gyrocal

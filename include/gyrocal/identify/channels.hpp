@@ -97,6 +97,13 @@ double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d);
 /// heading stays on its line), beta as planned.
 JointState measured_joints(const Dwell& d, std::size_t stretch, std::size_t i);
 
+/// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
+/// (docs/calibration.md, "The rate the channels follow"): the spline departs from the line beyond the
+/// readings' scatter, the encoder resolves the change, and measured_rate_effect_g exceeds
+/// kMeasuredRateFloorG. The gyro's channels (reduce_model_channels) and a sensor's
+/// (identify/sensor_channels.hpp) follow it alike.
+bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d);
+
 /// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
 /// the model evaluations of a spinning dwell (above) where a stride is configured; 0 (a calibration)
 /// evaluates ReduceOptions::model_samples_per_revolution per revolution, however many revolutions. A dwell
