@@ -272,6 +272,40 @@ TEST(AccelerometerPlan, PredictsTheStdOfARecordsCalibrationAndNamesTheOneSpeedDi
   EXPECT_TRUE(said);
 }
 
+TEST(AccelerometerPlan, CountsTheBiasInstabilityAsTheSimulatedRecordsScatterShowsIt) {
+  // With a bias instability well above the white noise's share, the plan's std of each coefficient is the
+  // spread of the estimates over simulated records (an independent route: the simulator's Gauss-Markov
+  // draws), within the sampling error of 40 seeds' std (~11 %, bound 4x that); white noise alone would
+  // predict a std several times too small for K0.
+  Scenario s = accelerometer_scenario(true);
+  s.accelerometer.noise.bias_instability_ug = 40.0;
+  CalibrationOptions o;
+  o.sensor = SensorKind::kAccelerometer;
+  const CalibrationResult plan = predict_calibration(s, o);
+  Scenario white = s;
+  white.accelerometer.noise.bias_instability_ug = 0.0;
+  const CalibrationResult plan_white = predict_calibration(white, o);
+  constexpr int kSeeds = 40;
+  std::vector<double> sum(kNumAccelCoefficients, 0.0), sum2(kNumAccelCoefficients, 0.0);
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const CalibrationResult r = calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed)));
+    for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+      const double e = r.sensor_coefficients[k].value - truth_of(s, k);
+      sum[k] += e;
+      sum2[k] += e * e;
+    }
+  }
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const double mean = sum[k] / kSeeds;
+    const double spread = std::sqrt((sum2[k] - kSeeds * mean * mean) / (kSeeds - 1));
+    const SensorCoefficientEstimate& p = plan.sensor_coefficients[k];
+    EXPECT_NEAR(spread / p.std, 1.0, 0.45) << p.name << ": spread " << spread << ", plan " << p.std
+                                           << ", white only " << plan_white.sensor_coefficients[k].std;
+  }
+  const std::size_t k0 = static_cast<std::size_t>(AccelCoefficient::K0);
+  EXPECT_GT(plan.sensor_coefficients[k0].std, 2.0 * plan_white.sensor_coefficients[k0].std);
+}
+
 TEST(AccelerometerCalibration, TheGyrosRoutesAreRefusedNamingTheOption) {
   const Scenario s = accelerometer_scenario(false);
   const Reduction r = simulate_and_reduce(s, 1);

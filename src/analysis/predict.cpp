@@ -18,6 +18,7 @@
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/dwell_reduction.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
+#include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
@@ -590,10 +591,16 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
   std::vector<double*> stds;
   std::vector<double> base;
   std::vector<std::function<double(const CalibrationResult&)>> value_of;
-  for (std::size_t c = 0; c < kNumCoefficients; ++c)
+  for (std::size_t c = 0; c < kNumCoefficients && result.sensor == SensorKind::kGyro; ++c)
     if (result.coefficients[c].identifiable) {
       stds.push_back(&result.coefficients[c].std);
       value_of.push_back([c](const CalibrationResult& e) { return e.coefficients[c].value; });
+    }
+  // A sensor other than the gyro: its coefficients (an accelerometer's K0 .. delta_o).
+  for (std::size_t c = 0; c < result.sensor_coefficients.size(); ++c)
+    if (result.sensor_coefficients[c].identifiable) {
+      stds.push_back(&result.sensor_coefficients[c].std);
+      value_of.push_back([c](const CalibrationResult& e) { return e.sensor_coefficients[c].value; });
     }
   for (auto* list : {&result.combinations, &result.alternatives})
     for (NamedEstimate& est : *list) {
@@ -606,13 +613,18 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
       });
     }
   for (const auto& f : value_of) base.push_back(f(result));
+  // The gain of each estimate on each position's value, by a step of `step` in that value: 1 deg/h for the
+  // gyro's (its estimates are linear in the values); for an accelerometer, whose coefficients are ratios of
+  // its products (Kx = u_x / K1), a step of 1e-4 output units, small enough that the derivative's error
+  // (relative, of the step's order over a value of ~1 g) is far below a std's own precision.
+  const double step = result.sensor == SensorKind::kGyro ? 1.0 : 1e-4;
   Eigen::MatrixXd gain(static_cast<Eigen::Index>(stds.size()), np);
   for (Eigen::Index k = 0; k < np; ++k) {
     Reduction shifted = r;
-    shifted.positions[static_cast<std::size_t>(k)].mean_deg_h += 1.0;
+    shifted.positions[static_cast<std::size_t>(k)].mean_deg_h += step;
     const CalibrationResult e = identify(shifted, channels, model, options);
     for (std::size_t i = 0; i < stds.size(); ++i)
-      gain(static_cast<Eigen::Index>(i), k) = value_of[i](e) - base[i];
+      gain(static_cast<Eigen::Index>(i), k) = (value_of[i](e) - base[i]) / step;
   }
   for (std::size_t i = 0; i < stds.size(); ++i) {
     const Eigen::VectorXd g = gain.row(static_cast<Eigen::Index>(i)).transpose();
@@ -643,21 +655,32 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
     for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
     r.positions[i].mean_deg_h = e;
   }
-  // The white noise as the simulator draws it (simulate/accelerometer_noise.hpp): per sample N sqrt(fs) ug
-  // referred to the input, K1 times that in output units; the gyro's white term with that sample std.
-  GyroNoise white;
-  white.angle_random_walk_deg_rt_h =
-      a.noise.velocity_random_walk_ug_rt_hz * 1e-6 * std::abs(a.coefficients[AccelCoefficient::K1]) / 60.0;
-  set_predicted_std_errors(r, white, s.test.sample_rate_hz, options.reduce);
+  // The noise as the simulator draws it (simulate/accelerometer_noise.hpp): the gyro's generators in ug
+  // referred to the input (white, bias instability, quantization), K1 x 1e-6 times that in output units; its
+  // covariance through the reduction in closed form as the gyro's (coloured_noise_position_covariance).
+  GyroNoise noise = accelerometer_noise_as_generator_parameters(a.noise);
+  const double to_output = 1e-6 * std::abs(a.coefficients[AccelCoefficient::K1]);
+  noise.angle_random_walk_deg_rt_h *= to_output;
+  noise.bias_instability_deg_h *= to_output;
+  noise.quantization_deg_h *= to_output;
+  set_predicted_std_errors(r, noise, s.test.sample_rate_hz, options.reduce);
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
   CalibrationResult result = identify(r, channels, model, identify_options);
-  if (a.noise.bias_instability_ug > 0.0)
-    result.warnings.push_back(
-        "the predicted uncertainties count the accelerometer's white noise only: its bias instability adds "
-        "to "
-        "them.");
-  if (a.noise.velocity_random_walk_ug_rt_hz == 0.0)
+  if (a.noise.bias_instability_ug > 0.0 || a.noise.quantization_ug > 0.0) {
+    // The noise correlated across positions (the bias instability's), as the gyro's plan counts it: each
+    // estimate's variance g' C g over every position's covariance C.
+    bool complete = true;
+    const Eigen::MatrixXd covariance =
+        predicted_noise_position_covariance(r, options.reduce, noise, s.test.sample_rate_hz, &complete);
+    count_whole_noise(result, r, channels, model, identify_options, covariance);
+    if (!complete)
+      result.warnings.push_back(
+          "the predicted uncertainties leave out the bias instability and quantization of the dwells reduced "
+          "by the window mean; they add to them.");
+  }
+  if (a.noise.velocity_random_walk_ug_rt_hz == 0.0 && a.noise.bias_instability_ug == 0.0 &&
+      a.noise.quantization_ug == 0.0)
     result.warnings.push_back(
         "the configured accelerometer noise is zero: the predicted uncertainties are zero.");
   return result;
