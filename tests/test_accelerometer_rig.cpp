@@ -1,0 +1,271 @@
+// An accelerometer's rig-like records through the real path (issue 19, "Done when"; docs/accelerometer.md):
+// records of the test generator (tests/support/rig_record.hpp: its own order, ramps, extra dwell time, the
+// IEEE 1293 output at the exact specific force of its own joint states), written as a rig writes them (ms,
+// encoder counts, ';', a channel in mV/g with a zero offset), read through [record] and calibrated by
+// calibrate_record or the command line; the estimates against the generator's truth.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/model/machine_errors.hpp"
+#include "support/cli_run.hpp"
+#include "support/rig_record.hpp"
+
+namespace gyrocal {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The rig's channel: its true scale (the generator's K1, mV/g), the nominal scale a user configures and the
+/// zero offset (mV).
+constexpr double kTrueMilliVoltPerG = 2500.37;
+constexpr double kNominalMilliVoltPerG = 2500.0;
+constexpr double kZeroMilliVolt = 12.5;
+/// The main and counter encoders' counts per revolution, and the position encoder's (0.002 deg a count).
+constexpr double kPositionCounts = 180000.0;
+
+/// A small two-speed test on the default machine (its wobbles and runouts in the truth and the
+/// configuration alike): a static set at four gamma, 6 and 12 rad/s, four beta, 8 revolutions at 50 Hz, the
+/// default truth with K1 the rig's mV/g.
+Scenario rig_accelerometer(bool noisy) {
+  Scenario s = default_scenario();
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  s.accelerometer.coefficients[AccelCoefficient::K1] = kTrueMilliVoltPerG;
+  if (!noisy) s.accelerometer.noise = AccelerometerNoise{};
+  s.test.rates_rad_s = {0.0, 6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;
+  s.test.revolutions = 8;
+  s.test.sample_rate_hz = 50.0;
+  s.test.settle_s = 2.0;
+  s.test.static_hold_s = 2.0;
+  return s;
+}
+
+/// The rig's [record]: ms, encoder counts, ';', the channel in mV with its nominal scale and zero.
+std::string record_toml(double counts) {
+  return fmt::format(
+      "[sensor]\nkind = \"accelerometer\"\n[record]\ndelimiter = \";\"\ntime_column = \"t_ms\"\n"
+      "time_unit = \"ms\"\nmain_angle_column = \"theta\"\ncounter_angle_column = \"psi\"\n"
+      "position_angle_column = \"beta\"\nmain_counts_per_revolution = {:.0f}\n"
+      "counter_counts_per_revolution = {:.0f}\nposition_counts_per_revolution = {:.0f}\n"
+      "output_column = \"U_mV\"\noutput_scale_per_g = {}\noutput_offset = {}\n",
+      counts, counts, kPositionCounts, kNominalMilliVoltPerG, kZeroMilliVolt);
+}
+
+/// Every imperfection of the generator whose effect the calibration models exactly: its own order, ramps,
+/// jitter and rounded stamps (the reducer's uniform grid), encoder counts of `counts` a turn, a toggling
+/// position encoder, the drive's rate offset (the channels follow the measured rate), a gap, a clock jump,
+/// spikes, a beta glitch. No ripple (see ADriveRippleInflatesTheStdWhichCoversTheBiasItLeaves).
+testing::RigImperfections exactly_modelled(double counts) {
+  testing::RigImperfections imp = testing::every_imperfection();
+  imp.ripple = 0.0;
+  imp.angle_quantum_deg = 360.0 / counts;
+  imp.position_count_deg = 360.0 / kPositionCounts;
+  return imp;
+}
+
+/// Writes the generator's rows for `truth` as the rig's record file.
+void write_rig_record(const fs::path& path, const Scenario& truth, const testing::RigImperfections& imp,
+                      std::uint64_t seed, double counts) {
+  std::ofstream out(path);
+  out << "t_ms;theta;psi;beta;U_mV\n";
+  const double q = 360.0 / counts, qb = 360.0 / kPositionCounts;
+  testing::rig_rows(truth, imp, testing::RigMotion{}, seed, [&](const testing::RigRow& r) {
+    out << fmt::format("{:.17g};{:.0f};{:.0f};{:.0f};{:.17g}\n", r.time_s * 1e3,
+                       std::round(r.main_angle_deg / q), std::round(r.counter_angle_deg / q),
+                       std::round(r.position_angle_deg / qb), kZeroMilliVolt + r.output);
+  });
+}
+
+/// calibrate_record on the rig's file through its [record].
+CalibrationResult calibrate_rig(const fs::path& path, const Scenario& config, double counts,
+                                const std::vector<std::string>& estimate = {}) {
+  const Scenario rig = parse_scenario(record_toml(counts), "rig.toml");
+  CalibrationOptions o;
+  o.sensor = SensorKind::kAccelerometer;
+  if (!estimate.empty()) o.estimate = parse_machine_error_names(estimate, "test");
+  return calibrate_record(path.string(), config.model(), config.test, o, rig.record);
+}
+
+/// The tolerance of coefficient k noise-free: 1e-4 of its unit, K1 1e-9 relative.
+double noise_free_tolerance(std::size_t k) {
+  return k == 1 ? 1e-9 * kTrueMilliVoltPerG : 1e-4;
+}
+
+class AccelerometerRig : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::fresh_test_folder("arig"); }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(AccelerometerRig, NoiseFreeRecordGivesAllElevenAndK1InTheRigsMillivoltsPerG) {
+  // Encoders of 2^32 counts a turn: the line through a dwell's readings then misses the arm's phase by
+  // ~q / sqrt(12 N) ~ 1e-11 rad, which turns the first harmonic into delta_p, delta_o, Kip, Kio by far less
+  // than 1e-4 of their units (measured: 6e-6 urad of delta_p). With 2^20 counts the same record misses by
+  // 3e-3 urad of delta_p, 2e-3 ug/g^2 of Kip, Kio and Kpp, 2 nm of the radius: the rounding of the readings,
+  // not the calibration, is then what limits it. The truth's K1 is the generator's 2500.37 mV/g, the
+  // configured scale a nominal 2500: K1 comes back as the true scale (an independent route to
+  // output_scale_per_g x the fitted ratio).
+  const double counts = 4294967296.0;
+  const Scenario s = rig_accelerometer(false);
+  const fs::path path = dir_ / "rig.csv";
+  write_rig_record(path, s, exactly_modelled(counts), 1, counts);
+  const CalibrationResult r = calibrate_rig(path, s, counts);
+  ASSERT_EQ(r.sensor_coefficients.size(), kNumAccelCoefficients);
+  EXPECT_EQ(r.rank, 11);
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+    ASSERT_TRUE(c.identifiable) << c.name;
+    std::printf("%s: %.12g (truth %.12g)\n", c.name.c_str(), c.value, s.accelerometer.coefficients.values[k]);
+    EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], noise_free_tolerance(k)) << c.name;
+  }
+  EXPECT_NEAR(r.sensor_coefficients[1].value, kTrueMilliVoltPerG, 1e-9 * kTrueMilliVoltPerG);
+
+  // The radius error from the sensor: the truth's arm 30 um long, the configuration's nominal; through the
+  // command line (calibrate --estimate radius_error --json).
+  Scenario truth = s;
+  truth.errors.radius_error_m = 30e-6;
+  write_rig_record(dir_ / "radius.csv", truth, exactly_modelled(counts), 2, counts);
+  Scenario config = s;
+  config.record = parse_scenario(record_toml(counts), "rig.toml").record;
+  const test::CliOutcome o =
+      test::calibrate_in(dir_, "radius.csv", scenario_to_toml(config), " --estimate radius_error");
+  ASSERT_EQ(o.status, 0) << o.err;
+  const nlohmann::json j = nlohmann::json::parse(o.out);
+  ASSERT_EQ(j.at("machine_errors").size(), 1u);
+  const nlohmann::json& e = j.at("machine_errors").at(0);
+  EXPECT_EQ(e.at("error"), "radius_error");
+  ASSERT_TRUE(e.at("identifiable").get<bool>()) << e.dump();
+  std::printf("radius_error: %.6g (truth 30e-6 m, unit %s)\n", e.at("value").get<double>(),
+              e.at("unit").get<std::string>().c_str());
+  EXPECT_NEAR(e.at("value").get<double>(), 30e-6, 1e-10) << e.dump();
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const std::string name(kAccelerometerParameters[k].name);
+    EXPECT_NEAR(j.at("coefficients").at(name).at("value").get<double>(),
+                s.accelerometer.coefficients.values[k], noise_free_tolerance(k))
+        << name;
+  }
+}
+
+/// Mean and standard deviation of `v`.
+std::pair<double, double> mean_std(const std::vector<double>& v) {
+  const auto n = static_cast<double>(v.size());
+  double mean = 0.0, sq = 0.0;
+  for (double x : v) mean += x / n;
+  for (double x : v) sq += (x - mean) * (x - mean);
+  return {mean, std::sqrt(sq / (n - 1.0))};
+}
+
+TEST_F(AccelerometerRig, NoisyZScoresOfTheElevenAndTheRadiusErrorHaveUnitSpread) {
+  // 200 rig records (10 ug/sqrt(Hz), every exactly modelled imperfection, encoders of 2^24 counts a turn,
+  // whose phase miss ~1e-9 rad is far below the noise's), each calibrated with --estimate radius_error
+  // against a truth whose arm is 30 um long: (estimate - truth) / std spreads as a unit normal when the
+  // stated std is honest. The std of 200 unit normals lies in [0.9, 1.1] with probability ~0.95; the band is
+  // [0.85, 1.15], and the mean within 4 / sqrt(200) = 0.28.
+  const double counts = 16777216.0;
+  const Scenario config = rig_accelerometer(true);
+  Scenario truth = config;
+  truth.errors.radius_error_m = 30e-6;
+  const int seeds = 200;
+  std::vector<std::vector<double>> z(kNumAccelCoefficients + 1);
+  const fs::path path = dir_ / "rig.csv";
+  for (int seed = 1; seed <= seeds; ++seed) {
+    write_rig_record(path, truth, exactly_modelled(counts), static_cast<std::uint64_t>(seed), counts);
+    const CalibrationResult r = calibrate_rig(path, config, counts, {"radius_error"});
+    for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+      const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+      ASSERT_TRUE(c.identifiable) << c.name;
+      z[k].push_back((c.value - truth.accelerometer.coefficients.values[k]) / c.std);
+    }
+    ASSERT_EQ(r.machine_errors.size(), 1u);
+    ASSERT_TRUE(r.machine_errors[0].identifiable) << r.machine_errors[0].reason;
+    z.back().push_back((r.machine_errors[0].value - 30e-6) / r.machine_errors[0].std);
+  }
+  for (std::size_t k = 0; k <= kNumAccelCoefficients; ++k) {
+    const std::string name =
+        k < kNumAccelCoefficients ? std::string(kAccelerometerParameters[k].name) : "radius_error";
+    const auto [mean, sd] = mean_std(z[k]);
+    std::printf("%s: z mean %.3f, std %.3f over %d seeds\n", name.c_str(), mean, sd, seeds);
+    EXPECT_GE(sd, 0.85) << name;
+    EXPECT_LE(sd, 1.15) << name;
+    EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(seeds))) << name;
+  }
+}
+
+TEST_F(AccelerometerRig, ADriveRippleInflatesTheStdWhichCoversTheBiasItLeaves) {
+  // The same records (same noise: the generator draws it apart from the motion) with and without a drive
+  // ripple of 2e-4 at 0.37 Hz, 40 seeds. What is measured (docs/accelerometer.md, "The drive's ripple"): a
+  // reduced value's std comes from the output's scatter between revolutions, which the ripple's centripetal
+  // modulation (2 eps Ar: 5 mg at 12 g) inflates, so the stated std grows x10 to x105 while the estimates'
+  // scatter about their mean barely grows; and the channels following the measured motion leave a bias of up
+  // to ~22 of the smooth records' std (Kpp; Kio, delta_p, Kip ~10) on this short 50 Hz test. The inflated std
+  // covers that bias (every |z| < 0.8): nothing is stated wrongly, but the std is not the noise's. Making it
+  // honest needs both the scatter of the output minus the model and a closer following; until then this test
+  // pins what holds.
+  const double counts = 16777216.0;
+  const Scenario s = rig_accelerometer(true);
+  const int seeds = 40;
+  std::vector<std::vector<double>> z_rippled(kNumAccelCoefficients), inflation(kNumAccelCoefficients),
+      scatter_smooth(kNumAccelCoefficients), scatter_rippled(kNumAccelCoefficients);
+  std::vector<double> smooth_std_of(kNumAccelCoefficients, 0.0);
+  const fs::path path = dir_ / "rig.csv";
+  for (int seed = 1; seed <= seeds; ++seed) {
+    testing::RigImperfections imp = exactly_modelled(counts);
+    write_rig_record(path, s, imp, static_cast<std::uint64_t>(seed), counts);
+    const CalibrationResult smooth = calibrate_rig(path, s, counts);
+    imp.ripple = 2e-4;
+    write_rig_record(path, s, imp, static_cast<std::uint64_t>(seed), counts);
+    const CalibrationResult rippled = calibrate_rig(path, s, counts);
+    for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+      const double t = s.accelerometer.coefficients.values[k];
+      const SensorCoefficientEstimate &a = smooth.sensor_coefficients[k], &b = rippled.sensor_coefficients[k];
+      ASSERT_TRUE(b.identifiable) << b.name;
+      z_rippled[k].push_back((b.value - t) / b.std);
+      inflation[k].push_back(b.std / a.std);
+      scatter_smooth[k].push_back((a.value - t) / a.std);
+      scatter_rippled[k].push_back((b.value - t) / a.std);
+      smooth_std_of[k] += a.std / seeds;
+    }
+  }
+  // The ripple's deterministic part: a noise-free rippled record's errors, in the smooth records' std.
+  testing::RigImperfections imp = exactly_modelled(counts);
+  imp.ripple = 2e-4;
+  write_rig_record(path, rig_accelerometer(false), imp, 1, counts);
+  const CalibrationResult clean = calibrate_rig(path, rig_accelerometer(false), counts);
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const std::string name(kAccelerometerParameters[k].name);
+    const double bias = clean.sensor_coefficients[k].value - s.accelerometer.coefficients.values[k];
+    const auto [zm, zs] = mean_std(z_rippled[k]);
+    const double inflation_mean = mean_std(inflation[k]).first;
+    std::printf(
+        "%s: std inflated x%.1f; rippled z mean %.3f std %.3f; error in the smooth std: noise-free %.2f, "
+        "mean %.2f (smooth records %.2f), scatter %.2f (smooth %.2f)\n",
+        name.c_str(), inflation_mean, zm, zs, bias / smooth_std_of[k], mean_std(scatter_rippled[k]).first,
+        mean_std(scatter_smooth[k]).first, mean_std(scatter_rippled[k]).second,
+        mean_std(scatter_smooth[k]).second);
+    // What holds: every rippled estimate lies within its stated std (the ripple biases none beyond it) ...
+    for (double z : z_rippled[k]) EXPECT_LT(std::abs(z), 1.0) << name;
+    // ... the stated std is inflated, boundedly (measured x10 to x105) ...
+    EXPECT_GT(inflation_mean, 1.0) << name;
+    EXPECT_LT(inflation_mean, 200.0) << name;
+    // ... while the estimates' scatter about their mean barely grows (measured x0.95 to x1.5).
+    EXPECT_LT(mean_std(scatter_rippled[k]).second, 2.0 * mean_std(scatter_smooth[k]).second) << name;
+  }
+}
+
+}  // namespace
+}  // namespace gyrocal
