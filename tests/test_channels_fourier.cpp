@@ -14,6 +14,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
 namespace gyrocal {
@@ -151,6 +152,74 @@ TEST(FourierChannels, TakeEverySampleWhereTheSeriesCheckFails) {
   for (std::size_t i = 0; i < exact.size(); ++i) {
     EXPECT_EQ(exact[i].omega_exact_deg_h, every[i].omega_exact_deg_h);
     EXPECT_EQ(exact[i].regressors_exact, every[i].regressors_exact);
+  }
+}
+
+TEST(FourierChannels, AnAccelerometersDesignRowsEqualTheEverySampleOnesWithinTheirBound) {
+  // The accelerometer's design row (its known part and its regressors, polynomials of degree <= 3 in the
+  // specific force, g to g^3) on the same machine with large errors, static holds and two speeds, reduced to
+  // the whole harmonic content as `calibrate` does: each reduced column by closed forms within the bound the
+  // series states of the every-sample one, as the gyro's columns above.
+  Scenario s = two_speed_test(60);
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  s.accelerometer.noise = AccelerometerNoise{};
+  s.test.rates_rad_s = {0.0, 6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;
+  s.test.static_hold_s = 30.0;
+  set_large_errors(s, 3);
+  const ReduceOptions ro;
+  Reducer reducer(reduction_plan(s.test, SensorKind::kAccelerometer, ro), ro, "large_errors.csv",
+                  s.centrifuge.rate_rad_s);
+  SimulationOptions so;
+  so.seed = 3;
+  simulate(s, so, [&](const RecordSample& x) { reducer.push(x); });
+  const Reduction r = reducer.finish();
+  std::vector<DwellChannelsRoute> routes;
+  const auto fourier = reduce_sensor_channels(r, s.model(), ro, s.sensor(), 0, ChannelRoute::kExact, &routes);
+  const auto every = reduce_sensor_channels(r, s.model(), ro, s.sensor(), 0, ChannelRoute::kEverySample);
+  ASSERT_EQ(routes.size(), r.dwells.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < r.positions.size(); ++i) {
+    const ReducedPosition& p = r.positions[i];
+    const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
+    const DwellChannelsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
+    ASSERT_TRUE(route.fourier) << "position " << p.index << " (" << d.samples << " samples)";
+    const DesignRow& a = fourier[i].sensor_exact;
+    const DesignRow& b = every[i].sensor_exact;
+    ASSERT_EQ(a.size, b.size);
+    ASSERT_EQ(route.outer_tail.size(), a.size + 1);
+    const double l1 = std::sqrt(static_cast<double>(d.samples) *
+                                route.operator_gain[static_cast<std::size_t>(p.gamma_slot)]);
+    for (std::size_t c = 0; c <= a.size; ++c) {
+      const double x = c == 0 ? a.known : a.regressors[c - 1];
+      const double y = c == 0 ? b.known : b.regressors[c - 1];
+      // The aliased and truncated part (twice the outer band's sum) through the operator's L1 norm, plus the
+      // two sums' rounding: the every-sample route adds the dwell's samples one by one, whose rounding grows
+      // as (samples x 1.1e-16) of the column's scale (a static hold of 6000 like samples: 7e-13), at least
+      // 1e-13 as for the gyro's columns above.
+      const double rounding = std::max(1e-13, static_cast<double>(d.samples) * 1.1e-16);
+      const double bound = l1 * (2.0 * route.outer_tail[c] + rounding * route.scale[c]) + 1e-300;
+      worst = std::max(worst, std::abs(x - y) / bound);
+      EXPECT_LE(std::abs(x - y), bound)
+          << "position " << p.index << ", column " << c << ": " << x << " vs " << y;
+    }
+  }
+  std::printf("largest |fourier - every sample| / bound: %.3g (H = %d)\n", worst, routes.back().harmonics);
+  // The calibrations from the two: every coefficient the same to 1e-6 of its unit (ug, ug/g^n, urad), the
+  // scale to 1e-12; and the noise-free truth recovered as an accelerometer's calibration must (1e-4 of each
+  // unit, K1 1e-9).
+  CalibrationOptions o;
+  o.sensor = SensorKind::kAccelerometer;
+  const CalibrationResult cf = identify(r, fourier, s.model(), o);
+  const CalibrationResult ce = identify(r, every, s.model(), o);
+  ASSERT_EQ(cf.sensor_coefficients.size(), s.accelerometer.coefficients.values.size());
+  ASSERT_EQ(ce.sensor_coefficients.size(), cf.sensor_coefficients.size());
+  for (std::size_t k = 0; k < cf.sensor_coefficients.size(); ++k) {
+    const double x = cf.sensor_coefficients[k].value;
+    EXPECT_NEAR(x, ce.sensor_coefficients[k].value, k == 1 ? 1e-12 : 1e-6) << cf.sensor_coefficients[k].name;
+    EXPECT_NEAR(x, s.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4)
+        << cf.sensor_coefficients[k].name;
   }
 }
 

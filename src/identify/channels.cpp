@@ -136,44 +136,46 @@ std::vector<Run> runs_of(const Dwell& d) {
 /// docs/calibration.md, "The model's side of each position", states the bound.
 class FourierChannels {
  public:
-  FourierChannels(const CentrifugeModel& model, const Dwell& d, int harmonics)
+  FourierChannels(const DwellChannelEvaluator& evaluate, int column_count, int harmonics)
       : h_(harmonics),
         size_(2 * harmonics + 1),
-        coefficients_(static_cast<std::size_t>(size_ * size_ * kColumns)) {
+        columns_(column_count),
+        coefficients_(static_cast<std::size_t>(size_ * size_ * column_count)) {
+    const auto columns = static_cast<std::size_t>(columns_);
     const auto m = static_cast<std::size_t>(size_);
     // Samples on the grid theta_a = 2 pi a / M, psi_b = 2 pi b / M.
-    std::vector<double> grid(m * m * kColumns);
+    std::vector<double> grid(m * m * columns);
     for (std::size_t a = 0; a < m; ++a)
       for (std::size_t b = 0; b < m; ++b)
-        evaluate_channels(model, d, 2.0 * kPi * static_cast<double>(a) / size_,
-                          2.0 * kPi * static_cast<double>(b) / size_, &grid[(a * m + b) * kColumns]);
+        evaluate(2.0 * kPi * static_cast<double>(a) / size_, 2.0 * kPi * static_cast<double>(b) / size_,
+                 &grid[(a * m + b) * columns]);
     // e^{-j 2 pi q / M}, q = 0 .. M-1.
     std::vector<Complex> twiddle(m);
     for (std::size_t q = 0; q < m; ++q)
       twiddle[q] = std::polar(1.0, -2.0 * kPi * static_cast<double>(q) / size_);
     // Along theta, then along psi: F[n][b] = 1/M sum_a c_ab e^{-j n theta_a}, C[n][m] = 1/M sum_b F[n][b]
     // e^{-j m psi_b}.
-    std::vector<Complex> along(m * m * kColumns);
+    std::vector<Complex> along(m * m * columns);
     for (int n = -h_; n <= h_; ++n)
       for (std::size_t b = 0; b < m; ++b) {
-        Complex* out = &along[(index(n) * m + b) * kColumns];
+        Complex* out = &along[(index(n) * m + b) * columns];
         for (std::size_t a = 0; a < m; ++a) {
           const Complex w =
               twiddle[static_cast<std::size_t>(((n * static_cast<long>(a)) % size_ + size_) % size_)] /
               static_cast<double>(size_);
-          const double* c = &grid[(a * m + b) * kColumns];
-          for (int col = 0; col < kColumns; ++col) out[col] += w * c[col];
+          const double* c = &grid[(a * m + b) * columns];
+          for (std::size_t col = 0; col < columns; ++col) out[col] += w * c[col];
         }
       }
     for (int n = -h_; n <= h_; ++n)
       for (int k = -h_; k <= h_; ++k) {
-        Complex* out = &coefficients_[(index(n) * m + index(k)) * kColumns];
+        Complex* out = &coefficients_[(index(n) * m + index(k)) * columns];
         for (std::size_t b = 0; b < m; ++b) {
           const Complex w =
               twiddle[static_cast<std::size_t>(((k * static_cast<long>(b)) % size_ + size_) % size_)] /
               static_cast<double>(size_);
-          const Complex* f = &along[(index(n) * m + b) * kColumns];
-          for (int col = 0; col < kColumns; ++col) out[col] += w * f[col];
+          const Complex* f = &along[(index(n) * m + b) * columns];
+          for (std::size_t col = 0; col < columns; ++col) out[col] += w * f[col];
         }
       }
   }
@@ -181,15 +183,16 @@ class FourierChannels {
   /// Per column: the sum of |C_nm| over the outer quarter of the band (max(|n|, |m|) > 3H/4), and over all
   /// of it; the number of coefficients in that quarter.
   int tails(std::vector<double>& outer, std::vector<double>& all) const {
-    outer.assign(kColumns, 0.0);
-    all.assign(kColumns, 0.0);
+    const int columns = columns_;
+    outer.assign(static_cast<std::size_t>(columns), 0.0);
+    all.assign(static_cast<std::size_t>(columns), 0.0);
     int count = 0;
     for (int n = -h_; n <= h_; ++n)
       for (int k = -h_; k <= h_; ++k) {
         const bool out = 4 * std::max(std::abs(n), std::abs(k)) > 3 * h_;
         count += out ? 1 : 0;
         const Complex* c = at(n, k);
-        for (int col = 0; col < kColumns; ++col) {
+        for (int col = 0; col < columns; ++col) {
           all[static_cast<std::size_t>(col)] += std::abs(c[col]);
           if (out) outer[static_cast<std::size_t>(col)] += std::abs(c[col]);
         }
@@ -201,6 +204,7 @@ class FourierChannels {
   /// tsum[col] that of tau_i c_i with tau_i = alpha + beta i (the scaled time).
   void add_run(const Dwell& d, const Run& r, int order, double alpha, double beta, std::vector<Complex>& q,
                std::vector<double>& tsum) const {
+    const int columns = columns_;
     const double n_samples = static_cast<double>(r.count);
     const double wm = d.main.rate_rad_s, wc = d.counter.rate_rad_s;
     const double theta = reduce_angle(r.main_rad), psi = reduce_angle(r.counter_rad);
@@ -224,21 +228,23 @@ class FourierChannels {
         // e^{j k gamma} = e^{-j k psi}: the harmonic m - k of psi.
         for (int k = 0; k <= order; ++k) {
           const Complex w = p[index(n) * width + static_cast<std::size_t>(m - k + mk)];
-          Complex* out = &q[static_cast<std::size_t>(k * kColumns)];
-          for (int col = 0; col < kColumns; ++col) out[col] += c[col] * w;
+          Complex* out = &q[static_cast<std::size_t>(k * columns)];
+          for (int col = 0; col < columns; ++col) out[col] += c[col] * w;
         }
         const Complex w1 = p1[index(n) * width + static_cast<std::size_t>(m + mk)];
-        for (int col = 0; col < kColumns; ++col) tsum[static_cast<std::size_t>(col)] += (c[col] * w1).real();
+        for (int col = 0; col < columns; ++col) tsum[static_cast<std::size_t>(col)] += (c[col] * w1).real();
       }
   }
 
  private:
   std::size_t index(int n) const { return static_cast<std::size_t>(n + h_); }
   const Complex* at(int n, int m) const {
-    return &coefficients_[(index(n) * static_cast<std::size_t>(size_) + index(m)) * kColumns];
+    return &coefficients_[(index(n) * static_cast<std::size_t>(size_) + index(m)) *
+                          static_cast<std::size_t>(columns_)];
   }
   int h_;
   int size_;
+  int columns_;
   std::vector<Complex> coefficients_;  // [n][m][column]
 };
 
@@ -272,29 +278,32 @@ constexpr double kRegressorRounding = 2e-15;
 constexpr double kRateRounding = 2e-16;
 constexpr int kMaxFourierHarmonic = 64;
 
-bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
-                       DwellAccumulator& acc, DwellChannelsRoute& route) {
+}  // namespace
+
+bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
+                             DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
+                             const DwellChannelEvaluator& evaluate, DwellChannelsRoute& route) {
   const std::vector<Run> runs = runs_of(d);
   if (runs.empty()) return false;
   const int order = d.is_static ? 0 : options.harmonic_order;
   int harmonics = std::max(12, 8 * highest_error_harmonic(model.errors()) + 4);
-  // The closed forms cost about (2H+1)^2 (order + 2) kColumns operations a stretch; every sample about a
+  // The closed forms cost about (2H+1)^2 (order + 2) columns operations a stretch; every sample about a
   // model evaluation (~1000 operations) a sample: the cheaper route is taken.
   std::size_t total = 0;
   for (const Run& r : runs) total += r.count;
   for (int attempt = 0; attempt < 2 && harmonics <= kMaxFourierHarmonic; ++attempt, harmonics *= 2) {
     const double width = 2.0 * harmonics + 1.0;
     const double closed_cost =
-        width * width * (static_cast<double>(runs.size()) * (order + 2.0) * kColumns + 1000.0);
+        width * width * (static_cast<double>(runs.size()) * (order + 2.0) * columns + 1000.0);
     if (closed_cost > 1000.0 * static_cast<double>(total)) return false;
-    const FourierChannels fourier(model, d, harmonics);
+    const FourierChannels fourier(evaluate, columns, harmonics);
     std::vector<double> outer, all;
     const double outer_count = fourier.tails(outer, all);
     const double rates_deg_h =
         (std::abs(d.main.rate_rad_s) + std::abs(d.counter.rate_rad_s)) * kRadPerSecToDegPerHour;
     bool holds = true;
-    for (int c = 0; c < kColumns; ++c) {
-      const bool rate = c < kFirstRegressor || c >= kOmegaO;
+    for (int c = 0; c < columns; ++c) {
+      const bool rate = rate_column[static_cast<std::size_t>(c)];
       const double floor = rate ? kRateRounding * std::max(1.0, rates_deg_h)
                                 : kRegressorRounding * std::max(1.0, all[static_cast<std::size_t>(c)]);
       holds = holds && outer[static_cast<std::size_t>(c)] <= floor * outer_count / width;
@@ -309,8 +318,8 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
     const double t_first = runs.front().first_time_s;
     const Run& last = runs.back();
     const double t_last = last.first_time_s + static_cast<double>(last.count - 1) * last.interval_s;
-    std::vector<Complex> q(static_cast<std::size_t>((order + 1) * kColumns));
-    std::vector<double> tsum(kColumns, 0.0);
+    std::vector<Complex> q(static_cast<std::size_t>((order + 1) * columns));
+    std::vector<double> tsum(static_cast<std::size_t>(columns), 0.0);
     std::vector<Complex> e0(static_cast<std::size_t>(2 * order + 1)), e1(static_cast<std::size_t>(order + 1));
     double tt = 0.0;
     for (const Run& r : runs) {
@@ -329,8 +338,8 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
             beta * beta * (n - 1.0) * n * (2.0 * n - 1.0) / 6.0;
     }
     if (d.is_static) {
-      Eigen::MatrixXd rhs(1, kColumns);
-      for (int c = 0; c < kColumns; ++c) rhs(0, c) = q[static_cast<std::size_t>(c)].real();
+      Eigen::MatrixXd rhs(1, columns);
+      for (int c = 0; c < columns; ++c) rhs(0, c) = q[static_cast<std::size_t>(c)].real();
       acc.add_sums(t_first, t_last, total, Eigen::MatrixXd(), rhs);
     } else {
       const auto fit = std::get_if<HarmonicFit>(&acc.reduction());
@@ -342,7 +351,7 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
       const auto harmonic = [](int j) { return (j + 1) / 2; };
       const auto is_sine = [](int j) { return j > 0 && j % 2 == 0; };
       Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(size, size);
-      Eigen::MatrixXd rhs(size, kColumns);
+      Eigen::MatrixXd rhs(size, columns);
       for (int a = 0; a < harmonic_rows; ++a) {
         for (int b = 0; b < harmonic_rows; ++b) {
           const int ka = harmonic(a), kb = harmonic(b);
@@ -356,8 +365,8 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
           else
             normal(a, b) = 0.5 * (plus - diff).imag();
         }
-        const Complex* qa = &q[static_cast<std::size_t>(harmonic(a) * kColumns)];
-        for (int c = 0; c < kColumns; ++c) rhs(a, c) = is_sine(a) ? qa[c].imag() : qa[c].real();
+        const Complex* qa = &q[static_cast<std::size_t>(harmonic(a) * columns)];
+        for (int c = 0; c < columns; ++c) rhs(a, c) = is_sine(a) ? qa[c].imag() : qa[c].real();
       }
       if (fit->fits_drift()) {
         const int t = harmonic_rows;
@@ -366,7 +375,7 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
           normal(a, t) = normal(t, a) = is_sine(a) ? w.imag() : w.real();
         }
         normal(t, t) = tt;
-        for (int c = 0; c < kColumns; ++c) rhs(t, c) = tsum[static_cast<std::size_t>(c)];
+        for (int c = 0; c < columns; ++c) rhs(t, c) = tsum[static_cast<std::size_t>(c)];
       }
       acc.add_sums(t_first, t_last, total, normal, rhs);
     }
@@ -376,8 +385,6 @@ bool reduce_by_fourier(const CentrifugeModel& model, const Dwell& d, const Reduc
   }
   return false;
 }
-
-}  // namespace
 
 JointState measured_joints(const Dwell& d, std::size_t si, std::size_t i) {
   const TimeStretch& s = d.stretches[si];
@@ -413,6 +420,10 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
                                                     std::vector<DwellChannelsRoute>* routes) {
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
   std::vector<DwellChannelsRoute> chosen(reduction.dwells.size());
+  // The rates (deg/h): omega exact, nominal, seed, omega_O, omega_S; the rest are regressors (g, g^2).
+  std::vector<bool> rate_columns(kColumns, false);
+  for (int c = 0; c < kColumns; ++c)
+    rate_columns[static_cast<std::size_t>(c)] = c < kFirstRegressor || c >= kOmegaO;
   // Dwells are independent: one per thread, each writing its own slot (the same numbers for any number of
   // threads).
   parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
@@ -437,7 +448,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     const bool exact_requested = options.model_samples_per_revolution == 0 &&
                                  (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
     if (!follow && exact_requested && route == ChannelRoute::kExact &&
-        reduce_by_fourier(model, d, options, acc, chosen[di])) {
+        reduce_dwell_by_fourier(model, d, options, acc, kColumns, rate_columns, evaluate, chosen[di])) {
       for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
       return;
     }

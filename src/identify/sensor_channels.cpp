@@ -24,10 +24,15 @@ TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOpt
 
 std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                      const ReduceOptions& options, const Sensor& sensor,
-                                                     std::size_t max_samples_per_dwell) {
+                                                     std::size_t max_samples_per_dwell, ChannelRoute route,
+                                                     std::vector<DwellChannelsRoute>* routes) {
   const DesignRow probe = sensor_design_row(sensor, exact_inputs(model, JointState{}));
   const int columns = 1 + static_cast<int>(probe.size);
+  // The design row's known part and regressors are in the output's unit and its powers (g, g^2, g^3): no
+  // column is a difference of the joints' rates.
+  const std::vector<bool> rate_columns(static_cast<std::size_t>(columns), false);
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
+  std::vector<DwellChannelsRoute> chosen(reduction.dwells.size());
   parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
     const Dwell& d = reduction.dwells[di];
     // The reducer's operator, the heading's sweep at a counter rate offset included (as the gyro's channels).
@@ -40,6 +45,29 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     // operator's gamma stays the line's. An accelerometer reads the centripetal force, first order in the
     // rate.
     const bool follow = follows_measured_rate(model, d);
+    chosen[di].measured_rate = follow;
+    // Every sample asked for: the same sums by closed forms when the series' check holds
+    // (reduce_dwell_by_fourier; the joints on the dwell's lines, so not where they follow the measured
+    // motion).
+    const bool exact_requested = options.model_samples_per_revolution == 0 &&
+                                 (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
+    if (!follow && exact_requested && route == ChannelRoute::kExact) {
+      const DwellChannelEvaluator evaluate = [&](double main_rad, double counter_rad, double* row_out) {
+        JointState j;
+        j.main_angle_rad = main_rad;
+        j.main_rate_rad_s = d.main.rate_rad_s;
+        j.counter_angle_rad = counter_rad;
+        j.counter_rate_rad_s = d.counter.rate_rad_s;
+        j.position_angle_rad = d.beta_rad;
+        const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
+        row_out[0] = row.known;
+        for (std::size_t k = 0; k < row.size; ++k) row_out[k + 1] = row.regressors[k];
+      };
+      if (reduce_dwell_by_fourier(model, d, options, acc, columns, rate_columns, evaluate, chosen[di])) {
+        for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
+        return;
+      }
+    }
     const auto add_joints = [&](double t, const JointState& j, double gamma_rad) {
       const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
       v[0] = row.known;
@@ -92,6 +120,7 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     }
     for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
   });
+  if (routes) *routes = std::move(chosen);
   std::vector<PositionChannels> out;
   for (const ReducedPosition& p : reduction.positions) {
     const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];

@@ -3,6 +3,7 @@
 // 4) and nominal (section 5), evaluated on each dwell's samples and reduced by the very operator that reduced
 // the gyro output (reduce/dwell_accumulator.hpp).
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "gyrocal/model/centrifuge.hpp"
@@ -71,7 +72,8 @@ struct DwellChannelsRoute {
   /// The joints followed the dwell's measured motion (Dwell::measured; every sample, no closed form).
   bool measured_rate = false;
   int harmonics = 0;  ///< H of the Fourier series tried last (0: not tried)
-  /// Per channel column (omega exact, nominal, seed, 10 exact and 10 nominal regressors, omega_O, omega_S):
+  /// Per channel column (the gyro's: omega exact, nominal, seed, 10 exact and 10 nominal regressors, omega_O,
+  /// omega_S; another sensor's: its design row's known part, then its regressors):
   /// the sum of |C_nm| over the outer quarter of the band (max(|n|, |m|) > 3H/4), and
   /// over all of it, in the column's unit.
   std::vector<double> outer_tail, scale;
@@ -79,6 +81,20 @@ struct DwellChannelsRoute {
   /// white_noise_gain); sqrt(samples x gain) bounds the operator's L1 norm sum_i |w_i|.
   std::vector<double> operator_gain;
 };
+
+/// A dwell's channels (`columns` values into v) with the main axis at main_rad and the counter platform at
+/// counter_rad, rad, the other joints as the dwell has them (its lines' rates, beta as planned).
+using DwellChannelEvaluator = std::function<void(double main_rad, double counter_rad, double* v)>;
+
+/// The sums the reduction operator takes of a dwell's channels, from their Fourier series in the two joint
+/// angles summed over its samples in closed form (docs/calibration.md, "The model's side of each position"),
+/// added to `acc` (built with `columns` columns) when the series' check holds for every column; false when it
+/// does not or every sample costs less (`acc` untouched: the caller then takes every sample). The check's
+/// floor is the rate's rounding where rate_column[c] (deg/h), a regressor's otherwise. `route` says what was
+/// tried: H, the outer band's and the whole series' sums of |C_nm| per column, the operator's gains.
+bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
+                             DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
+                             const DwellChannelEvaluator& evaluate, DwellChannelsRoute& route);
 
 /// Below this, in g, what a dwell's constant-rate line misses of the specific force (measured_rate_effect_g)
 /// is not worth following the measured motion: 1e-4 ug, the exactness asked of a noise-free accelerometer

@@ -28,11 +28,17 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
 TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options);
 
 /// Channels of every position of `reduction`, in its order, for `sensor` on `model`: PositionChannels::
-/// sensor_exact holds the reduced design row (the gyro's fields zero). Every sample of a dwell is evaluated
-/// (its stretches as the output has them; a planned dwell's evenly spaced instants), or every k-th one as
-/// ReduceOptions::model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_channels).
+/// sensor_exact holds the reduced design row (the gyro's fields zero). Every sample of a dwell is reduced
+/// (its stretches as the output has them; a planned dwell's evenly spaced instants): by default (route
+/// kExact) from the design row's Fourier series in the two joint angles in closed form where its check holds
+/// (reduce_dwell_by_fourier, as the gyro's channels), else by evaluating every sample (kEverySample, or a
+/// dwell that follows its measured motion); or every k-th sample as ReduceOptions::
+/// model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_channels). `routes`, when
+/// given, receives what was done per dwell.
 std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
                                                      const ReduceOptions& options, const Sensor& sensor,
-                                                     std::size_t max_samples_per_dwell = 0);
+                                                     std::size_t max_samples_per_dwell = 0,
+                                                     ChannelRoute route = ChannelRoute::kExact,
+                                                     std::vector<DwellChannelsRoute>* routes = nullptr);
 
 }  // namespace gyrocal
