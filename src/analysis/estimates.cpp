@@ -7,6 +7,7 @@
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
+#include "gyrocal/simulate/accelerometer_noise.hpp"
 
 namespace gyrocal {
 
@@ -62,53 +63,22 @@ std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Sc
 
 GyroNoise output_noise(const Scenario& s) {
   if (s.sensor_kind == SensorKind::kGyro) return s.noise;
-  GyroNoise g;
+  // As the simulator draws it (simulate/accelerometer_noise.hpp): the gyro's generators in ug referred to the
+  // input, times K1 x 1e-6 in output units.
+  GyroNoise g = accelerometer_noise_as_generator_parameters(s.accelerometer.noise);
   const double scale = 1e-6 * std::abs(s.accelerometer.coefficients[AccelCoefficient::K1]);
-  g.angle_random_walk_deg_rt_h = s.accelerometer.noise.velocity_random_walk_ug_rt_hz / 60.0 * scale;
-  g.bias_instability_deg_h = s.accelerometer.noise.bias_instability_ug * scale;
+  g.angle_random_walk_deg_rt_h *= scale;
+  g.bias_instability_deg_h *= scale;
+  g.quantization_deg_h *= scale;
   return g;
 }
-
-namespace {
-
-/// The planned reduction of `s`'s test with each spinning dwell reduced to spinning_gammas(test) (what a
-/// record's reduction gives; planned_reduction reduces a spinning dwell to gamma_rad where it does not
-/// already follow spinning_gammas).
-Reduction planned_spinning_reduction(const Scenario& s) {
-  Reduction out = planned_reduction(s);
-  const std::vector<double>& spinning = spinning_gammas(s.test);
-  bool changed = false;
-  for (Dwell& d : out.dwells) {
-    if (d.is_static || d.gammas_rad == spinning) continue;
-    changed = true;
-    d.gammas_rad = spinning;
-    d.gyro.value.assign(spinning.size(), 0.0);
-    d.gyro.std_err.assign(spinning.size(), 0.0);
-    d.gyro.samples.assign(spinning.size(), d.samples);
-  }
-  if (!changed) return out;
-  out.positions.clear();
-  for (const Position& p : test_positions(s.test))
-    for (std::size_t di = 0; di < out.dwells.size(); ++di) {
-      const Dwell& d = out.dwells[di];
-      if (d.planned_rate_rad_s != p.rate_rad_s || d.beta_rad != p.beta_rad ||
-          d.planned_counter_rate_offset_rad_s != p.counter_rate_offset_rad_s)
-        continue;
-      if (d.is_static && d.gammas_rad[0] != p.gamma_rad) continue;
-      out.positions.push_back(reduced_position(p, d, static_cast<int>(di)));
-      break;
-    }
-  return out;
-}
-
-}  // namespace
 
 PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& told,
                                       const ReduceOptions& options) {
   Scenario planned = s;
   planned.test = reduction_plan(s.test, s.sensor_kind, options);
   PlannedSensorTest p;
-  p.reduction = planned_spinning_reduction(planned);
+  p.reduction = planned_reduction(planned);
   const Sensor sensor = s.sensor();
   // The sensor's truth on the true machine: known + sum_j u_j r_j, u its products.
   const std::vector<PositionChannels> truth =

@@ -12,13 +12,13 @@
 #include <Eigen/Cholesky>
 #include <limits>
 
+#include "gyrocal/analysis/estimates.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/dwell_reduction.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
-#include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "gyrocal/simulate/noise.hpp"
 
 namespace gyrocal {
@@ -655,14 +655,9 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
     for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
     r.positions[i].mean_deg_h = e;
   }
-  // The noise as the simulator draws it (simulate/accelerometer_noise.hpp): the gyro's generators in ug
-  // referred to the input (white, bias instability, quantization), K1 x 1e-6 times that in output units; its
+  // The noise as the simulator draws it, in output units (analysis/estimates.hpp output_noise); its
   // covariance through the reduction in closed form as the gyro's (coloured_noise_position_covariance).
-  GyroNoise noise = accelerometer_noise_as_generator_parameters(a.noise);
-  const double to_output = 1e-6 * std::abs(a.coefficients[AccelCoefficient::K1]);
-  noise.angle_random_walk_deg_rt_h *= to_output;
-  noise.bias_instability_deg_h *= to_output;
-  noise.quantization_deg_h *= to_output;
+  const GyroNoise noise = output_noise(s);
   set_predicted_std_errors(r, noise, s.test.sample_rate_hz, options.reduce);
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();

@@ -34,7 +34,7 @@ std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Sc
 /// The white and coloured noise of a sensor other than the gyro in its output units, as the parameters of
 /// the gyro's noise model that the prediction functions of analysis/predict.hpp take (per sample, the
 /// accelerometer's white noise is K1 N sqrt(fs) 1e-6 output units, which the angle random walk K1 N 1e-6 / 60
-/// gives; its bias instability K1 B 1e-6). The gyro: its [gyro.noise].
+/// gives; its bias instability K1 B 1e-6, its quantization K1 q 1e-6). The gyro: its [gyro.noise].
 GyroNoise output_noise(const Scenario& scenario);
 
 /// The planned test of `scenario`'s sensor other than the gyro: the dwells its record would give, reduced as
