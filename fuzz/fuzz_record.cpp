@@ -72,7 +72,7 @@ bool same_bits(const gyrocal::RecordSample& a, const gyrocal::RecordSample& b, s
   const auto eq = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
   if (!eq(a.time_s, b.time_s) || !eq(a.main_angle_deg, b.main_angle_deg) ||
       !eq(a.counter_angle_deg, b.counter_angle_deg) || !eq(a.position_angle_deg, b.position_angle_deg) ||
-      !eq(a.gyro_deg_h, b.gyro_deg_h))
+      !eq(a.output, b.output))
     return false;
   for (std::size_t i = 0; i < extra; ++i)
     if (!eq(a.extra[i], b.extra[i])) return false;
