@@ -114,6 +114,46 @@ void MeasuredMotionFit::begin_phase(double x_s) {
   phases_.back().first_knot = x_s;
 }
 
+namespace {
+
+/// The uniform cubic B-splines of `basis` as polynomials in t: b[a](t) = sum_k kSplinePoly[a][k] t^k / 6.
+constexpr double kSplinePoly[4][4] = {{1, -3, 3, -1}, {4, 0, -6, 3}, {1, 3, 3, -3}, {0, 0, 0, 1}};
+
+/// The products b[a] b[a + m] as polynomials of degree 6: kSplineProducts[a][m][k] / 36.
+struct SplineProducts {
+  double c[4][4][7] = {};
+  constexpr SplineProducts() {
+    for (int a = 0; a < 4; ++a)
+      for (int m = 0; a + m < 4; ++m)
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) c[a][m][i + j] += kSplinePoly[a][i] * kSplinePoly[a + m][j];
+  }
+};
+constexpr SplineProducts kSplineProducts;
+
+}  // namespace
+
+void MeasuredMotionFit::fold(Phase& p) {
+  if (p.t_moment[0] == 0.0) return;
+  const std::size_t j = p.interval;
+  if (p.rhs.size() < j + 4) {
+    p.rhs.resize(j + 4, 0.0);
+    p.band.resize(4 * (j + 4), 0.0);
+  }
+  for (std::size_t a = 0; a < 4; ++a) {
+    double r = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) r += kSplinePoly[a][k] * p.ty_moment[k];
+    p.rhs[j + a] += r / 6.0;
+    for (std::size_t m = 0; a + m < 4; ++m) {
+      double v = 0.0;
+      for (std::size_t k = 0; k < 7; ++k) v += kSplineProducts.c[a][m][k] * p.t_moment[k];
+      p.band[4 * (j + a) + m] += v / 36.0;
+    }
+  }
+  for (double& v : p.t_moment) v = 0.0;
+  for (double& v : p.ty_moment) v = 0.0;
+}
+
 void MeasuredMotionFit::add(double x_s, double theta_rad) {
   if (phases_.empty()) begin_phase(x_s);
   Phase& p = phases_.back();
@@ -121,17 +161,25 @@ void MeasuredMotionFit::add(double x_s, double theta_rad) {
   const double y = theta_rad - out_.origin_rad - out_.reference_rate_rad_s * (x_s - out_.origin_s);
   const double x = x_s - p.first_knot;
   const double u = std::max(0.0, x / h);
-  const auto j = static_cast<std::size_t>(std::floor(u));
-  if (p.rhs.size() < j + 4) {
-    p.rhs.resize(j + 4, 0.0);
-    p.band.resize(4 * (j + 4), 0.0);
+  const auto j = static_cast<std::size_t>(u);  // u >= 0: the truncation is the floor
+  if (j != p.interval) {
+    fold(p);
+    p.interval = j;
   }
-  double b[4], d1[4], d2[4];
-  basis(u - static_cast<double>(j), b, d1, d2);
-  for (std::size_t a = 0; a < 4; ++a) {
-    p.rhs[j + a] += b[a] * y;
-    for (std::size_t m = 0; a + m < 4; ++m) p.band[4 * (j + a) + m] += b[a] * b[a + m];
-  }
+  const double t = u - static_cast<double>(j), t2 = t * t, t3 = t2 * t;
+  double* tm = p.t_moment;
+  tm[0] += 1.0;
+  tm[1] += t;
+  tm[2] += t2;
+  tm[3] += t3;
+  tm[4] += t2 * t2;
+  tm[5] += t2 * t3;
+  tm[6] += t3 * t3;
+  double* ty = p.ty_moment;
+  ty[0] += y;
+  ty[1] += t * y;
+  ty[2] += t2 * y;
+  ty[3] += t3 * y;
   // Second differences of readings evenly spaced on the grid (a dropped row breaks the spacing).
   if (p.n >= 2 && std::abs((x - p.x1) - (p.x1 - p.x2)) < 1e-6 * out_.grid_interval_s)
     out_.count_bound_rad = std::max(out_.count_bound_rad, std::abs((y - p.y1) - (p.y1 - p.y2)));
@@ -145,7 +193,8 @@ void MeasuredMotionFit::add(double x_s, double theta_rad) {
   ++out_.samples;
 }
 
-MeasuredMotion MeasuredMotionFit::finish() const {
+MeasuredMotion MeasuredMotionFit::finish() {
+  for (Phase& p : phases_) fold(p);
   MeasuredMotion out = out_;
   const double h = out.knot_interval_s;
   double rss_line = 0.0, rss_spline = 0.0, parameters = 0.0, dof = 0.0;

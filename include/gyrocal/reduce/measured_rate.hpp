@@ -83,7 +83,8 @@ class MeasuredMotionFit {
   void begin_phase(double x_s);
   void add(double x_s, double theta_rad);
   std::size_t phase() const { return phases_.empty() ? 0 : phases_.size() - 1; }
-  MeasuredMotion finish() const;
+  /// The fitted motion (folds the moments of the intervals still open: call it once, at the end).
+  MeasuredMotion finish();
 
  private:
   struct Phase {
@@ -92,7 +93,15 @@ class MeasuredMotionFit {
     std::vector<double> rhs;
     double n = 0, sx = 0, sxx = 0, sy = 0, sxy = 0, syy = 0;
     double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  // the last two samples
+    // The knot interval the samples now go to, and their moments there: sum t^k (k = 0..6) and sum t^k y
+    // (k = 0..3), t the place in the interval. The B-splines are cubics in t, so these give the interval's
+    // terms of `band` and `rhs` exactly (up to rounding) when it is left (fold), at a fraction of evaluating
+    // the basis at every sample (it was a sixth of a calibration's reducer, docs/performance.md).
+    std::size_t interval = 0;
+    double t_moment[7] = {}, ty_moment[4] = {};
   };
+  /// Adds the current interval's moments of `p` into its band and right-hand side, and clears them.
+  static void fold(Phase& p);
   MeasuredMotion out_;
   std::vector<Phase> phases_;
 };
