@@ -191,9 +191,28 @@ HarmonicFit::HarmonicFit(std::vector<double> gammas_rad, int order, bool linear_
   const int n = basis_size();
   normal_ = Eigen::MatrixXd::Zero(n, n);
   rhs_ = Eigen::MatrixXd::Zero(n, columns_);
-  const int nr = 2 * order_ + 1;
-  rev_normal_ = Eigen::MatrixXd::Zero(nr, nr);
-  rev_rhs_ = Eigen::VectorXd::Zero(nr);
+  if (with_periods_) {
+    period_normal_ = Eigen::MatrixXd::Zero(n, n);
+    period_rhs_ = Eigen::MatrixXd::Zero(n, columns_);
+  }
+}
+
+Eigen::MatrixXd HarmonicFit::total_normal() const {
+  if (!with_periods_) return normal_;
+  return normal_ + period_normal_;
+}
+
+Eigen::MatrixXd HarmonicFit::total_rhs() const {
+  if (!with_periods_) return rhs_;
+  return rhs_ + period_rhs_;
+}
+
+void HarmonicFit::fold_period() {
+  if (!with_periods_) return;
+  normal_ += period_normal_;
+  rhs_ += period_rhs_;
+  period_normal_.setZero();
+  period_rhs_.setZero();
 }
 
 void HarmonicFit::basis(double gamma_rad, double t_scaled, double* out) const {
@@ -211,17 +230,13 @@ void HarmonicFit::add_basis(double t_scaled, const double* b, const double* valu
   ++samples_;
   // The hot loop of a calibration: raw column-major storage, lower triangles only.
   const int n = basis_size();
-  add_outer_product(normal_.data(), b, n);
-  double* __restrict rhs = rhs_.data();
+  add_outer_product(with_periods_ ? period_normal_.data() : normal_.data(), b, n);
+  double* __restrict rhs = with_periods_ ? period_rhs_.data() : rhs_.data();
   for (int c = 0; c < columns_; ++c) {
     const double v = values[c];
     for (int i = 0; i < n; ++i) rhs[i + c * n] += b[i] * v;
   }
   if (!with_periods_) return;
-  const int nr = 2 * order_ + 1;
-  add_outer_product(rev_normal_.data(), b, nr);
-  double* __restrict rev_rhs = rev_rhs_.data();
-  for (int i = 0; i < nr; ++i) rev_rhs[i] += b[i] * values[0];
   ++rev_samples_;
   rev_time_sum_ += t_scaled;
 }
@@ -235,8 +250,8 @@ void HarmonicFit::add_sums(std::size_t samples, const Eigen::MatrixXd& normal, c
 void HarmonicFit::close_period(RevolutionSums& scatter) {
   const int nr = 2 * order_ + 1;
   if (rev_samples_ >= static_cast<std::size_t>(2 * nr)) {
-    const Eigen::MatrixXd full = rev_normal_.selfadjointView<Eigen::Lower>();
-    const Eigen::VectorXd x = full.ldlt().solve(rev_rhs_);
+    const Eigen::MatrixXd full = period_normal_.topLeftCorner(nr, nr).selfadjointView<Eigen::Lower>();
+    const Eigen::VectorXd x = full.ldlt().solve(period_rhs_.col(0).head(nr));
     const double t_mean = rev_time_sum_ / static_cast<double>(rev_samples_);
     Eigen::VectorXd values(static_cast<Eigen::Index>(gammas_.size()));
     for (std::size_t k = 0; k < gammas_.size(); ++k) {
@@ -252,16 +267,15 @@ void HarmonicFit::close_period(RevolutionSums& scatter) {
 }
 
 void HarmonicFit::discard_period() {
-  rev_normal_.setZero();
-  rev_rhs_.setZero();
+  fold_period();
   rev_samples_ = 0;
   rev_time_sum_ = 0.0;
 }
 
 void HarmonicFit::values(int column, double t_mid, DwellValues& out) const {
   if (samples_ == 0) return;
-  const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
-  const Eigen::VectorXd x = full.ldlt().solve(rhs_.col(column));
+  const Eigen::MatrixXd full = total_normal().selfadjointView<Eigen::Lower>();
+  const Eigen::VectorXd x = full.ldlt().solve(total_rhs().col(column));
   const int n = basis_size();
   for (std::size_t k = 0; k < gammas_.size(); ++k) {
     double b[32];
@@ -276,7 +290,7 @@ void HarmonicFit::values(int column, double t_mid, DwellValues& out) const {
 std::vector<double> HarmonicFit::white_noise_gain(double t_mid) const {
   std::vector<double> gain(gammas_.size(), kNaN);
   if (samples_ == 0) return gain;
-  const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd full = total_normal().selfadjointView<Eigen::Lower>();
   const auto ldlt = full.ldlt();
   const int n = basis_size();
   for (std::size_t k = 0; k < gammas_.size(); ++k) {
@@ -290,7 +304,7 @@ std::vector<double> HarmonicFit::white_noise_gain(double t_mid) const {
 Eigen::MatrixXd HarmonicFit::white_noise_covariance(double t_mid) const {
   if (samples_ == 0) return diagonal_of(white_noise_gain(t_mid));
   const auto ng = static_cast<Eigen::Index>(gammas_.size());
-  const Eigen::MatrixXd full = normal_.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd full = total_normal().selfadjointView<Eigen::Lower>();
   Eigen::MatrixXd b(basis_size(), ng);
   for (Eigen::Index k = 0; k < ng; ++k) basis(gammas_[static_cast<std::size_t>(k)], t_mid, b.col(k).data());
   return b.transpose() * full.ldlt().solve(b);

@@ -120,11 +120,18 @@ class HarmonicFit {
   int columns_;
   bool with_periods_;
   std::size_t samples_ = 0;
+  /// The sums of the periods closed (or discarded) so far; with periods, those of the period in progress are
+  /// in period_normal_ and period_rhs_, whose harmonic part is also the revolution's own fit (without drift,
+  /// column 0): one outer product a sample serves both (docs/performance.md).
   Eigen::MatrixXd normal_;  // basis x basis
   Eigen::MatrixXd rhs_;     // basis x columns
-  // The revolution's fit without drift, column 0.
-  Eigen::MatrixXd rev_normal_;
-  Eigen::VectorXd rev_rhs_;
+  Eigen::MatrixXd period_normal_;
+  Eigen::MatrixXd period_rhs_;
+  /// normal_ and rhs_ with the period in progress added.
+  Eigen::MatrixXd total_normal() const;
+  Eigen::MatrixXd total_rhs() const;
+  /// Moves the period's sums into normal_ and rhs_.
+  void fold_period();
   std::size_t rev_samples_ = 0;
   double rev_time_sum_ = 0.0;
 };
