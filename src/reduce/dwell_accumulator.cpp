@@ -215,11 +215,13 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   t_last_ = t;
   gamma_last_ = gamma;
   ++samples_;
-  if (spinning_) seen_revolution_ = revolution_of(gamma);
+  // Its period, found once (revolution_of was 4 % of a calibration's time, computed twice a sample).
+  const int period = spinning_ ? revolution_of(gamma) : with_std_err_ ? period_of(t, gamma) : 0;
+  if (spinning_) seen_revolution_ = period;
   const bool after_break = break_next_;
   break_next_ = false;
   if (!robust_) {
-    accumulate(t, gamma, values, after_break);
+    accumulate(t, gamma, period, values, after_break);
     return;
   }
   // A block closes where a revolution begins (a static hold: anywhere) once it holds enough samples.
@@ -227,7 +229,7 @@ void DwellAccumulator::add(double t, double gamma, const double* values) {
   const bool boundary = !spinning_ || seen_revolution_ != block_revolution_;
   if ((boundary && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples) test_block();
   block_revolution_ = seen_revolution_;
-  pending_.push_back({t, gamma, values[0], after_break});
+  pending_.push_back({t, gamma, values[0], period, after_break});
 }
 
 void DwellAccumulator::add_sums(double first_time_s, double last_time_s, std::size_t samples,
@@ -263,6 +265,26 @@ void DwellAccumulator::test_block() {
   for (std::size_t i = 0; i < n; ++i)
     detection_basis(pending_[i].gamma, scaled_time(pending_[i].t), &scratch_basis_[i * pp]);
   const auto basis_of = [&](std::size_t i) { return &scratch_basis_[i * pp]; };
+  // Where the harmonic fit's basis is the detection basis (harmonics and drift, no sweep), the sums of b b'
+  // both fits need are formed once, per run of samples in one period (the fit's revolution sums need them
+  // apart), instead of an outer product per sample for each fit.
+  auto* const fit = std::get_if<HarmonicFit>(&reduction_);
+  const bool shared = fit != nullptr && spinning_ && fit->basis_size() == p;
+  std::vector<std::size_t> segment_first;
+  std::vector<double> segment_normal;
+  Eigen::MatrixXd block_normal;
+  if (shared) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i == 0 || pending_[i].period != pending_[i - 1].period) {
+        segment_first.push_back(i);
+        segment_normal.resize(segment_first.size() * pp * pp, 0.0);
+      }
+      add_outer_product(&segment_normal[(segment_first.size() - 1) * pp * pp], basis_of(i), p);
+    }
+    block_normal = Eigen::MatrixXd::Zero(p, p);
+    for (std::size_t k = 0; k < segment_first.size(); ++k)
+      block_normal += Eigen::Map<const Eigen::MatrixXd>(&segment_normal[k * pp * pp], p, p);
+  }
   const auto fit_at = [&](std::size_t i, const Eigen::VectorXd& x) {
     const double* b = basis_of(i);
     double v = 0.0;
@@ -307,13 +329,16 @@ void DwellAccumulator::test_block() {
   Eigen::MatrixXd normal;
   Eigen::VectorXd rhs;
   bool settled = false, scale_pending = false;
+  const Eigen::MatrixXd ref_normal_before = ref_normal_;
   for (int iteration = 0; iteration < 20; ++iteration) {
     normal = ref_normal_;
     rhs = ref_rhs_;
+    const bool any_out = std::find(out.begin(), out.end(), 1) != out.end();
+    if (shared && !any_out) normal += block_normal;
     for (std::size_t i = 0; i < n; ++i) {
       if (out[i]) continue;
       const double* b = basis_of(i);
-      add_outer_product(normal.data(), b, p);
+      if (!shared || any_out) add_outer_product(normal.data(), b, p);
       for (int j = 0; j < p; ++j) rhs[j] += b[j] * pending_[i].value;
     }
     const Eigen::MatrixXd full = normal.selfadjointView<Eigen::Lower>();
@@ -365,16 +390,22 @@ void DwellAccumulator::test_block() {
     ref_normal_ = std::move(normal);
     ref_rhs_ = std::move(rhs);
   }
+  // Every sample's b b' enters the reference sums (an outlier's with the fit's value in place of its own).
+  if (shared) ref_normal_ = ref_normal_before + block_normal;
+  std::size_t segment = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Pending& s = pending_[i];
     const double v = out[i] ? fit_at(i, x) : s.value;
     if (out[i]) ++outliers_;
     if (!settled || out[i]) {
       const double* b = basis_of(i);
-      add_outer_product(ref_normal_.data(), b, p);
+      if (!shared) add_outer_product(ref_normal_.data(), b, p);
       for (int j = 0; j < p; ++j) ref_rhs_[j] += b[j] * v;
     }
-    accumulate(s.t, s.gamma, &v, s.after_break, basis_of(i));
+    accumulate(s.t, s.gamma, s.period, &v, s.after_break, basis_of(i), !shared);
+    // A period's sums join the fit's once its first sample is in (after the period before was closed).
+    if (shared && segment < segment_first.size() && segment_first[segment] == i)
+      fit->add_normal_sum(&segment_normal[segment++ * pp * pp]);
   }
   pending_.clear();
 }
@@ -414,10 +445,9 @@ int DwellAccumulator::complete_revolutions() const {
   return seen_revolution_ + (last_revolution_complete() ? 1 : 0);
 }
 
-void DwellAccumulator::accumulate(double t, double gamma, const double* values, bool after_break,
-                                  const double* basis) {
+void DwellAccumulator::accumulate(double t, double gamma, int period, const double* values, bool after_break,
+                                  const double* basis, bool with_normal) {
   if (with_std_err_) {
-    const int period = period_of(t, gamma);
     if (period != period_) {
       std::visit(
           [&](auto& method) {
@@ -437,7 +467,8 @@ void DwellAccumulator::accumulate(double t, double gamma, const double* values, 
   // The outlier rule's basis begins with the harmonic fit's (harmonic_basis at gamma, then the scaled time):
   // evaluated once, not twice.
   if (basis != nullptr) {
-    if (auto* fit = std::get_if<HarmonicFit>(&reduction_)) return fit->add_basis(ts, basis, values);
+    if (auto* fit = std::get_if<HarmonicFit>(&reduction_))
+      return fit->add_basis(ts, basis, values, with_normal);
   }
   std::visit([&](auto& method) { method.add(ts, gamma, values); }, reduction_);
 }

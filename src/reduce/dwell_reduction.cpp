@@ -226,11 +226,11 @@ void HarmonicFit::add(double t_scaled, double gamma_rad, const double* values) {
   add_basis(t_scaled, b, values);
 }
 
-void HarmonicFit::add_basis(double t_scaled, const double* b, const double* values) {
+void HarmonicFit::add_basis(double t_scaled, const double* b, const double* values, bool with_normal) {
   ++samples_;
   // The hot loop of a calibration: raw column-major storage, lower triangles only.
   const int n = basis_size();
-  add_outer_product(with_periods_ ? period_normal_.data() : normal_.data(), b, n);
+  if (with_normal) add_outer_product(with_periods_ ? period_normal_.data() : normal_.data(), b, n);
   double* __restrict rhs = with_periods_ ? period_rhs_.data() : rhs_.data();
   for (int c = 0; c < columns_; ++c) {
     const double v = values[c];
@@ -239,6 +239,13 @@ void HarmonicFit::add_basis(double t_scaled, const double* b, const double* valu
   if (!with_periods_) return;
   ++rev_samples_;
   rev_time_sum_ += t_scaled;
+}
+
+void HarmonicFit::add_normal_sum(const double* lower) {
+  const int n = basis_size();
+  double* normal = with_periods_ ? period_normal_.data() : normal_.data();
+  for (int j = 0; j < n; ++j)
+    for (int i = j; i < n; ++i) normal[i + j * n] += lower[i + j * n];
 }
 
 void HarmonicFit::add_sums(std::size_t samples, const Eigen::MatrixXd& normal, const Eigen::MatrixXd& rhs) {

@@ -180,12 +180,14 @@ class DwellAccumulator {
  private:
   struct Pending {
     double t, gamma, value;
+    int period;
     bool after_break;
   };
-  /// basis: the outlier rule's detection basis at the sample (its first terms are a harmonic fit's basis), or
-  /// null.
-  void accumulate(double time_s, double gamma_rad, const double* values, bool after_break,
-                  const double* basis = nullptr);
+  /// period: period_of(time_s, gamma_rad). basis: the outlier rule's detection basis at the sample (its first
+  /// terms are a harmonic fit's basis), or null; with_normal false: the fit's b b' term is added by the
+  /// caller (HarmonicFit::add_normal_sum).
+  void accumulate(double time_s, double gamma_rad, int period, const double* values, bool after_break,
+                  const double* basis = nullptr, bool with_normal = true);
   void test_block();
   void flush();
   int revolution_of(double gamma_rad) const;
