@@ -22,19 +22,24 @@
 namespace gyrocal {
 namespace {
 
-/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
-/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
-/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
-/// a / 360, and a quotient that a / 360's rounding put on the wrong side of a half turn is corrected. Only
-/// exactly +-180 may come out with the other sign than remainder's.
-double wrap_deg_quick(double a) {
-  if (std::abs(a) <= 180.0) return a;
+/// wrap_deg_quick of an angle out of range: the rarer case, kept out of line so that the common one is
+/// inlined.
+[[gnu::noinline]] double wrap_deg_beyond(double a) {
   double r = a - 360.0 * std::nearbyint(a / 360.0);
   if (r > 180.0)
     r -= 360.0;
   else if (r < -180.0)
     r += 360.0;
   return r;
+}
+
+/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
+/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
+/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
+/// a / 360, and a quotient that a / 360's rounding put on the wrong side of a half turn is corrected. Only
+/// exactly +-180 may come out with the other sign than remainder's.
+[[gnu::always_inline]] inline double wrap_deg_quick(double a) {
+  return std::abs(a) <= 180.0 ? a : wrap_deg_beyond(a);
 }
 
 /// Straight-line fit of y against t, streaming, on deviations from a planned line (well conditioned).
@@ -1139,7 +1144,9 @@ constexpr std::size_t kReadAheadBatches = 4;
 /// (gyrocal::Error naming the file and line) is rethrown by next() where its row would have been.
 class ReadAhead {
  public:
-  explicit ReadAhead(RecordReader& reader) : reader_(reader), batches_(kReadAheadBatches) {
+  /// observe (may be empty) sees each batch on the reader's thread, before the caller does.
+  ReadAhead(RecordReader& reader, const std::function<void(std::span<const RecordSample>)>& observe)
+      : reader_(reader), observe_(observe), batches_(kReadAheadBatches) {
     for (auto& b : batches_) b.rows.resize(kReadAheadRows);
     thread_ = std::thread([this] { produce(); });
   }
@@ -1199,6 +1206,15 @@ class ReadAhead {
       } catch (...) {
         b.error = std::current_exception();
       }
+      // The observer's work (e.g. the output's range) is done here, beside the parsing, rather than on the
+      // reducer's thread, which is the slower of the two (docs/performance.md).
+      if (observe_ && b.count > 0) {
+        try {
+          observe_(std::span<const RecordSample>(b.rows.data(), b.count));
+        } catch (...) {
+          if (!b.error) b.error = std::current_exception();
+        }
+      }
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++filled_;
@@ -1211,6 +1227,7 @@ class ReadAhead {
   }
 
   RecordReader& reader_;
+  const std::function<void(std::span<const RecordSample>)>& observe_;
   std::vector<Batch> batches_;
   std::thread thread_;
   std::mutex mutex_;
@@ -1226,11 +1243,9 @@ Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const Reduce
                         const std::function<void(std::span<const RecordSample>)>& observe) {
   Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
   reducer.set_record_layout(reader.layout());
-  ReadAhead ahead(reader);
-  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next()) {
-    if (observe) observe(rows);
+  ReadAhead ahead(reader, observe);
+  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next())
     for (const RecordSample& s : rows) reducer.push(s);
-  }
   return reducer.finish();
 }
 

@@ -103,6 +103,7 @@ class MeasuredMotionFit {
   /// Adds the current interval's moments of `p` into its band and right-hand side, and clears them.
   static void fold(Phase& p);
   MeasuredMotion out_;
+  double inverse_knot_interval_ = 0.0;
   std::vector<Phase> phases_;
 };
 

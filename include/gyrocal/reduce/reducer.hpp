@@ -177,8 +177,8 @@ class Reducer {
 };
 
 /// Reduce a whole record file (streaming; the rows are read ahead on a thread of their own). `observe`, when
-/// given, sees every batch of rows before the reducer takes them (e.g. the output's range,
-/// identify/misfit.hpp).
+/// given, sees every batch of rows, in order, on the reader's thread (e.g. the output's range,
+/// identify/misfit.hpp): what it writes must not be read before reduce_record returns.
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s,
                         const std::function<void(std::span<const RecordSample>)>& observe = {});
