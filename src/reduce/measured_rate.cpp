@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace gyrocal {
 
@@ -163,7 +164,7 @@ void MeasuredMotionFit::add(double x_s, double theta_rad) {
   // x / h by a product (a division's latency was a third of this function's time): a sample within a
   // rounding of a knot may go to the interval on the other side, where the B-splines take the same values.
   const double u = std::max(0.0, x * inverse_knot_interval_);
-  const auto j = static_cast<std::size_t>(u);  // u >= 0: the truncation is the floor
+  const auto j = static_cast<std::size_t>(static_cast<std::int64_t>(u));  // u >= 0: truncation = floor
   if (j != p.interval) {
     fold(p);
     p.interval = j;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <exception>
 #include <map>
@@ -22,10 +23,20 @@
 namespace gyrocal {
 namespace {
 
-/// wrap_deg_quick of an angle out of range: the rarer case, kept out of line so that the common one is
-/// inlined.
-[[gnu::noinline]] double wrap_deg_beyond(double a) {
-  double r = a - 360.0 * std::nearbyint(a / 360.0);
+/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
+/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
+/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
+/// a / 360 or one off it, and a k that the quotient's rounding put on the wrong side of a half turn is
+/// corrected. Only exactly +-180 may come out with the other sign than remainder's. The common case is an
+/// unwrapped prediction minus a wrapped reading, out of range: k comes from a truncating conversion (a call
+/// of libm's nearbyint was 3 % of a calibration's time), nearbyint only beyond 2^50 turns.
+[[gnu::always_inline]] inline double wrap_deg_quick(double a) {
+  if (std::abs(a) <= 180.0) return a;
+  const double q = a * (1.0 / 360.0);
+  const double k = std::abs(q) < 0x1p50
+                       ? static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)))
+                       : std::nearbyint(q);
+  double r = a - 360.0 * k;
   if (r > 180.0)
     r -= 360.0;
   else if (r < -180.0)
@@ -33,14 +44,40 @@ namespace {
   return r;
 }
 
-/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
-/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
-/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
-/// a / 360, and a quotient that a / 360's rounding put on the wrong side of a half turn is corrected. Only
-/// exactly +-180 may come out with the other sign than remainder's.
-[[gnu::always_inline]] inline double wrap_deg_quick(double a) {
-  return std::abs(a) <= 180.0 ? a : wrap_deg_beyond(a);
-}
+/// A first-in first-out queue on one growing ring of slots: std::deque allocates a block every few elements
+/// of a large type (four of Run::Waiting), and the guard pushes and pops every row of a record.
+template <class T>
+class RingQueue {
+ public:
+  bool empty() const { return size_ == 0; }
+  std::size_t size() const { return size_; }
+  T& front() { return slots_[head_]; }
+  void push_back(const T& x) {
+    if (size_ == slots_.size()) grow();
+    slots_[(head_ + size_) & (slots_.size() - 1)] = x;
+    ++size_;
+  }
+  void pop_front() {
+    head_ = (head_ + 1) & (slots_.size() - 1);
+    --size_;
+  }
+  void clear() { head_ = size_ = 0; }
+  /// Calls f on each element, first to last.
+  template <class F>
+  void for_each(F f) const {
+    for (std::size_t i = 0; i < size_; ++i) f(slots_[(head_ + i) & (slots_.size() - 1)]);
+  }
+
+ private:
+  void grow() {
+    std::vector<T> bigger(std::max<std::size_t>(64, 2 * slots_.size()));
+    for (std::size_t i = 0; i < size_; ++i) bigger[i] = slots_[(head_ + i) & (slots_.size() - 1)];
+    slots_.swap(bigger);
+    head_ = 0;
+  }
+  std::vector<T> slots_;  // a power of two of them
+  std::size_t head_ = 0, size_ = 0;
+};
 
 /// Straight-line fit of y against t, streaming, on deviations from a planned line (well conditioned).
 struct LineSums {
@@ -168,7 +205,7 @@ struct Run {
     double t_record = 0.0;
     Deviations dev;
   };
-  std::deque<Waiting> guard;
+  RingQueue<Waiting> guard;
   Deviations steady_dev;  // the largest of the measured rows
   // A static hold's encoder readings (deg, unwrapped, from the lines at the end of its settle time): its
   // angles stay within beta_tolerance_deg of them.
@@ -782,14 +819,14 @@ struct Reducer::State {
       measure(w.u, w.gap, w.dropped, w.t_record);
     }
     if (!run) return;
-    for (const Run::Waiting& w : run->guard) {
+    run->guard.for_each([&](const Run::Waiting& w) {
       // Beyond the planned duration they would not have been measured anyway; before the match they are
       // settle rows.
       const bool beyond = run->measuring && w.u.t >= run->t_first + run->planned_duration - 1e-9;
       ++(!run->decided ? run->quality.settle_rows
          : beyond      ? run->quality.beyond_planned_rows
                        : run->quality.before_leaving_rows);
-    }
+    });
     run->guard.clear();
     Run r = std::move(*run);
     run.reset();
@@ -999,13 +1036,21 @@ void Reducer::set_record_layout(const std::optional<RecordLayout>& layout) {
 }
 
 void Reducer::push(const RecordSample& s) {
+  push_unsummarised(s);
+  state_->summary.add(s);
+}
+
+void Reducer::push_unsummarised(const RecordSample& s) {
   State& st = *state_;
   if (st.rows > 0 && !(s.time_s > st.t_last))
     throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
   ++st.rows;
   st.t_last = s.time_s;
-  st.summary.add(s);
   st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output});
+}
+
+void Reducer::set_summary(const RecordSummary& summary) {
+  state_->summary = summary;
 }
 
 Reduction Reducer::finish() {
@@ -1161,6 +1206,10 @@ class ReadAhead {
   ReadAhead(const ReadAhead&) = delete;
   ReadAhead& operator=(const ReadAhead&) = delete;
 
+  /// What the rows handed out so far hold, once next() returned the end of the record (the reader's thread
+  /// has stopped by then: the empty batch is its last).
+  const RecordSummary& summary() const { return summary_; }
+
   /// The next batch of rows (empty at the end of the record); valid until the next call.
   std::span<const RecordSample> next() {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -1206,8 +1255,9 @@ class ReadAhead {
       } catch (...) {
         b.error = std::current_exception();
       }
-      // The observer's work (e.g. the output's range) is done here, beside the parsing, rather than on the
-      // reducer's thread, which is the slower of the two (docs/performance.md).
+      // The record's summary and the observer's work (e.g. the output's range) are done here, beside the
+      // parsing, rather than on the reducer's thread, which is the slower of the two (docs/performance.md).
+      for (std::size_t i = 0; i < b.count; ++i) summary_.add(b.rows[i]);
       if (observe_ && b.count > 0) {
         try {
           observe_(std::span<const RecordSample>(b.rows.data(), b.count));
@@ -1228,6 +1278,7 @@ class ReadAhead {
 
   RecordReader& reader_;
   const std::function<void(std::span<const RecordSample>)>& observe_;
+  RecordSummary summary_;  // of every row read, written by the reader's thread only
   std::vector<Batch> batches_;
   std::thread thread_;
   std::mutex mutex_;
@@ -1245,7 +1296,8 @@ Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const Reduce
   reducer.set_record_layout(reader.layout());
   ReadAhead ahead(reader, observe);
   for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next())
-    for (const RecordSample& s : rows) reducer.push(s);
+    for (const RecordSample& s : rows) reducer.push_unsummarised(s);
+  reducer.set_summary(ahead.summary());
   return reducer.finish();
 }
 

@@ -15,6 +15,7 @@
 #include "gyrocal/record/record.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/reduce/measured_rate.hpp"
+#include "gyrocal/reduce/record_summary.hpp"
 
 namespace gyrocal {
 
@@ -165,6 +166,11 @@ class Reducer {
   Reducer& operator=(const Reducer&) = delete;
 
   void push(const RecordSample& sample);
+  /// push() for a caller that keeps the record's summary itself (reduce_record does, on its reader's
+  /// thread) and hands it over with set_summary() before finish().
+  void push_unsummarised(const RecordSample& sample);
+  /// What the record holds, for finish()'s refusal (replaces what push() gathered).
+  void set_summary(const RecordSummary& summary);
   /// The layout the record was read through (nullopt: gyrocal's own format), for the message of finish()
   /// only: it names the [record] key a unit mistake points to.
   void set_record_layout(const std::optional<RecordLayout>& layout);
