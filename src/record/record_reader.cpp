@@ -545,37 +545,50 @@ struct RecordReader::State {
 
   /// The common row, read fast: every field a number of parse_short_decimal's form (a layout's time stamp:
   /// parse_ticks's, finite) or a column the layout skips, with a single delimiter between fields and no
-  /// blank. Fills the value slots as parse_row does and returns true, or returns false for any other row
-  /// (parse_row then reads it and gives its verdict and message). Not for a blank-delimited layout.
-  bool parse_plain_row(std::string_view text, double* values) const {
-    const char* p = text.data();
-    const char* const last = p + text.size();
+  /// blank. Fills the value slots as parse_row does and returns the end of the last field, or returns nullptr
+  /// for any other row (parse_row then reads it and gives its verdict and message). `last` is the end of the
+  /// line, or of the bytes read: a field never reaches past a line break ('\n' ends a skipped field too). Not
+  /// for a blank-delimited layout.
+  const char* scan_plain_row(const char* p, const char* last, double* values) const {
     // A row beginning with a blank, '#' or a layout's comment prefix is parse_row's (a blank or comment line,
     // or an error).
     if (p == last || blank(*p) || *p == '#' ||
         (layout && !layout->comment.empty() && *p == layout->comment[0]))
-      return false;
+      return nullptr;
     const std::size_t count = columns.size();
     for (std::size_t i = 0; i < count; ++i) {
       const int s = slot[i];
       if (s < 0) {
-        const void* at = std::memchr(p, delimiter, static_cast<std::size_t>(last - p));
-        p = at == nullptr ? last : static_cast<const char*>(at);
+        while (p != last && *p != delimiter && *p != '\n') ++p;
       } else if (s == 0 && time_ticks_per_s != 1) {
         const auto result = parse_ticks(p, last, values[0]);
-        if (result.ec != std::errc() || !std::isfinite(values[0])) return false;
+        if (result.ec != std::errc() || !std::isfinite(values[0])) return nullptr;
         p = result.ptr;
       } else {
         p = parse_short_decimal(p, last, decimal, values[s]);  // a finite value: at most 19 digits
-        if (p == nullptr) return false;
+        if (p == nullptr) return nullptr;
       }
       if (i + 1 < count) {
-        if (p == last || *p != delimiter) return false;
+        if (p == last || *p != delimiter) return nullptr;
         ++p;
-      } else if (p != last) {
-        return false;
       }
     }
+    return p;
+  }
+
+  /// Reads the next row at once when it is a common row (scan_plain_row) wholly in the buffer, ended by LF or
+  /// CRLF: its values into the slots, the line counted and consumed. False, with nothing consumed, for any
+  /// other line (next_line and parse_row then read it).
+  bool next_plain_row(double* values) {
+    const char* const first = text() + begin;
+    const char* const last = text() + end;
+    const char* p = scan_plain_row(first, last, values);
+    if (p == nullptr || p == last) return false;
+    if (*p == '\r' && p + 1 != last) ++p;
+    if (*p != '\n') return false;
+    begin = static_cast<std::size_t>(p + 1 - text());
+    ++line;
+    check_time(values[0]);
     return true;
   }
 
@@ -596,7 +609,7 @@ struct RecordReader::State {
   template <bool kBlankDelimited>
   bool parse_row(std::string_view text, double* values) {
     if constexpr (!kBlankDelimited) {
-      if (parse_plain_row(text, values)) {
+      if (scan_plain_row(text.data(), text.data() + text.size(), values) == text.data() + text.size()) {
         check_time(values[0]);
         return true;
       }
@@ -757,10 +770,12 @@ std::uint64_t RecordReader::line_number() const {
 bool RecordReader::next(RecordSample& sample) {
   State& s = *state_;
   double values[kColumnCountMax];
-  std::string_view text;
-  do {
-    if (!s.next_line(text)) return false;
-  } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
+  if (s.blank_delimited || !s.next_plain_row(values)) {
+    std::string_view text;
+    do {
+      if (!s.next_line(text)) return false;
+    } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
+  }
   sample.time_s = values[0];
   if (!s.layout) {
     if (s.lone_output) {

@@ -42,14 +42,14 @@ inline constexpr std::size_t kDecimalReadAfter = 64;
 
 namespace short_decimal {
 
-inline std::uint64_t load8(const char* p) {
+[[gnu::always_inline]] inline std::uint64_t load8(const char* p) {
   std::uint64_t v = 0;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
 
 /// The 8 digit values of `v` (byte 0, the lowest address, the most significant; each 0..9) as an integer.
-inline std::uint32_t eight_digits(std::uint64_t v) {
+[[gnu::always_inline]] inline std::uint32_t eight_digits(std::uint64_t v) {
   constexpr std::uint64_t kMask = 0x000000FF000000FF;
   constexpr std::uint64_t kMul1 = 100 + (std::uint64_t{1000000} << 32);
   constexpr std::uint64_t kMul2 = 1 + (std::uint64_t{10000} << 32);
@@ -71,13 +71,13 @@ inline constexpr std::uint64_t kKeepLast[9] = {0,
 inline constexpr std::uint64_t kZeros = 0x3030303030303030;  // "00000000"
 
 /// The value of the n <= 8 ASCII digits that end at `end`.
-inline std::uint64_t up_to_8_digits(const char* end, unsigned n) {
+[[gnu::always_inline]] inline std::uint64_t up_to_8_digits(const char* end, unsigned n) {
   const std::uint64_t keep = kKeepLast[n];
   return eight_digits((load8(end - 8) & keep) - (kZeros & keep));  // no borrow: every kept byte is >= '0'
 }
 
 /// The value of the n <= 16 ASCII digits that end at `end`, without a branch on n.
-inline std::uint64_t up_to_16_digits(const char* end, unsigned n) {
+[[gnu::always_inline]] inline std::uint64_t up_to_16_digits(const char* end, unsigned n) {
   const unsigned low = n < 8 ? n : 8;
   const std::uint64_t keep_high = kKeepLast[n - low];
   const std::uint64_t high = eight_digits((load8(end - 16) & keep_high) - (kZeros & keep_high));
@@ -103,7 +103,7 @@ inline constexpr std::uint64_t kPow10[17] = {1,
                                              10000000000000000};
 
 /// Bit k set when first[k] (k < 32, first + k < last) is an ASCII digit.
-inline std::uint32_t digit_mask(const char* first, const char* last) {
+[[gnu::always_inline]] inline std::uint32_t digit_mask(const char* first, const char* last) {
   std::uint32_t mask = 0;
 #if defined(__SSE2__)
   const __m128i zero = _mm_set1_epi8('0');
