@@ -141,7 +141,8 @@ TEST(ShortDecimal, EdgeCasesAreCorrectlyRoundedOrLeftToFastFloat) {
                                  "infinity",
                                  "--1",
                                  "12345678901234567",
-                                 "0.00000000000000001", "0.30000000000000004",
+                                 "0.00000000000000001",
+                                 "0.30000000000000004",
                                  "99999999999999999999",
                                  "1234567890.1234567890",
                                  " 1",
@@ -248,6 +249,28 @@ TEST(ShortDecimal, AnyTextItTakesReadsAsWithFastFloat) {
     const std::size_t length = random() % 36;
     for (std::size_t i = 0; i < length; ++i) text += alphabet[random() % alphabet.size()];
     check(text, trial % 3 == 0 ? ',' : '.', trial % 2 == 0 ? ',' : '9');
+    if (::testing::Test::HasFailure()) break;
+  }
+}
+
+TEST(ShortDecimal, TheSse2HelpersAgreeWithTheirPortableForms) {
+  // Where there is SSE2 the digits are found and read 16 at a time; elsewhere byte by byte and 8 at a time.
+  // Both on random bytes (digits, and the bytes next to '0' and '9'), every count of digits.
+  const std::string alphabet = "0123456789/:.-, \x80\xff";
+  std::mt19937_64 random(3);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string bytes(48, '0');
+    for (char& c : bytes) c = alphabet[random() % alphabet.size()];
+    EXPECT_EQ(short_decimal::digits_of_32(bytes.data()), short_decimal::digits_of_32_portable(bytes.data()))
+        << bytes;
+    std::string digits(48, '0');
+    for (char& c : digits) c = static_cast<char>('0' + random() % 10);
+    for (unsigned n = 0; n <= 16; ++n) {
+      const char* end = digits.data() + 16 + random() % 32;
+      const std::uint64_t expected = n == 0 ? 0 : std::stoull(std::string(end - n, end));
+      EXPECT_EQ(short_decimal::up_to_16_digits(end, n), expected) << std::string(end - n, end);
+      EXPECT_EQ(short_decimal::up_to_16_digits_portable(end, n), expected) << std::string(end - n, end);
+    }
     if (::testing::Test::HasFailure()) break;
   }
 }

@@ -76,12 +76,42 @@ inline constexpr std::uint64_t kZeros = 0x3030303030303030;  // "00000000"
   return eight_digits((load8(end - 8) & keep) - (kZeros & keep));  // no borrow: every kept byte is >= '0'
 }
 
-/// The value of the n <= 16 ASCII digits that end at `end`, without a branch on n.
-[[gnu::always_inline]] inline std::uint64_t up_to_16_digits(const char* end, unsigned n) {
+/// 16 zero bytes, then 16 bytes 0xFF: the 16 bytes from kSlide + n keep the last n of 16.
+alignas(32) inline constexpr unsigned char kSlide[32] = {
+    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,
+    0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+
+/// The value of the n <= 16 ASCII digits that end at `end`, without a branch on n: two octets of
+/// up_to_8_digits.
+[[gnu::always_inline]] inline std::uint64_t up_to_16_digits_portable(const char* end, unsigned n) {
   const unsigned low = n < 8 ? n : 8;
   const std::uint64_t keep_high = kKeepLast[n - low];
   const std::uint64_t high = eight_digits((load8(end - 16) & keep_high) - (kZeros & keep_high));
   return high * 100000000 + up_to_8_digits(end, low);
+}
+
+/// The same as up_to_16_digits_portable (tests/test_decimal.cpp compares them), with SSE2 where there is
+/// SSE2.
+[[gnu::always_inline]] inline std::uint64_t up_to_16_digits(const char* end, unsigned n) {
+#if defined(__SSE2__)
+  // The 16 bytes before `end`, less '0', all but the last n zeroed: 16 digit values d0..d15 (d0 the most
+  // significant). Pairs, then quadruples, then octets by multiply-adds of 16-bit lanes.
+  const __m128i zero = _mm_setzero_si128();
+  __m128i x = _mm_sub_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(end - 16)), _mm_set1_epi8('0'));
+  x = _mm_and_si128(x, _mm_loadu_si128(reinterpret_cast<const __m128i*>(kSlide + n)));
+  const __m128i pairs_low =
+      _mm_madd_epi16(_mm_unpacklo_epi8(x, zero), _mm_setr_epi16(10, 1, 10, 1, 10, 1, 10, 1));
+  const __m128i pairs_high =
+      _mm_madd_epi16(_mm_unpackhi_epi8(x, zero), _mm_setr_epi16(10, 1, 10, 1, 10, 1, 10, 1));
+  __m128i v = _mm_packs_epi32(pairs_low, pairs_high);                     // 8 values <= 99
+  v = _mm_madd_epi16(v, _mm_setr_epi16(100, 1, 100, 1, 100, 1, 100, 1));  // 4 values <= 9999
+  v = _mm_packs_epi32(v, v);
+  v = _mm_madd_epi16(v, _mm_setr_epi16(10000, 1, 10000, 1, 10000, 1, 10000, 1));  // 2 values <= 99999999
+  const auto octets = static_cast<std::uint64_t>(_mm_cvtsi128_si64(v));
+  return (octets & 0xFFFFFFFF) * 100000000 + (octets >> 32);
+#else
+  return up_to_16_digits_portable(end, n);
+#endif
 }
 
 inline constexpr std::uint64_t kPow10[17] = {1,
@@ -102,22 +132,33 @@ inline constexpr std::uint64_t kPow10[17] = {1,
                                              1000000000000000,
                                              10000000000000000};
 
-/// Bit k set when first[k] (k < 32, first + k < last) is an ASCII digit.
-[[gnu::always_inline]] inline std::uint32_t digit_mask(const char* first, const char* last) {
+/// Bit k set when first[k] is an ASCII digit, k < 32, one byte at a time.
+[[gnu::always_inline]] inline std::uint32_t digits_of_32_portable(const char* first) {
   std::uint32_t mask = 0;
+  for (unsigned k = 0; k < 32; ++k) {
+    if (static_cast<unsigned char>(first[k] - '0') < 10) mask |= std::uint32_t{1} << k;
+  }
+  return mask;
+}
+
+/// The same as digits_of_32_portable (tests/test_decimal.cpp compares them), with SSE2 where there is SSE2.
+[[gnu::always_inline]] inline std::uint32_t digits_of_32(const char* first) {
 #if defined(__SSE2__)
   const __m128i zero = _mm_set1_epi8('0');
   const __m128i nine = _mm_set1_epi8(9);
   const __m128i a = _mm_sub_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(first)), zero);
   const __m128i b = _mm_sub_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(first + 16)), zero);
   // A digit's byte minus '0' is 0..9 unsigned: min(x, 9) == x.
-  mask = static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(a, nine), a))) |
+  return static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(a, nine), a))) |
          (static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(b, nine), b))) << 16);
 #else
-  for (unsigned k = 0; k < 32; ++k) {
-    if (static_cast<unsigned char>(first[k] - '0') < 10) mask |= std::uint32_t{1} << k;
-  }
+  return digits_of_32_portable(first);
 #endif
+}
+
+/// Bit k set when first[k] (k < 32, first + k < last) is an ASCII digit.
+[[gnu::always_inline]] inline std::uint32_t digit_mask(const char* first, const char* last) {
+  std::uint32_t mask = digits_of_32(first);
   const std::ptrdiff_t room = last - first;
   if (room < 32) mask &= (std::uint32_t{1} << room) - 1;
   return mask;
