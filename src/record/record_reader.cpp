@@ -594,15 +594,17 @@ struct RecordReader::State {
 
   /// Refuses a time that does not increase from the previous row's; remembers it.
   void check_time(double time_s) {
-    if (have_previous && !(time_s > previous_time_s)) {
-      if (!layout) {
-        fail(fmt::format("time_s {} does not increase (the previous row has {})", time_s, previous_time_s));
-      }
-      fail(fmt::format("the time ({}, {} s) does not increase (the previous row has {} s)",
-                       printable(layout->time_column), time_s, previous_time_s));
-    }
+    if (have_previous && !(time_s > previous_time_s)) fail_time(time_s);
     previous_time_s = time_s;
     have_previous = true;
+  }
+
+  [[noreturn, gnu::noinline, gnu::cold]] void fail_time(double time_s) const {
+    if (!layout) {
+      fail(fmt::format("time_s {} does not increase (the previous row has {})", time_s, previous_time_s));
+    }
+    fail(fmt::format("the time ({}, {} s) does not increase (the previous row has {} s)",
+                     printable(layout->time_column), time_s, previous_time_s));
   }
 
   /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
