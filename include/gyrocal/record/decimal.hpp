@@ -23,10 +23,10 @@
 // To find the digits without a branch per byte, the parser reads up to kDecimalReadBefore bytes before
 // `first` and kDecimalReadAfter bytes after `last`; the caller's buffer must hold them (their values do not
 // matter: they are masked off).
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -206,10 +206,10 @@ struct ShortDecimal {
   return end;
 }
 
-/// The value of a number found by scan_short_decimal: w * 10^-fraction correctly rounded, with its sign (see
-/// the top of this header); NaN in the case compute_float cannot decide, which does not arise for these w and
-/// q (a guard: the caller then leaves the text to fast_float).
-[[gnu::always_inline]] inline double short_decimal_value(const ShortDecimal& d) {
+/// The value of a number found by scan_short_decimal into `value`: w * 10^-fraction correctly rounded, with
+/// its sign (see the top of this header). False (`value` unchanged) in the case compute_float cannot decide,
+/// which does not arise for these w and q (a guard: the caller then leaves the text to fast_float).
+[[gnu::always_inline]] inline bool short_decimal_value(const ShortDecimal& d, double& value) {
   std::uint64_t w = d.whole <= 8 ? short_decimal::up_to_8_digits(d.whole_end, d.whole)
                                  : short_decimal::up_to_16_digits(d.whole_end, d.whole);
   if (d.fraction > 0) {
@@ -220,10 +220,13 @@ struct ShortDecimal {
   // w < 10^19 and q in [-16, 0]: compute_float's Eisel-Lemire product decides every case (power2 >= 0).
   const fast_float::adjusted_mantissa am =
       fast_float::compute_float<fast_float::binary_format<double>>(-static_cast<std::int64_t>(d.fraction), w);
-  if (am.power2 < 0) return std::numeric_limits<double>::quiet_NaN();
-  double value = 0.0;
-  fast_float::to_float(d.negative, am, value);
-  return value;
+  if (am.power2 < 0) return false;
+  // fast_float::to_float's packing (mantissa without its implicit bit, biased exponent, sign), with the sign
+  // or'ed in as a bit: a choice between two words would be a branch, mispredicted on half of a noisy column.
+  const std::uint64_t word = am.mantissa | (static_cast<std::uint64_t>(am.power2) << 52) |
+                             (static_cast<std::uint64_t>(d.negative) << 63);
+  value = std::bit_cast<double>(word);
+  return true;
 }
 
 /// scan_short_decimal and short_decimal_value in one: the end of the number and its value in `value`, or
@@ -232,10 +235,7 @@ struct ShortDecimal {
                                                               char decimal, double& value) {
   ShortDecimal d;
   const char* const end = scan_short_decimal(first, last, decimal, d);
-  if (end == nullptr) return nullptr;
-  const double v = short_decimal_value(d);
-  if (v != v) return nullptr;  // NaN: not decided (see short_decimal_value)
-  value = v;
+  if (end == nullptr || !short_decimal_value(d, value)) return nullptr;
   return end;
 }
 
