@@ -547,8 +547,8 @@ struct RecordReader::State {
   /// parse_ticks's, finite) or a column the layout skips, with a single delimiter between fields and no
   /// blank. Fills the value slots as parse_row does and returns the end of the last field, or returns nullptr
   /// for any other row (parse_row then reads it and gives its verdict and message). `last` is the end of the
-  /// line, or of the bytes read: a field never reaches past a line break ('\n' ends a skipped field too). Not
-  /// for a blank-delimited layout.
+  /// bytes read, beyond the line: no field reaches past a line break (a number cannot hold one; '\n' ends a
+  /// skipped field). Not for a blank-delimited layout.
   const char* scan_plain_row(const char* p, const char* last, double* values) const {
     // A row beginning with a blank, '#' or a layout's comment prefix is parse_row's (a blank or comment line,
     // or an error).
@@ -610,12 +610,6 @@ struct RecordReader::State {
   /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
   template <bool kBlankDelimited>
   bool parse_row(std::string_view text, double* values) {
-    if constexpr (!kBlankDelimited) {
-      if (scan_plain_row(text.data(), text.data() + text.size(), values) == text.data() + text.size()) {
-        check_time(values[0]);
-        return true;
-      }
-    }
     const char* p = text.data();
     const char* const last = p + text.size();
     while (p != last && blank(*p)) ++p;
