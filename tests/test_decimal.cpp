@@ -116,6 +116,9 @@ TEST(ShortDecimal, EdgeCasesAreCorrectlyRoundedOrLeftToFastFloat) {
   expect_accepted("1.7976931348623157", 1.7976931348623157);
   expect_accepted("0.0000000000000001", 1e-16);  // 16 digits after the mark
   expect_accepted("9999999999999999", 9999999999999999.0);
+  expect_accepted("999999999999999", 999999999999999.0);  // 15 digits: an integer converted directly
+  expect_accepted("-123456789012345", -123456789012345.0);
+  expect_accepted("16777216", 16777216.0);
   expect_accepted("999.9999999999999999", 1000.0);  // 19 digits
   expect_accepted("0000000000000001.500", 1.5);     // 19 digits, leading zeros
   // Near 2^53, where doubles are 2 apart: a tie goes to the even mantissa.

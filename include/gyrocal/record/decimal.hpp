@@ -14,11 +14,12 @@
 //   fast_float itself (fast_float::compute_float), which is exact for every w < 2^64 and -27 <= q <= 55, so
 //   it never reports the rare failure it can report beyond that range. fast_float reaches the same routine
 //   for w > 2^53 and otherwise takes Clinger's shortcut (w and 10^-q exact doubles, one division): another
-//   correctly rounded route to the same double. The sign is applied last in both; "-0" is -0.0.
-// - Integer arithmetic only: the result does not depend on the floating-point rounding mode (fast_float's
-//   result does not either).
-// tests/test_decimal.cpp checks the result against std::from_chars and strtod on many random and edge-case
-// texts.
+//   correctly rounded route to the same double. An integer of at most 15 digits (below 2^53) is converted
+//   directly: it is a double exactly, so no rounding is involved. The sign is applied last; "-0" is -0.0.
+// - Integer arithmetic and exact conversions only: the result does not depend on the floating-point rounding
+//   mode (fast_float's result does not either).
+// tests/test_decimal.cpp checks the result against glibc's strtod and against fast_float on many random and
+// edge-case texts.
 //
 // To find the digits without a branch per byte, the parser reads up to kDecimalReadBefore bytes before
 // `first` and kDecimalReadAfter bytes after `last`; the caller's buffer must hold them (their values do not
@@ -216,6 +217,11 @@ struct ShortDecimal {
     w = w * short_decimal::kPow10[d.fraction] + (d.fraction <= 8
                                                      ? short_decimal::up_to_8_digits(d.end, d.fraction)
                                                      : short_decimal::up_to_16_digits(d.end, d.fraction));
+  } else if (d.whole <= 15) {
+    // An integer below 10^15 < 2^53 is a double exactly: no rounding (fast_float's shortcut too).
+    value = std::bit_cast<double>(std::bit_cast<std::uint64_t>(static_cast<double>(w)) |
+                                  (static_cast<std::uint64_t>(d.negative) << 63));
+    return true;
   }
   // w < 10^19 and q in [-16, 0]: compute_float's Eisel-Lemire product decides every case (power2 >= 0).
   const fast_float::adjusted_mantissa am =
