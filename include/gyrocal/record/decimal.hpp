@@ -1,25 +1,25 @@
 #pragma once
 // The record reader's parser of short plain decimals ("357.1638594870602", "-0.005", "16645042"), the form
-// nearly every field of a record has (docs/records.md, "Numbers"). It gives exactly the double that
+// nearly every field of a record has (docs/records.md, "Speed"). It gives exactly the double that
 // fast_float::from_chars_advanced gives for the same text, or declines and leaves the text to fast_float:
 //
 // - It accepts only: an optional '-', then digits, an optional decimal mark and digits, at least one digit,
-// at
-//   most 16 before the mark, 16 after it and 19 in all, not followed by a digit, 'e' or 'E'. Anything else
-//   (an exponent, a '+', "inf", "nan", more digits, no digit) is declined: the caller falls back to
+//   at most 16 before the mark, 16 after it and 19 in all, not followed by a digit, 'e' or 'E'. Anything
+//   else (an exponent, a '+', "inf", "nan", more digits, no digit) is declined: the caller falls back to
 //   fast_float.
-// - For an accepted text both read the same digits w (< 10^19, so exact in 64 bits) and the same power of ten
-//   q = -(digits after the mark), and both end at the same byte.
+// - For an accepted text both read the same digits w (< 10^19, so exact in 64 bits) and the same power of
+//   ten q = -(digits after the mark), and both end at the same byte.
 // - The value is w * 10^q correctly rounded (to nearest, ties to even) by the Eisel-Lemire routine of
-//   fast_float itself (fast_float::compute_float), which is exact for every w < 2^64 and -27 <= q <= 55, so
+//   fast_float itself (fast_float::compute_float), which decides every w < 2^64 for -27 <= q <= 55, so
 //   it never reports the rare failure it can report beyond that range. fast_float reaches the same routine
 //   for w > 2^53 and otherwise takes Clinger's shortcut (w and 10^-q exact doubles, one division): another
 //   correctly rounded route to the same double. An integer of at most 15 digits (below 2^53) is converted
 //   directly: it is a double exactly, so no rounding is involved. The sign is applied last; "-0" is -0.0.
-// - Integer arithmetic and exact conversions only: the result does not depend on the floating-point rounding
-//   mode (fast_float's result does not either).
+// - Integer arithmetic and exact conversions only: the result does not depend on the floating-point
+//   rounding mode (fast_float's result does not either).
 // tests/test_decimal.cpp checks the result against glibc's strtod and against fast_float on many random and
-// edge-case texts.
+// edge-case texts. It relies on fast_float's compute_float, adjusted_mantissa and binary_format (Debian's
+// libfast-float-dev 3.9), which are in its headers but not its documented interface.
 //
 // To find the digits without a branch per byte, the parser reads up to kDecimalReadBefore bytes before
 // `first` and kDecimalReadAfter bytes after `last`; the caller's buffer must hold them (their values do not
