@@ -5,7 +5,10 @@
 // refusal: where a line falls across reads must not change what is read. The same twice more through a rig's
 // layout ([record], docs/records.md: ';', a '%' comment, columns by name, ns stamps, counts, radians, a
 // negative scale, offsets, a decimal comma), and once through a whitespace-delimited layout (a preamble line
-// and a units row skipped).
+// and a units row skipped). Besides, the reader's parser of short decimals (record/decimal.hpp) is run at
+// every place of the input (with both decimal marks): every text it takes must read as fast_float reads it,
+// the same double ending at the same byte.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -14,7 +17,10 @@
 #include <string>
 #include <vector>
 
+#include <fast_float/fast_float.h>
+
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/record/decimal.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace {
@@ -79,10 +85,33 @@ bool same_bits(const gyrocal::RecordSample& a, const gyrocal::RecordSample& b, s
   return true;
 }
 
+/// parse_short_decimal against fast_float at each place of `text` (up to 4096 places), the text cut at
+/// `last` places after it (the bytes beyond, and the padding either side, are the text's own or '7's).
+void compare_short_decimals(const std::string& text) {
+  std::string padded =
+      std::string(gyrocal::kDecimalReadBefore, '7') + text + std::string(gyrocal::kDecimalReadAfter, '7');
+  const char* const begin = padded.data() + gyrocal::kDecimalReadBefore;
+  const char* const end = begin + text.size();
+  for (std::size_t at = 0; at < text.size() && at < 4096; ++at) {
+    for (const char decimal : {'.', ','}) {
+      const char* const last = std::min(end, begin + at + 1 + (text.size() - at) % 40);
+      double fast = 0.0;
+      const char* stop = gyrocal::parse_short_decimal(begin + at, last, decimal, fast);
+      if (stop == nullptr) continue;
+      double reference = 0.0;
+      const auto result = fast_float::from_chars_advanced(
+          begin + at, last, reference, fast_float::parse_options{fast_float::chars_format::general, decimal});
+      if (result.ec != std::errc() || result.ptr != stop || std::memcmp(&fast, &reference, sizeof fast) != 0)
+        std::abort();
+    }
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  compare_short_decimals(text);
   // The whole input in one read, as the program reads any file shorter than its 1 MiB read size (asking for
   // the 1 MiB itself made every run page in a fresh megabyte: 70 runs a second instead of thousands).
   const Reading whole = read_all(text, size + 1);

@@ -16,6 +16,7 @@
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/record/decimal.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace gyrocal {
@@ -77,7 +78,9 @@ struct RecordReader::State {
   std::string memory;           ///< the whole record, for from_string
   std::size_t memory_read = 0;  ///< bytes of `memory` handed to the buffer so far
   std::size_t chunk_bytes = 0;  ///< bytes asked for per read
-  std::vector<char> buffer;     ///< [begin, end) not yet consumed
+  /// The bytes read: text() + [begin, end) not yet consumed. kDecimalReadBefore bytes before text() and
+  /// kDecimalReadAfter after its capacity are padding that parse_short_decimal may read.
+  std::vector<char> buffer;
   std::size_t begin = 0;
   std::size_t end = 0;
   bool at_eof = false;
@@ -117,13 +120,15 @@ struct RecordReader::State {
   State(std::string name_, std::size_t chunk)
       : name(std::move(name_)), chunk_bytes(std::max<std::size_t>(chunk, 1)) {
     // Room for the longest accepted line plus one chunk: memory is bounded whatever the input.
-    buffer.resize(kMaxLineBytes + chunk_bytes);
+    buffer.resize(kDecimalReadBefore + kMaxLineBytes + chunk_bytes + kDecimalReadAfter);
   }
   ~State() {
     if (fd >= 0) ::close(fd);
   }
   State(const State&) = delete;
   State& operator=(const State&) = delete;
+
+  char* text() { return buffer.data() + kDecimalReadBefore; }
 
   [[noreturn]] void fail(std::string_view problem) const {
     throw Error(fmt::format("{}, line {}: {}.", name, line, problem));
@@ -177,19 +182,19 @@ struct RecordReader::State {
   /// Moves the unconsumed bytes to the front and appends up to one chunk; sets at_eof at the end.
   void fill() {
     const std::size_t kept = end - begin;
-    std::memmove(buffer.data(), buffer.data() + begin, kept);
+    std::memmove(text(), text() + begin, kept);
     begin = 0;
     end = kept;
     if (fd < 0) {
       const std::size_t count = std::min(chunk_bytes, memory.size() - memory_read);
-      std::memcpy(buffer.data() + end, memory.data() + memory_read, count);
+      std::memcpy(text() + end, memory.data() + memory_read, count);
       memory_read += count;
       end += count;
       at_eof = count == 0;
       return;
     }
     for (;;) {
-      const ssize_t count = ::read(fd, buffer.data() + end, chunk_bytes);
+      const ssize_t count = ::read(fd, text() + end, chunk_bytes);
       if (count < 0 && errno == EINTR) continue;
       if (count < 0) {
         throw Error(fmt::format("Cannot read record '{}': {}.", name,
@@ -204,7 +209,7 @@ struct RecordReader::State {
   /// The next line without its line ending (LF or CRLF), valid until the next call; false at the end.
   bool next_line(std::string_view& out) {
     for (;;) {
-      const char* first = buffer.data() + begin;
+      const char* first = text() + begin;
       const std::size_t available = end - begin;
       if (const void* newline = std::memchr(first, '\n', available)) {
         std::size_t length = static_cast<std::size_t>(static_cast<const char*>(newline) - first);
@@ -484,6 +489,13 @@ struct RecordReader::State {
     fail(fmt::format("the row has {} fields but the header has {} columns", fields, columns.size()));
   }
 
+  /// The number at p (before `last`) as fast_float::from_chars_advanced reads it, the common short decimals
+  /// by parse_short_decimal (the same double, faster; p and `last` must lie in `buffer`'s text).
+  fast_float::from_chars_result parse_number(const char* p, const char* last, double& value) const {
+    if (const char* stop = parse_short_decimal(p, last, decimal, value)) return {stop, std::errc()};
+    return fast_float::from_chars_advanced(p, last, value, number_options);
+  }
+
   /// ticks / ticks_per_s as the nearest double (ties to even), exactly: one division where both are exact
   /// doubles, else the integer quotient rounded at the precision of the result's binade.
   static double nearest_seconds(std::uint64_t ticks, std::uint64_t ticks_per_s) {
@@ -526,9 +538,73 @@ struct RecordReader::State {
       seconds = negative ? -magnitude : magnitude;
       return {q, std::errc()};
     }
-    const auto result = fast_float::from_chars_advanced(p, last, seconds, number_options);
+    const auto result = parse_number(p, last, seconds);
     seconds /= static_cast<double>(time_ticks_per_s);
     return result;
+  }
+
+  /// The common row, read fast: every field a number of parse_short_decimal's form (a layout's time stamp:
+  /// parse_ticks's, finite) or a column the layout skips, with a single delimiter between fields and no
+  /// blank. Fills the value slots as parse_row does and returns the end of the last field, or returns nullptr
+  /// for any other row (parse_row then reads it and gives its verdict and message). `last` is the end of the
+  /// bytes read, beyond the line: no field reaches past a line break (a number cannot hold one; '\n' ends a
+  /// skipped field). Not for a blank-delimited layout.
+  const char* scan_plain_row(const char* p, const char* last, double* values) const {
+    // A row beginning with a blank, '#' or a layout's comment prefix is parse_row's (a blank or comment line,
+    // or an error).
+    if (p == last || blank(*p) || *p == '#' ||
+        (layout && !layout->comment.empty() && *p == layout->comment[0]))
+      return nullptr;
+    const std::size_t count = columns.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      const int s = slot[i];
+      if (s < 0) {
+        while (p != last && *p != delimiter && *p != '\n') ++p;
+      } else if (s == 0 && time_ticks_per_s != 1) {
+        const auto result = parse_ticks(p, last, values[0]);
+        if (result.ec != std::errc() || !std::isfinite(values[0])) return nullptr;
+        p = result.ptr;
+      } else {
+        p = parse_short_decimal(p, last, decimal, values[s]);  // a finite value: at most 19 digits
+        if (p == nullptr) return nullptr;
+      }
+      if (i + 1 < count) {
+        if (p == last || *p != delimiter) return nullptr;
+        ++p;
+      }
+    }
+    return p;
+  }
+
+  /// Reads the next row at once when it is a common row (scan_plain_row) wholly in the buffer, ended by LF or
+  /// CRLF: its values into the slots, the line counted and consumed. False, with nothing consumed, for any
+  /// other line (next_line and parse_row then read it).
+  bool next_plain_row(double* values) {
+    const char* const first = text() + begin;
+    const char* const last = text() + end;
+    const char* p = scan_plain_row(first, last, values);
+    if (p == nullptr || p == last) return false;
+    if (*p == '\r' && p + 1 != last) ++p;
+    if (*p != '\n') return false;
+    begin = static_cast<std::size_t>(p + 1 - text());
+    ++line;
+    check_time(values[0]);
+    return true;
+  }
+
+  /// Refuses a time that does not increase from the previous row's; remembers it.
+  void check_time(double time_s) {
+    if (have_previous && !(time_s > previous_time_s)) fail_time(time_s);
+    previous_time_s = time_s;
+    have_previous = true;
+  }
+
+  [[noreturn, gnu::noinline, gnu::cold]] void fail_time(double time_s) const {
+    if (!layout) {
+      fail(fmt::format("time_s {} does not increase (the previous row has {})", time_s, previous_time_s));
+    }
+    fail(fmt::format("the time ({}, {} s) does not increase (the previous row has {} s)",
+                     printable(layout->time_column), time_s, previous_time_s));
   }
 
   /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
@@ -559,9 +635,8 @@ struct RecordReader::State {
           p = at == nullptr ? last : static_cast<const char*>(at);
         }
       } else {
-        const auto result = s == 0 && time_ticks_per_s != 1
-                                ? parse_ticks(p, last, values[0])
-                                : fast_float::from_chars_advanced(p, last, values[s], number_options);
+        const auto result = s == 0 && time_ticks_per_s != 1 ? parse_ticks(p, last, values[0])
+                                                            : parse_number(p, last, values[s]);
         p = result.ptr;
         const char* const number_end = p;
         while (p != last && blank(*p)) ++p;
@@ -597,16 +672,7 @@ struct RecordReader::State {
         fail_field_count(text);
       }
     }
-    if (have_previous && !(values[0] > previous_time_s)) {
-      if (!layout) {
-        fail(
-            fmt::format("time_s {} does not increase (the previous row has {})", values[0], previous_time_s));
-      }
-      fail(fmt::format("the time ({}, {} s) does not increase (the previous row has {} s)",
-                       printable(layout->time_column), values[0], previous_time_s));
-    }
-    previous_time_s = values[0];
-    have_previous = true;
+    check_time(values[0]);
     return true;
   }
 };
@@ -700,10 +766,12 @@ std::uint64_t RecordReader::line_number() const {
 bool RecordReader::next(RecordSample& sample) {
   State& s = *state_;
   double values[kColumnCountMax];
-  std::string_view text;
-  do {
-    if (!s.next_line(text)) return false;
-  } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
+  if (s.blank_delimited || !s.next_plain_row(values)) {
+    std::string_view text;
+    do {
+      if (!s.next_line(text)) return false;
+    } while (!(s.blank_delimited ? s.parse_row<true>(text, values) : s.parse_row<false>(text, values)));
+  }
   sample.time_s = values[0];
   if (!s.layout) {
     if (s.lone_output) {
