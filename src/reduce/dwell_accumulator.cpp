@@ -194,8 +194,10 @@ void DwellAccumulator::detection_basis(double gamma_rad, double t_scaled, double
 // Revolutions counted from the first sample's gamma, in either sense of rotation.
 int DwellAccumulator::revolution_of(double gamma_rad) const {
   // The quotient is >= 0, so the conversion's truncation is its floor (std::floor is a call of libm on the
-  // baseline x86-64 and was 4 % of a calibration's time).
-  return static_cast<int>(std::abs(gamma_rad - gamma_first_) / (2.0 * kPi));
+  // baseline x86-64 and was 4 % of a calibration's time); a product by 1 / (2 pi), not a division (a sample
+  // within a rounding of a whole turn may fall in either revolution).
+  constexpr double kTurnsPerRad = 1.0 / (2.0 * kPi);
+  return static_cast<int>(std::abs(gamma_rad - gamma_first_) * kTurnsPerRad);
 }
 
 int DwellAccumulator::period_of(double t, double gamma_rad) const {
