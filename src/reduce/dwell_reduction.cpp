@@ -24,7 +24,10 @@ Eigen::MatrixXd diagonal_of(const std::vector<double>& gain) {
 }  // namespace
 
 void harmonic_basis(double gamma_rad, int order, double* out) {
-  const double c1 = std::cos(gamma_rad), s1 = std::sin(gamma_rad);
+  harmonic_basis(std::cos(gamma_rad), std::sin(gamma_rad), order, out);
+}
+
+void harmonic_basis(double c1, double s1, int order, double* out) {
   out[0] = 1.0;
   double c = 1.0, s = 0.0;
   for (int k = 1; k <= order; ++k) {

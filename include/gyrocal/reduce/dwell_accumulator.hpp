@@ -196,7 +196,7 @@ class DwellAccumulator {
   double scaled_time(double time_s) const { return (time_s - t_first_) / duration_s_ - 0.5; }
   double scaled_mid_time() const;
   int detection_size() const;
-  void detection_basis(double gamma_rad, double t_scaled, double* out) const;
+  void detection_basis(double cos_gamma, double sin_gamma, double t_scaled, double* out) const;
 
   ReduceOptions options_;
   bool spinning_;

@@ -24,6 +24,8 @@ struct DwellValues;    // reduce/dwell_accumulator.hpp
 /// cos kg and sin kg by angle addition from cos g and sin g). The harmonic fit's basis and, whatever the
 /// method, the outlier rule's.
 void harmonic_basis(double gamma_rad, int order, double* out);
+/// harmonic_basis from cos gamma and sin gamma.
+void harmonic_basis(double cos_gamma, double sin_gamma, int order, double* out);
 
 /// normal += b b' on the lower triangle of an n x n column-major matrix: the normal equations' update of one
 /// sample, the hot loop of a calibration. Each element's sum is the one a plain double loop forms (the same
