@@ -114,10 +114,6 @@ bool none_beyond(const std::vector<double>& x, double factor, double floor_lo) {
   return l * per_l >= deviation;
 }
 
-/// A block never holds more samples than this (a revolution of more samples is tested in parts): it bounds
-/// the memory of the outlier rule to a few MB whatever the plan.
-constexpr std::size_t kMaxBlockSamples = std::size_t{1} << 15;
-
 }  // namespace
 
 bool ReduceOptions::IsValid(std::string* error) const {
@@ -192,15 +188,6 @@ void DwellAccumulator::detection_basis(double cos_gamma, double sin_gamma, doubl
   }
 }
 
-// Revolutions counted from the first sample's gamma, in either sense of rotation.
-int DwellAccumulator::revolution_of(double gamma_rad) const {
-  // The quotient is >= 0, so the conversion's truncation is its floor (std::floor is a call of libm on the
-  // baseline x86-64 and was 4 % of a calibration's time); a product by 1 / (2 pi), not a division (a sample
-  // within a rounding of a whole turn may fall in either revolution).
-  constexpr double kTurnsPerRad = 1.0 / (2.0 * kPi);
-  return static_cast<int>(std::abs(gamma_rad - gamma_first_) * kTurnsPerRad);
-}
-
 int DwellAccumulator::period_of(double t, double gamma_rad) const {
   if (spinning_) return revolution_of(gamma_rad);
   return static_cast<int>(std::floor((t - t_first_) / (duration_s_ / options_.static_batches)));
@@ -210,7 +197,7 @@ double DwellAccumulator::scaled_mid_time() const {
   return scaled_time(0.5 * (t_first_ + t_last_));
 }
 
-void DwellAccumulator::add(double t, double gamma, const double* values) {
+void DwellAccumulator::add_general(double t, double gamma, const double* values) {
   if (samples_ == 0) {
     t_first_ = t;
     gamma_first_ = gamma;

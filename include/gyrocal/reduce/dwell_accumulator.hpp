@@ -4,6 +4,7 @@
 // (omega_I and the drift regressors) evaluated on the dwell's samples, so that
 //   reduce(W) = reduce(omega_I) + sum_j c_j reduce(x_j)
 // holds exactly whatever harmonics the machine's errors add.
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -138,7 +139,24 @@ class DwellAccumulator {
   /// spinning), with `columns` values. With outlier rejection (with_std_err, one column and
   /// ReduceOptions::outlier_threshold > 0) samples wait in a block of whole revolutions (at least
   /// outlier_block_samples) until the block is tested; finish() tests the last one.
-  void add(double time_s, double gamma_rad, const double* values);
+  void add(double time_s, double gamma_rad, const double* values) {
+    // The usual sample of a record's spinning dwell, inline (a call a sample from the reducer was measurable
+    // in calibrate's time); the first sample, one after a gap and every other case go out of line.
+    if (robust_ && spinning_ && samples_ > 0 && !break_next_) {
+      t_last_ = time_s;
+      gamma_last_ = gamma_rad;
+      ++samples_;
+      const int period = revolution_of(gamma_rad);
+      seen_revolution_ = period;
+      const std::size_t block = static_cast<std::size_t>(options_.outlier_block_samples);
+      if ((period != block_revolution_ && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples)
+        test_block();
+      block_revolution_ = period;
+      pending_.push_back({time_s, gamma_rad, values[0], period, false});
+      return;
+    }
+    add_general(time_s, gamma_rad, values);
+  }
   /// A whole dwell's samples at once, given by their sums (identify/channels.hpp: the model's channels summed
   /// in closed form): `samples` samples from first_time_s to last_time_s (s); for a harmonic fit `normal` and
   /// `rhs` as HarmonicFit::add_sums takes them (the basis' time is scaled as add() scales it), for a static
@@ -190,7 +208,18 @@ class DwellAccumulator {
                   const double* basis = nullptr, bool with_normal = true);
   void test_block();
   void flush();
-  int revolution_of(double gamma_rad) const;
+  void add_general(double time_s, double gamma_rad, const double* values);
+  /// A block never holds more samples than this (a revolution of more samples is tested in parts): it bounds
+  /// the memory of the outlier rule to a few MB whatever the plan.
+  static constexpr std::size_t kMaxBlockSamples = std::size_t{1} << 15;
+  /// Revolutions counted from the first sample's gamma, in either sense of rotation. The quotient is >= 0, so
+  /// the conversion's truncation is its floor (std::floor is a call of libm on the baseline x86-64 and was 4
+  /// % of a calibration's time); a product by 1 / (2 pi), not a division (a sample within a rounding of a
+  /// whole turn may fall in either revolution).
+  int revolution_of(double gamma_rad) const {
+    constexpr double kTurnsPerRad = 0.15915494309189533577;  // 1 / (2 pi)
+    return static_cast<int>(std::abs(gamma_rad - gamma_first_) * kTurnsPerRad);
+  }
   int period_of(double time_s, double gamma_rad) const;
   bool last_revolution_complete() const;
   double scaled_time(double time_s) const { return (time_s - t_first_) / duration_s_ - 0.5; }

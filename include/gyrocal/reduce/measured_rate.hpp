@@ -4,7 +4,10 @@
 // that the model's channels can be evaluated at the angle, rate and angular acceleration the arm really had
 // at each sample (a drive's rate ripple moves an accelerometer's centripetal input at first order) rather
 // than on the dwell's constant-rate line. Physics-free: angles in rad, times in s.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace gyrocal {
@@ -114,5 +117,46 @@ class MeasuredMotionFit {
 /// against 4e-6 g at half a revolution and 2e-7 g at a quarter, whose noise with 2^16-count encoders was
 /// three times the half's).
 inline constexpr double kMeasuredKnotRevolutions = 0.5;
+
+// Inline: a sample of every spinning dwell of a record goes through it (a call a sample was measurable).
+inline void MeasuredMotionFit::add(double x_s, double theta_rad) {
+  if (phases_.empty()) begin_phase(x_s);
+  Phase& p = phases_.back();
+  const double y = theta_rad - out_.origin_rad - out_.reference_rate_rad_s * (x_s - out_.origin_s);
+  const double x = x_s - p.first_knot;
+  // x / h by a product (a division's latency was a third of this function's time): a sample within a
+  // rounding of a knot may go to the interval on the other side, where the B-splines take the same values.
+  const double u = std::max(0.0, x * inverse_knot_interval_);
+  const auto j = static_cast<std::size_t>(static_cast<std::int64_t>(u));  // u >= 0: truncation = floor
+  if (j != p.interval) {
+    fold(p);
+    p.interval = j;
+  }
+  const double t = u - static_cast<double>(j), t2 = t * t, t3 = t2 * t;
+  double* tm = p.t_moment;
+  tm[0] += 1.0;
+  tm[1] += t;
+  tm[2] += t2;
+  tm[3] += t3;
+  tm[4] += t2 * t2;
+  tm[5] += t2 * t3;
+  tm[6] += t3 * t3;
+  double* ty = p.ty_moment;
+  ty[0] += y;
+  ty[1] += t * y;
+  ty[2] += t2 * y;
+  ty[3] += t3 * y;
+  // Second differences of readings evenly spaced on the grid (a dropped row breaks the spacing).
+  if (p.n >= 2 && std::abs((x - p.x1) - (p.x1 - p.x2)) < 1e-6 * out_.grid_interval_s)
+    out_.count_bound_rad = std::max(out_.count_bound_rad, std::abs((y - p.y1) - (p.y1 - p.y2)));
+  p.x2 = p.x1, p.y2 = p.y1, p.x1 = x, p.y1 = y;
+  p.n += 1;
+  p.sx += x;
+  p.sxx += x * x;
+  p.sy += y;
+  p.sxy += x * y;
+  p.syy += y * y;
+  ++out_.samples;
+}
 
 }  // namespace gyrocal
