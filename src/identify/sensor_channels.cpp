@@ -104,18 +104,25 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       for (std::size_t i = 0; i + 1 < d.samples; i += stride) at(i);
       if (d.samples > 0) at(d.samples - 1);
     } else {
+      // Following the measured motion, the operator's angle is the output's own (Dwell::basis_angle): where
+      // a ripple bends the counter encoder's line window by window, the dwell's one line is not it.
+      BasisAngleCursor basis(d.basis_angle);
+      std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
           const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
           if (follow)
-            add_joints(s.first_time_s + dt, measured_joints(d, si, i), -counter_line);
+            add_joints(
+                s.first_time_s + dt, measured_joints(d, si, i),
+                d.basis_angle.empty() ? -counter_line : -basis.at(first_sample + i, s.first_time_s + dt));
           else
             add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);
         };
         for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
         if (s.count > 0) at(s.count - 1);
+        first_sample += s.count;
       }
     }
     for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));

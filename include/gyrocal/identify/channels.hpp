@@ -113,6 +113,21 @@ double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d);
 /// heading stays on its line), beta as planned.
 JointState measured_joints(const Dwell& d, std::size_t stretch, std::size_t i);
 
+/// The output's basis angle replayed sample by sample (Dwell::basis_angle): psi_r, rad, of the measured
+/// samples in their order (the stretches' samples one after the other), at their times on the dwell's clock.
+class BasisAngleCursor {
+ public:
+  explicit BasisAngleCursor(const std::vector<BasisAngle>& pieces) : pieces_(pieces) {}
+  double at(std::size_t sample, double t_s) {
+    while (next_ < pieces_.size() && pieces_[next_].first_sample <= sample) ++next_;
+    return next_ == 0 ? 0.0 : pieces_[next_ - 1].at(t_s);
+  }
+
+ private:
+  const std::vector<BasisAngle>& pieces_;
+  std::size_t next_ = 0;
+};
+
 /// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
 /// (docs/calibration.md, "The rate the channels follow"): the spline departs from the line beyond the
 /// readings' scatter, the encoder resolves the change, and measured_rate_effect_g exceeds
