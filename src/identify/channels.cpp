@@ -494,12 +494,14 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     } else {
       // The dwell's own samples, stretch by stretch (gaps and dropped rows as the gyro output has them).
       BasisAngleCursor basis(d.basis_angle);
+      LeftOutSamples left_out(d.gyro.outlier_samples);
       std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
           const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
+          if (follow && left_out.contains(first_sample + i)) return;
           if (follow) {
             // The joints the model is evaluated at follow the measured motion, and the operator's gamma is
             // the output's own (Dwell::basis_angle), which a ripple bends window by window.

@@ -929,7 +929,7 @@ struct Reducer::State {
     if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
       warnings.push_back(fmt::format(
           "{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} robust standard "
-          "deviations of the dwell's fit) and replaced by the fit.",
+          "deviations of the dwell's fit) and left out of it.",
           at(d.first_time_s), what, d.gyro.outliers, d.samples,
           100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
           options.outlier_threshold));

@@ -35,6 +35,16 @@ struct PositionChannels {
   /// regressors of its products) at the exact inputs, reduced by the same operator as its output. The gyro's
   /// fields above are then zero. Size 0 for the gyro.
   DesignRow sensor_exact;
+  /// A sensor's dwell that follows its measured motion (follows_measured_rate): the design row reduced
+  /// revolution by revolution as the output's scatter reduces it (the revolution's harmonic fit at this
+  /// position's gamma; `index` the revolution of the output's basis angle from the dwell's first sample),
+  /// so that identify takes the scatter of the output minus the model between revolutions. Empty otherwise:
+  /// on the dwell's lines the model is the same every revolution.
+  struct PeriodRow {
+    int index = 0;
+    DesignRow row;
+  };
+  std::vector<PeriodRow> sensor_periods;
 
   /// The omega_I the compensation assumes, deg/h.
   double omega_deg_h(Compensation c) const {
@@ -125,6 +135,21 @@ class BasisAngleCursor {
 
  private:
   const std::vector<BasisAngle>& pieces_;
+  std::size_t next_ = 0;
+};
+
+/// The samples the output's reduction left out as outliers (DwellValues::outlier_samples, ascending),
+/// asked for in ascending order of their numbers in the dwell.
+class LeftOutSamples {
+ public:
+  explicit LeftOutSamples(const std::vector<std::size_t>& samples) : samples_(samples) {}
+  bool contains(std::size_t sample) {
+    while (next_ < samples_.size() && samples_[next_] < sample) ++next_;
+    return next_ < samples_.size() && samples_[next_] == sample;
+  }
+
+ private:
+  const std::vector<std::size_t>& samples_;
   std::size_t next_ = 0;
 };
 
