@@ -68,7 +68,7 @@ std::string record_toml(double counts) {
 /// Every imperfection of the generator whose effect the calibration models exactly: its own order, ramps,
 /// jitter and rounded stamps (the reducer's uniform grid), encoder counts of `counts` a turn, a toggling
 /// position encoder, the drive's rate offset (the channels follow the measured rate), a gap, a clock jump,
-/// spikes, a beta glitch. No ripple (see ADriveRippleInflatesTheStdWhichCoversTheBiasItLeaves).
+/// spikes, a beta glitch. No ripple (see ADriveRippleNeitherBiasesNorInflates).
 testing::RigImperfections exactly_modelled(double counts) {
   testing::RigImperfections imp = testing::every_imperfection();
   imp.ripple = 0.0;
@@ -170,100 +170,98 @@ std::pair<double, double> mean_std(const std::vector<double>& v) {
   return {mean, std::sqrt(sq / (n - 1.0))};
 }
 
-TEST_F(AccelerometerRig, NoisyZScoresOfTheElevenAndTheRadiusErrorHaveUnitSpread) {
-  // 200 rig records (10 ug/sqrt(Hz), every exactly modelled imperfection, encoders of 2^24 counts a turn,
-  // whose phase miss ~1e-9 rad is far below the noise's), each calibrated with --estimate radius_error
-  // against a truth whose arm is 30 um long: (estimate - truth) / std spreads as a unit normal when the
-  // stated std is honest. The std of 200 unit normals lies in [0.9, 1.1] with probability ~0.95; the band is
-  // [0.85, 1.15], and the mean within 4 / sqrt(200) = 0.28.
+/// z-scores of the eleven and the radius error over `seeds` rig records (10 ug/sqrt(Hz), every exactly
+/// modelled imperfection, encoders of 2^24 counts a turn, whose phase miss ~1e-9 rad is far below the
+/// noise's) with a drive ripple of `ripple` at 0.37 Hz, each calibrated with --estimate radius_error against
+/// a truth whose arm is 30 um long; and the mean stated std of each.
+struct ZScores {
+  std::vector<std::vector<double>> z, std;
+};
+ZScores z_scores(const fs::path& dir, double ripple, int seeds) {
   const double counts = 16777216.0;
   const Scenario config = rig_accelerometer(true);
   Scenario truth = config;
   truth.errors.radius_error_m = 30e-6;
-  const int seeds = 200;
-  std::vector<std::vector<double>> z(kNumAccelCoefficients + 1);
-  const fs::path path = dir_ / "rig.csv";
+  ZScores out;
+  out.z.resize(kNumAccelCoefficients + 1);
+  out.std.resize(kNumAccelCoefficients + 1);
+  const fs::path path = dir / "rig.csv";
+  testing::RigImperfections imp = exactly_modelled(counts);
+  imp.ripple = ripple;
   for (int seed = 1; seed <= seeds; ++seed) {
-    write_rig_record(path, truth, exactly_modelled(counts), static_cast<std::uint64_t>(seed), counts);
+    write_rig_record(path, truth, imp, static_cast<std::uint64_t>(seed), counts);
     const CalibrationResult r = calibrate_rig(path, config, counts, {"radius_error"});
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
       const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
-      ASSERT_TRUE(c.identifiable) << c.name;
-      z[k].push_back((c.value - truth.accelerometer.coefficients.values[k]) / c.std);
+      EXPECT_TRUE(c.identifiable) << c.name;
+      out.z[k].push_back((c.value - truth.accelerometer.coefficients.values[k]) / c.std);
+      out.std[k].push_back(c.std);
     }
-    ASSERT_EQ(r.machine_errors.size(), 1u);
-    ASSERT_TRUE(r.machine_errors[0].identifiable) << r.machine_errors[0].reason;
-    z.back().push_back((r.machine_errors[0].value - 30e-6) / r.machine_errors[0].std);
+    EXPECT_EQ(r.machine_errors.size(), 1u);
+    EXPECT_TRUE(r.machine_errors[0].identifiable) << r.machine_errors[0].reason;
+    out.z.back().push_back((r.machine_errors[0].value - 30e-6) / r.machine_errors[0].std);
+    out.std.back().push_back(r.machine_errors[0].std);
   }
+  return out;
+}
+
+/// The std of z of 200 unit normals lies in [0.9, 1.1] with probability ~0.95; the band is [0.85, 1.15], and
+/// the mean within 4 / sqrt(seeds).
+void expect_unit_spread(const ZScores& zs, const char* what) {
   for (std::size_t k = 0; k <= kNumAccelCoefficients; ++k) {
     const std::string name =
         k < kNumAccelCoefficients ? std::string(kAccelerometerParameters[k].name) : "radius_error";
-    const auto [mean, sd] = mean_std(z[k]);
-    std::printf("%s: z mean %.3f, std %.3f over %d seeds\n", name.c_str(), mean, sd, seeds);
+    const auto [mean, sd] = mean_std(zs.z[k]);
+    std::printf("%s %s: z mean %.3f, std %.3f over %zu seeds\n", what, name.c_str(), mean, sd,
+                zs.z[k].size());
     EXPECT_GE(sd, 0.85) << name;
     EXPECT_LE(sd, 1.15) << name;
-    EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(seeds))) << name;
+    EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(static_cast<double>(zs.z[k].size()))) << name;
   }
 }
 
-TEST_F(AccelerometerRig, ADriveRippleInflatesTheStdWhichCoversTheBiasItLeaves) {
-  // The same records (same noise: the generator draws it apart from the motion) with and without a drive
-  // ripple of 2e-4 at 0.37 Hz, 40 seeds. What is measured (docs/accelerometer.md, "The drive's ripple"): a
-  // reduced value's std comes from the output's scatter between revolutions, which the ripple's centripetal
-  // modulation (2 eps Ar: 5 mg at 12 g) inflates, so the stated std grows x10 to x105 while the estimates'
-  // scatter about their mean barely grows; and the channels following the measured motion leave a bias of up
-  // to ~22 of the smooth records' std (Kpp; Kio, delta_p, Kip ~10) on this short 50 Hz test. The inflated std
-  // covers that bias (every |z| < 0.8): nothing is stated wrongly, but the std is not the noise's. Making it
-  // honest needs both the scatter of the output minus the model and a closer following; until then this test
-  // pins what holds.
-  const double counts = 16777216.0;
-  const Scenario s = rig_accelerometer(true);
-  const int seeds = 40;
-  std::vector<std::vector<double>> z_rippled(kNumAccelCoefficients), inflation(kNumAccelCoefficients),
-      scatter_smooth(kNumAccelCoefficients), scatter_rippled(kNumAccelCoefficients);
-  std::vector<double> smooth_std_of(kNumAccelCoefficients, 0.0);
-  const fs::path path = dir_ / "rig.csv";
-  for (int seed = 1; seed <= seeds; ++seed) {
-    testing::RigImperfections imp = exactly_modelled(counts);
-    write_rig_record(path, s, imp, static_cast<std::uint64_t>(seed), counts);
-    const CalibrationResult smooth = calibrate_rig(path, s, counts);
-    imp.ripple = 2e-4;
-    write_rig_record(path, s, imp, static_cast<std::uint64_t>(seed), counts);
-    const CalibrationResult rippled = calibrate_rig(path, s, counts);
-    for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-      const double t = s.accelerometer.coefficients.values[k];
-      const SensorCoefficientEstimate &a = smooth.sensor_coefficients[k], &b = rippled.sensor_coefficients[k];
-      ASSERT_TRUE(b.identifiable) << b.name;
-      z_rippled[k].push_back((b.value - t) / b.std);
-      inflation[k].push_back(b.std / a.std);
-      scatter_smooth[k].push_back((a.value - t) / a.std);
-      scatter_rippled[k].push_back((b.value - t) / a.std);
-      smooth_std_of[k] += a.std / seeds;
-    }
-  }
-  // The ripple's deterministic part: a noise-free rippled record's errors, in the smooth records' std.
+TEST_F(AccelerometerRig, NoisyZScoresOfTheElevenAndTheRadiusErrorHaveUnitSpread) {
+  // 200 rig records without a ripple: (estimate - truth) / std spreads as a unit normal when the stated std
+  // is honest.
+  expect_unit_spread(z_scores(dir_, 0.0, 200), "smooth");
+}
+
+TEST_F(AccelerometerRig, ADriveRippleNeitherBiasesNorInflates) {
+  // docs/accelerometer.md, "The drive's ripple". A ripple of 2e-4 at 0.37 Hz moves the centripetal force at
+  // 12 g by 5 mg and its direction by as much again, against ~14 ug of noise a revolution.
+  // Noise-free (encoders of 2^32 counts, every exactly modelled imperfection, spikes included): the channels
+  // follow the measured motion, reduced by the output's own operator (its basis angle, its outliers left
+  // out), and every coefficient comes back as from a smooth record to the spline's approximation of the
+  // ripple (reduce/measured_rate.hpp): measured 1.0e-3 ug/g^2 on Kip, 4.9e-4 urad on delta_p and below
+  // 1.3e-4 of their units on the others (K1 2e-12 relative), against 6e-3 and 7e-3 with the dwell's one line
+  // as the operator's angle and 2.8 ug/g^2 and 2.2 urad before that: within 1.5e-3 of each unit, K1 within
+  // 1e-9. The 1e-4 is not yet met for Kip and delta_p.
+  const double counts = 4294967296.0;
+  const Scenario s = rig_accelerometer(false);
   testing::RigImperfections imp = exactly_modelled(counts);
   imp.ripple = 2e-4;
-  write_rig_record(path, rig_accelerometer(false), imp, 1, counts);
-  const CalibrationResult clean = calibrate_rig(path, rig_accelerometer(false), counts);
+  const fs::path path = dir_ / "rippled.csv";
+  write_rig_record(path, s, imp, 1, counts);
+  const CalibrationResult clean = calibrate_rig(path, s, counts);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const std::string name(kAccelerometerParameters[k].name);
-    const double bias = clean.sensor_coefficients[k].value - s.accelerometer.coefficients.values[k];
-    const auto [zm, zs] = mean_std(z_rippled[k]);
-    const double inflation_mean = mean_std(inflation[k]).first;
-    std::printf(
-        "%s: std inflated x%.1f; rippled z mean %.3f std %.3f; error in the smooth std: noise-free %.2f, "
-        "mean %.2f (smooth records %.2f), scatter %.2f (smooth %.2f)\n",
-        name.c_str(), inflation_mean, zm, zs, bias / smooth_std_of[k], mean_std(scatter_rippled[k]).first,
-        mean_std(scatter_smooth[k]).first, mean_std(scatter_rippled[k]).second,
-        mean_std(scatter_smooth[k]).second);
-    // What holds: every rippled estimate lies within its stated std (the ripple biases none beyond it) ...
-    for (double z : z_rippled[k]) EXPECT_LT(std::abs(z), 1.0) << name;
-    // ... the stated std is inflated, boundedly (measured x10 to x105) ...
-    EXPECT_GT(inflation_mean, 1.0) << name;
-    EXPECT_LT(inflation_mean, 200.0) << name;
-    // ... while the estimates' scatter about their mean barely grows (measured x0.95 to x1.5).
-    EXPECT_LT(mean_std(scatter_rippled[k]).second, 2.0 * mean_std(scatter_smooth[k]).second) << name;
+    const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
+    ASSERT_TRUE(c.identifiable) << c.name;
+    std::printf("noise-free rippled %s: error %.3g (std %.3g)\n", c.name.c_str(),
+                c.value - s.accelerometer.coefficients.values[k], c.std);
+    EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], k == 1 ? noise_free_tolerance(k) : 1.5e-3)
+        << c.name;
+  }
+  // Noisy, 200 seeds: the std is the residual's after the model, so z spreads as a unit normal, and the
+  // stated std is the smooth records' (the same 20 seeds without the ripple: within 1.2x).
+  const ZScores rippled = z_scores(dir_, 2e-4, 200);
+  expect_unit_spread(rippled, "rippled");
+  const ZScores smooth = z_scores(dir_, 0.0, 20);
+  for (std::size_t k = 0; k <= kNumAccelCoefficients; ++k) {
+    double ratio = 0.0;
+    for (std::size_t i = 0; i < 20; ++i) ratio += rippled.std[k][i] / smooth.std[k][i] / 20.0;
+    std::printf("stated std rippled / smooth, %zu: %.3f\n", k, ratio);
+    EXPECT_LT(ratio, 1.2) << k;
+    EXPECT_GT(ratio, 1.0 / 1.2) << k;
   }
 }
 

@@ -124,7 +124,7 @@ Eigen::Vector3d force(const CentrifugeModel& model, JointState j, double beta) {
   return exact_inputs(model, j).specific_force_g;
 }
 
-/// Per position: the true specific force (a_I, a_O, a_S), reduced by the channels' operator on the dwell's
+/// Per position: the true specific force (a_I, a_O, a_S), reduced by the output's operator on the dwell's
 /// samples, the truth taken from the generator's row at each sample's instant (no jitter: the stamps are the
 /// instants).
 std::vector<Eigen::Vector3d> true_reduced_force(const Scenario& s, const RigReduction& r) {
@@ -133,8 +133,11 @@ std::vector<Eigen::Vector3d> true_reduced_force(const Scenario& s, const RigRedu
   std::vector<std::vector<DwellValues>> per_dwell;
   for (const Dwell& d : r.reduction.dwells) {
     DwellAccumulator acc(ReduceOptions{}, d.gammas_rad, d.is_static, 3, d.planned_duration_s, false, 0.0);
+    // The output's operator: its basis angle as the reducer took it (Dwell::basis_angle).
+    BasisAngleCursor basis(d.basis_angle);
+    std::size_t sample = 0;
     for (const TimeStretch& st : d.stretches)
-      for (std::size_t i = 0; i < st.count; ++i) {
+      for (std::size_t i = 0; i < st.count; ++i, ++sample) {
         const double dt = static_cast<double>(i) * st.interval_s, t = st.first_time_s + dt;
         // The row of that instant (rows are at k / fs; a gap leaves some out).
         const auto k = static_cast<long>(std::llround(t * fs));
@@ -144,7 +147,7 @@ std::vector<Eigen::Vector3d> true_reduced_force(const Scenario& s, const RigRedu
         EXPECT_NEAR(it->time_s, t, 1e-6);
         const Eigen::Vector3d f = force(model, it->truth, d.beta_rad);
         const double v[3] = {f.x(), f.y(), f.z()};
-        acc.add(t, -(st.counter_at_first_rad + d.counter.rate_rad_s * dt), v);
+        acc.add(t, -basis.at(sample, t), v);
       }
     std::vector<DwellValues> cols;
     for (int c = 0; c < 3; ++c) cols.push_back(acc.finish(c));

@@ -175,7 +175,7 @@ constexpr ReduceKey kReduceKeys[] = {
      "only choice exact on any configuration (32 left 4.3e-6 deg/h/g^2 on dOS with large machine errors)"},
     {"outlier_threshold", &ReduceOptions::outlier_threshold, nullptr, nullptr, "robust standard deviations",
      "an output sample further than this from its block's median residual about the dwell's fit is an "
-     "outlier, counted and replaced by the fit (0 = no rejection): Gaussian noise passes 6 once in 5e8"},
+     "outlier, counted and left out of the fit (0 = no rejection): Gaussian noise passes 6 once in 5e8"},
     {"outlier_block_samples", nullptr, &ReduceOptions::outlier_block_samples, nullptr, "samples",
      "the outlier rule tests blocks of whole revolutions of at least this many samples, enough for the "
      "median absolute deviation to be a good scale (+-13 % at 128); the memory of one block"},

@@ -493,21 +493,29 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       if (d.samples > 0) at(d.samples - 1);
     } else {
       // The dwell's own samples, stretch by stretch (gaps and dropped rows as the gyro output has them).
+      BasisAngleCursor basis(d.basis_angle);
+      LeftOutSamples left_out(d.gyro.outlier_samples);
+      std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
           const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
+          if (follow && left_out.contains(first_sample + i)) return;
           if (follow) {
-            // The operator's gamma stays the line's: only the joints the model is evaluated at move.
+            // The joints the model is evaluated at follow the measured motion, and the operator's gamma is
+            // the output's own (Dwell::basis_angle), which a ripple bends window by window.
             evaluate_channels(model, d, measured_joints(d, si, i), v);
-            acc.add(s.first_time_s + dt, -counter_line, v);
+            acc.add(s.first_time_s + dt,
+                    d.basis_angle.empty() ? -counter_line : -basis.at(first_sample + i, s.first_time_s + dt),
+                    v);
           } else {
             add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);
           }
         };
         for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
         if (s.count > 0) at(s.count - 1);
+        first_sample += s.count;
       }
     }
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
+#include <variant>
 
 #include "gyrocal/core/parallel.hpp"
 #include "gyrocal/core/units.hpp"
@@ -32,6 +35,8 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
   // column is a difference of the joints' rates.
   const std::vector<bool> rate_columns(static_cast<std::size_t>(columns), false);
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
+  // Following dwells: per revolution, its index and the columns' values at each gamma (gamma x column).
+  std::vector<std::vector<std::pair<int, Eigen::MatrixXd>>> per_revolution(reduction.dwells.size());
   std::vector<DwellChannelsRoute> chosen(reduction.dwells.size());
   parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
     const Dwell& d = reduction.dwells[di];
@@ -68,11 +73,42 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
         return;
       }
     }
+    // The revolutions' own fits, as the output's scatter takes them (DwellAccumulator: a revolution of the
+    // basis angle from the first sample, a harmonic fit without drift when it holds two samples a
+    // parameter), where the model changes from one revolution to the next: following the measured motion.
+    const bool per_rev = follow && std::holds_alternative<HarmonicFit>(acc.reduction());
+    std::optional<HarmonicFit> rev_fit;
+    int revolution = 0;
+    double gamma_first = 0.0;
+    const auto close_revolution = [&] {
+      if (!rev_fit) return;
+      const int nr = 2 * options.harmonic_order + 1;
+      if (rev_fit->samples() >= static_cast<std::size_t>(2 * nr)) {
+        Eigen::MatrixXd values(static_cast<Eigen::Index>(d.gammas_rad.size()), columns);
+        DwellValues out;
+        out.value.assign(d.gammas_rad.size(), 0.0);
+        out.samples.assign(d.gammas_rad.size(), 0);
+        for (int c = 0; c < columns; ++c) {
+          rev_fit->values(c, 0.0, out);
+          for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
+            values(static_cast<Eigen::Index>(k), c) = out.value[k];
+        }
+        per_revolution[di].emplace_back(revolution, std::move(values));
+      }
+      rev_fit.reset();
+    };
     const auto add_joints = [&](double t, const JointState& j, double gamma_rad) {
       const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
       v[0] = row.known;
       for (std::size_t k = 0; k < row.size; ++k) v[k + 1] = row.regressors[k];
       acc.add(t, gamma_rad, v.data());
+      if (!per_rev) return;
+      if (acc.samples() == 1) gamma_first = gamma_rad;
+      const int rev = static_cast<int>(std::abs(gamma_rad - gamma_first) / (2.0 * kPi));
+      if (rev != revolution) close_revolution();
+      revolution = rev;
+      if (!rev_fit) rev_fit.emplace(d.gammas_rad, options.harmonic_order, false, columns, false);
+      rev_fit->add(0.0, gamma_rad, v.data());
     };
     const auto add_sample = [&](double t, double main_rad, double counter_rad) {
       JointState j;
@@ -104,20 +140,30 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       for (std::size_t i = 0; i + 1 < d.samples; i += stride) at(i);
       if (d.samples > 0) at(d.samples - 1);
     } else {
+      // Following the measured motion, the operator's angle is the output's own (Dwell::basis_angle): where
+      // a ripple bends the counter encoder's line window by window, the dwell's one line is not it.
+      BasisAngleCursor basis(d.basis_angle);
+      LeftOutSamples left_out(d.gyro.outlier_samples);
+      std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];
         const auto at = [&](std::size_t i) {
           const double dt = static_cast<double>(i) * s.interval_s;
           const double counter_line = s.counter_at_first_rad + d.counter.rate_rad_s * dt;
+          if (follow && left_out.contains(first_sample + i)) return;
           if (follow)
-            add_joints(s.first_time_s + dt, measured_joints(d, si, i), -counter_line);
+            add_joints(
+                s.first_time_s + dt, measured_joints(d, si, i),
+                d.basis_angle.empty() ? -counter_line : -basis.at(first_sample + i, s.first_time_s + dt));
           else
             add_sample(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);
         };
         for (std::size_t i = 0; i + 1 < s.count; i += stride) at(i);
         if (s.count > 0) at(s.count - 1);
+        first_sample += s.count;
       }
     }
+    close_revolution();
     for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
   });
   if (routes) *routes = std::move(chosen);
@@ -131,6 +177,16 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     ch.sensor_exact.known = at(0);
     ch.sensor_exact.size = probe.size;
     for (std::size_t k = 0; k < probe.size; ++k) ch.sensor_exact.regressors[k] = at(static_cast<int>(k) + 1);
+    for (const auto& [index, values] : per_revolution[static_cast<std::size_t>(p.dwell)]) {
+      PositionChannels::PeriodRow pr;
+      pr.index = index;
+      const auto g = static_cast<Eigen::Index>(p.gamma_slot);
+      pr.row.known = values(g, 0);
+      pr.row.size = probe.size;
+      for (std::size_t k = 0; k < probe.size; ++k)
+        pr.row.regressors[k] = values(g, static_cast<Eigen::Index>(k) + 1);
+      ch.sensor_periods.push_back(pr);
+    }
     out.push_back(ch);
   }
   return out;

@@ -219,7 +219,7 @@ void DwellAccumulator::add_general(double t, double gamma, const double* values)
   const bool boundary = !spinning_ || seen_revolution_ != block_revolution_;
   if ((boundary && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples) test_block();
   block_revolution_ = seen_revolution_;
-  pending_.push_back({t, gamma, values[0], period, after_break});
+  pending_.push_back({t, gamma, values[0], period, after_break, samples_ - 1});
 }
 
 void DwellAccumulator::add_sums(double first_time_s, double last_time_s, std::size_t samples,
@@ -403,21 +403,34 @@ void DwellAccumulator::test_block() {
     ref_normal_ = std::move(normal);
     ref_rhs_ = std::move(rhs);
   }
-  // Every sample's b b' enters the reference sums (an outlier's with the fit's value in place of its own).
-  if (shared) ref_normal_ = ref_normal_before + block_normal;
+  // An outlier is left out of the fit (as the settled normal equations already leave it): replaced by the
+  // fit's value it would be the same for a signal the fit holds whole, but a drive's ripple moves an
+  // accelerometer's output by far more than the fit holds (docs/accelerometer.md), and the model's channels
+  // that follow the measured motion leave out the same samples (outlier_samples), so the two stay one
+  // operator. A gap's mark passes to the next sample kept.
+  bool carry_break = false;
+  // Without outliers the block's sums of b b' (per period) serve the reference sums and the fit; a block
+  // with outliers adds its kept samples one by one.
+  const bool use_shared = shared && std::find(out.begin(), out.end(), 1) == out.end();
+  if (use_shared) ref_normal_ = ref_normal_before + block_normal;
   std::size_t segment = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Pending& s = pending_[i];
-    const double v = out[i] ? fit_at(i, x) : s.value;
-    if (out[i]) ++outliers_;
-    if (!settled || out[i]) {
-      const double* b = basis_of(i);
-      if (!shared) add_outer_product(ref_normal_.data(), b, p);
-      for (int j = 0; j < p; ++j) ref_rhs_[j] += b[j] * v;
+    if (out[i]) {
+      ++outliers_;
+      outlier_samples_.push_back(s.index);
+      carry_break = carry_break || s.after_break;
+      continue;
     }
-    accumulate(s.t, s.gamma, s.period, &v, s.after_break, basis_of(i), !shared);
+    if (!settled) {
+      const double* b = basis_of(i);
+      if (!use_shared) add_outer_product(ref_normal_.data(), b, p);
+      for (int j = 0; j < p; ++j) ref_rhs_[j] += b[j] * s.value;
+    }
+    accumulate(s.t, s.gamma, s.period, &s.value, s.after_break || carry_break, basis_of(i), !use_shared);
+    carry_break = false;
     // A period's sums join the fit's once its first sample is in (after the period before was closed).
-    if (shared && segment < segment_first.size() && segment_first[segment] == i)
+    if (use_shared && segment < segment_first.size() && segment_first[segment] == i)
       fit->add_normal_sum(&segment_normal[segment++ * pp * pp]);
   }
   pending_.clear();
@@ -444,6 +457,7 @@ void DwellAccumulator::flush() {
   // complete: the dwell's last sample within 1.5 sample steps of a whole turn, without a gap.
   if (!with_std_err_) return;
   if (spinning_ && (!last_revolution_complete() || period_broken_)) return;
+  scatter_.index = period_;
   std::visit([&](auto& method) { method.close_period(scatter_); }, reduction_);
 }
 
@@ -462,6 +476,7 @@ void DwellAccumulator::accumulate(double t, double gamma, int period, const doub
                                   const double* basis, bool with_normal) {
   if (with_std_err_) {
     if (period != period_) {
+      scatter_.index = period_;
       std::visit(
           [&](auto& method) {
             if (period_broken_)
@@ -496,6 +511,7 @@ DwellValues DwellAccumulator::finish(int column) {
   const double t_mid = scaled_mid_time();
   std::visit([&](const auto& method) { method.values(column, t_mid, out); }, reduction_);
   out.outliers = outliers_;
+  if (column == 0) out.outlier_samples = outlier_samples_;
   if (!with_std_err_ || column != 0) return out;
 
   // Standard errors and covariance of the values at t_mid. The covariance's shape is the reduction
@@ -503,25 +519,51 @@ DwellValues DwellAccumulator::finish(int column) {
   // between revolutions (or batches), pooled over the dwell's gammas: a 4 x 4 covariance estimated from a few
   // revolutions would weight a generalised least-squares fit worse than none.
   const bool drift = std::visit([](const auto& method) { return method.fits_drift(); }, reduction_);
-  const Eigen::MatrixXd measured = scatter_.covariance_at(t_mid, drift);
-  out.revolutions = static_cast<int>(scatter_.n);
+  out.periods = scatter_.periods;
+  out.scatter_t_mid = t_mid;
+  out.scatter_sweep = scatter_.sweep;
+  out.scatter_drift = drift;
+  out.shape = white_noise_covariance();
+  state_level(out, scatter_);
+  return out;
+}
+
+void DwellAccumulator::state_level(DwellValues& out, const RevolutionSums& scatter) {
+  const double t_mid = out.scatter_t_mid;
+  const bool drift = out.scatter_drift;
+  const std::size_t gammas = out.value.size();
+  const Eigen::MatrixXd measured = scatter.covariance_at(t_mid, drift);
+  out.revolutions = static_cast<int>(scatter.n);
   out.dof = 0.0;
-  if (measured.size() == 0 || !measured.allFinite()) return out;
-  const Eigen::MatrixXd shape = white_noise_covariance();
+  if (measured.size() == 0 || !measured.allFinite()) return;
+  const Eigen::MatrixXd& shape = out.shape;
   // Degrees of freedom: the revolutions' scatter about a line (or their mean), pooled over the gammas,
   // whose values are correlated as the shape says: a mean of ng scaled chi-squares with correlations
   // rho has ng^2 / sum(rho^2) times their degrees of freedom (docs/calibration.md).
   const Eigen::VectorXd sd = shape.diagonal().cwiseSqrt();
   const double rho2 = (shape.array() / (sd * sd.transpose()).array()).square().sum();
-  out.dof = (scatter_.n - scatter_.parameters(drift)) * static_cast<double>(gammas_ * gammas_) / rho2;
+  out.dof = (scatter.n - scatter.parameters(drift)) * static_cast<double>(gammas * gammas) / rho2;
   const double level = (measured.diagonal().array() / shape.diagonal().array()).mean();
   out.covariance = level * shape;
   out.level = level;
-  for (std::size_t k = 0; k < gammas_; ++k) {
+  for (std::size_t k = 0; k < gammas; ++k) {
     const auto kk = static_cast<Eigen::Index>(k);
     out.std_err[k] = std::sqrt(out.covariance(kk, kk));
   }
-  return out;
+}
+
+void relevel_from_periods(DwellValues& v, const std::vector<PeriodValues>& periods) {
+  if (v.shape.size() == 0) return;
+  RevolutionSums scatter;
+  scatter.sweep = v.scatter_sweep;
+  for (const PeriodValues& p : periods) {
+    scatter.index = p.index;
+    scatter.add(p.t_scaled, p.values);
+  }
+  v.covariance.resize(0, 0);
+  v.level = std::numeric_limits<double>::quiet_NaN();
+  v.std_err.assign(v.value.size(), std::numeric_limits<double>::quiet_NaN());
+  DwellAccumulator::state_level(v, scatter);
 }
 
 std::vector<double> DwellAccumulator::white_noise_gain() const {

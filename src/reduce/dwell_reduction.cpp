@@ -70,6 +70,7 @@ void add_outer_product(double* normal, const double* b, int n) {
 // ---- RevolutionSums ---------------------------------------------------------------------------------------
 
 void RevolutionSums::add(double ti, const Eigen::VectorXd& vi) {
+  periods.push_back({index, ti, vi});
   if (v.size() == 0) {
     v0 = vi;
     v = tv = Eigen::VectorXd::Zero(vi.size());

@@ -103,7 +103,7 @@ MeasuredState MeasuredMotion::at(std::size_t phase, double x_s) const {
 MeasuredMotionFit::MeasuredMotionFit(double grid_interval_s, double origin_s, double origin_rad,
                                      double reference_rate_rad_s, double knot_interval_s, double span_s) {
   out_.grid_interval_s = grid_interval_s;
-  const double h = std::max(knot_interval_s, 16.0 * grid_interval_s);
+  const double h = std::max(knot_interval_s, 8.0 * grid_interval_s);
   out_.knot_interval_s = span_s > h ? span_s / std::round(span_s / h) : h;
   inverse_knot_interval_ = 1.0 / out_.knot_interval_s;
   out_.origin_s = origin_s;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -184,6 +185,7 @@ struct Run {
   double beta_deg = 0.0, gamma_deg = 0.0;
   // The local lines the next rows are checked against (the last window's), on the run's clock.
   Line theta_line, psi_line;
+  std::size_t psi_line_serial = 0;  // counts the lines psi_line has held
   bool psi_line_valid = true;  // psi_line holds the phase (false after a gap until the next window closes)
   // The current window of the rate check.
   LineSums block_theta, block_psi;
@@ -221,6 +223,10 @@ struct Run {
   std::vector<StretchSums> stretches;
   // The main axis' measured motion through the measured part (reduce/measured_rate.hpp): spinning dwells.
   std::optional<MeasuredMotionFit> motion;
+  // The output's basis angle, piece by piece (Dwell::basis_angle), and the line and whole turns of the last.
+  std::vector<BasisAngle> basis;
+  std::size_t basis_serial = 0;
+  double basis_turns = 0.0;
   double beta_sum = 0.0;
   std::size_t n = 0, gaps = 0;
   DwellQuality quality;
@@ -681,6 +687,7 @@ struct Reducer::State {
       };
       r.theta_line = line(r.block_theta, rt, r.block_theta0);
       r.psi_line = line(r.block_psi, rp, r.block_psi0);
+      ++r.psi_line_serial;
       r.psi_line_valid = true;
       if (!r.decided) r.gamma_deg = wrap_deg_quick(-r.psi_line(t));
       r.block_theta = r.block_psi = LineSums{};
@@ -765,6 +772,19 @@ struct Reducer::State {
     // deg would put its rounding into every basis function), continued from the reading to within half a
     // turn; after a gap, until a window has closed, the reading itself.
     const double psi = r.psi_line_valid ? u.psi + wrap_deg_quick(r.psi_line(u.t) - u.psi) : u.psi;
+    if (r.motion) {
+      // Recorded for the channels (Dwell::basis_angle): a piece where the line or its whole turns change.
+      const double turns = r.psi_line_valid ? 360.0 * std::round((psi - r.psi_line(u.t)) / 360.0) : 0.0;
+      if (!r.psi_line_valid) {
+        r.basis.push_back({r.n - 1, u.t, psi * kDegToRad, 0.0});
+        r.basis_serial = std::numeric_limits<std::size_t>::max();  // a reading: the next row starts a piece
+      } else if (r.basis.empty() || r.basis_serial != r.psi_line_serial || r.basis_turns != turns) {
+        r.basis.push_back(
+            {r.n - 1, r.psi_line.t0, (r.psi_line.at + turns) * kDegToRad, r.psi_line.rate * kDegToRad});
+        r.basis_serial = r.psi_line_serial;
+        r.basis_turns = turns;
+      }
+    }
     r.acc->add(u.t, -psi * kDegToRad, &u.y);
   }
 
@@ -935,6 +955,7 @@ struct Reducer::State {
     if (r.motion) {
       d.measured = r.motion->finish();
       for (const StretchSums& st : r.stretches) d.measured.stretch_phase.push_back(st.phase);
+      d.basis_angle = std::move(r.basis);
     }
     const double beta_deg = d.beta_rad * kRadToDeg;
     const std::string what =
@@ -950,7 +971,7 @@ struct Reducer::State {
     if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
       warnings.push_back(fmt::format(
           "{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} robust standard "
-          "deviations of the dwell's fit) and replaced by the fit.",
+          "deviations of the dwell's fit) and left out of it.",
           at(d.first_time_s), what, d.gyro.outliers, d.samples,
           100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
           options.outlier_threshold));

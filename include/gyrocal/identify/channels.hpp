@@ -35,6 +35,16 @@ struct PositionChannels {
   /// regressors of its products) at the exact inputs, reduced by the same operator as its output. The gyro's
   /// fields above are then zero. Size 0 for the gyro.
   DesignRow sensor_exact;
+  /// A sensor's dwell that follows its measured motion (follows_measured_rate): the design row reduced
+  /// revolution by revolution as the output's scatter reduces it (the revolution's harmonic fit at this
+  /// position's gamma; `index` the revolution of the output's basis angle from the dwell's first sample),
+  /// so that identify takes the scatter of the output minus the model between revolutions. Empty otherwise:
+  /// on the dwell's lines the model is the same every revolution.
+  struct PeriodRow {
+    int index = 0;
+    DesignRow row;
+  };
+  std::vector<PeriodRow> sensor_periods;
 
   /// The omega_I the compensation assumes, deg/h.
   double omega_deg_h(Compensation c) const {
@@ -112,6 +122,36 @@ double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d);
 /// acceleration from the spline; the counter platform turns back what the arm departs from its line (the
 /// heading stays on its line), beta as planned.
 JointState measured_joints(const Dwell& d, std::size_t stretch, std::size_t i);
+
+/// The output's basis angle replayed sample by sample (Dwell::basis_angle): psi_r, rad, of the measured
+/// samples in their order (the stretches' samples one after the other), at their times on the dwell's clock.
+class BasisAngleCursor {
+ public:
+  explicit BasisAngleCursor(const std::vector<BasisAngle>& pieces) : pieces_(pieces) {}
+  double at(std::size_t sample, double t_s) {
+    while (next_ < pieces_.size() && pieces_[next_].first_sample <= sample) ++next_;
+    return next_ == 0 ? 0.0 : pieces_[next_ - 1].at(t_s);
+  }
+
+ private:
+  const std::vector<BasisAngle>& pieces_;
+  std::size_t next_ = 0;
+};
+
+/// The samples the output's reduction left out as outliers (DwellValues::outlier_samples, ascending),
+/// asked for in ascending order of their numbers in the dwell.
+class LeftOutSamples {
+ public:
+  explicit LeftOutSamples(const std::vector<std::size_t>& samples) : samples_(samples) {}
+  bool contains(std::size_t sample) {
+    while (next_ < samples_.size() && samples_[next_] < sample) ++next_;
+    return next_ < samples_.size() && samples_[next_] == sample;
+  }
+
+ private:
+  const std::vector<std::size_t>& samples_;
+  std::size_t next_ = 0;
+};
 
 /// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
 /// (docs/calibration.md, "The rate the channels follow"): the spline departs from the line beyond the

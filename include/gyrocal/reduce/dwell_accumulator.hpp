@@ -77,8 +77,8 @@ struct ReduceOptions {
   /// Spikes (docs/physics.md section 14): a sample of the gyro output whose residual about the dwell's fit
   /// lies more than this many robust standard deviations (1.4826 x the median absolute deviation of the
   /// residuals of its block) from the block's median residual is an outlier; iterated until the set of
-  /// outliers is stable. It is counted and replaced by the fit's value at its instant (docs/calibration.md,
-  /// "Spikes"). 0: no rejection.
+  /// outliers is stable. It is counted and left out of the fit (docs/calibration.md, "Spikes"). 0: no
+  /// rejection.
   double outlier_threshold = 6.0;
   /// The rule tests whole revolutions (a static hold: runs of samples) in blocks of at least this many
   /// samples, against the fit of the dwell so far and the block: the memory of one block.
@@ -107,9 +107,27 @@ struct DwellValues {
   /// The covariance's level: the white-noise variance per sample, unit^2, that the scatter implies
   /// (covariance = level x the operator's white-noise covariance). NaN when not measured.
   double level = std::numeric_limits<double>::quiet_NaN();
-  /// Samples rejected as outliers (ReduceOptions::outlier_threshold) and replaced by the fit's value.
+  /// Samples rejected as outliers (ReduceOptions::outlier_threshold) and left out of the fit.
   std::size_t outliers = 0;
+  /// Their numbers in the dwell (from 0, in the order added), ascending: the model's channels evaluated
+  /// sample by sample where they follow the measured motion leave out the same samples
+  /// (identify/channels.hpp).
+  std::vector<std::size_t> outlier_samples;
+  /// With the standard errors: the values of each period (revolution or batch) that entered the scatter,
+  /// the fit in time the scatter is taken about (mid-time, drift, the sweep's phase rate), and the
+  /// operator's white-noise covariance (the covariance's shape), so that the level can be measured again
+  /// from the scatter of the periods' values minus a model's (relevel_from_periods).
+  std::vector<PeriodValues> periods;
+  double scatter_t_mid = 0.0, scatter_sweep = 0.0;
+  bool scatter_drift = false;
+  Eigen::MatrixXd shape;
 };
+
+/// `v`'s covariance level (and std_err, dof, revolutions) measured again, as DwellAccumulator::finish
+/// measures it, from the scatter between `periods` (per period of v.periods, the same index and time, other
+/// values: e.g. the output's minus the model's, identify/calibration.cpp) about v's fit in time, with v's
+/// shape. Periods missing from `periods` do not count. v is left as it was when it holds no shape.
+void relevel_from_periods(DwellValues& v, const std::vector<PeriodValues>& periods);
 
 /// Accumulates one dwell's samples (streaming, memory independent of the dwell's length) and reduces them.
 /// Spinning dwell: the values at each gamma of `gammas_rad`. Static hold: one value (the mean).
@@ -152,7 +170,7 @@ class DwellAccumulator {
       if ((period != block_revolution_ && pending_.size() >= block) || pending_.size() >= kMaxBlockSamples)
         test_block();
       block_revolution_ = period;
-      pending_.push_back({time_s, gamma_rad, values[0], period, false});
+      pending_.push_back({time_s, gamma_rad, values[0], period, false, samples_ - 1});
       return;
     }
     add_general(time_s, gamma_rad, values);
@@ -194,12 +212,17 @@ class DwellAccumulator {
   void break_revolution();
   /// The method reducing this dwell (make_dwell_reduction's choice).
   const DwellReduction& reduction() const { return reduction_; }
+  /// out's covariance, std_err, level, dof and revolutions from `scatter` about out's fit in time
+  /// (out.scatter_t_mid, scatter_drift) with out.shape: the level is the scatter's variance per unit of the
+  /// shape's, pooled over the gammas.
+  static void state_level(DwellValues& out, const RevolutionSums& scatter);
 
  private:
   struct Pending {
     double t, gamma, value;
     int period;
     bool after_break;
+    std::size_t index;  // the sample's number in the dwell
   };
   /// period: period_of(time_s, gamma_rad). basis: the outlier rule's detection basis at the sample (its first
   /// terms are a harmonic fit's basis), or null; with_normal false: the fit's b b' term is added by the
@@ -250,7 +273,7 @@ class DwellAccumulator {
 
   // Outlier rejection (docs/physics.md section 14): the block waiting to be tested, and the normal equations
   // of the dwell's fit (harmonics and drift; a static hold: mean and drift) on every sample accumulated so
-  // far, with outliers replaced by the fit.
+  // far, outliers left out.
   bool robust_ = false;
   std::vector<Pending> pending_;
   int seen_revolution_ = 0;  // of the samples added
@@ -264,6 +287,7 @@ class DwellAccumulator {
   std::vector<double> last_residuals_, last_abs_values_;
   double last_scale();
   std::size_t outliers_ = 0;
+  std::vector<std::size_t> outlier_samples_;
   std::vector<double> scratch_basis_;  // the block's detection basis, sample by sample
 };
 

@@ -35,6 +35,14 @@ void add_outer_product(double* normal, const double* b, int n);
 /// Per-revolution (or per-batch) values of column 0 at every gamma of a dwell, as sums for straight-line fits
 /// in time and their cross products: their scatter is the level of the reduced values' covariance
 /// (docs/calibration.md).
+/// One period's values (one per gamma) at its mean scaled time: `index` numbers the period in its dwell (a
+/// spinning dwell's revolution of gamma counted from its first sample; a static hold's batch).
+struct PeriodValues {
+  int index = 0;
+  double t_scaled = 0.0;
+  Eigen::VectorXd values;
+};
+
 struct RevolutionSums {
   /// The sweep's phase per unit of scaled time (0: none): then the fit in time is of 1, t, cos, sin of it
   /// (docs/physics.md section 15).
@@ -44,6 +52,10 @@ struct RevolutionSums {
   Eigen::VectorXd v0;     // the first values: sums are of deviations from them (no cancellation)
   Eigen::VectorXd v, tv;  // sums of (v - v0) and t (v - v0)
   Eigen::MatrixXd vv;
+  /// Every period added, in order (a few numbers a revolution): what the scatter of the output minus a
+  /// model is taken from (relevel_from_periods). `index` is the number the next one added gets.
+  std::vector<PeriodValues> periods;
+  int index = 0;
   /// One period's values vi (one per gamma) at its mean scaled time ti.
   void add(double ti, const Eigen::VectorXd& vi);
   /// Covariance of the lines' predictions at t_mid (of the means without drift); NaN without enough

@@ -75,12 +75,13 @@ struct MeasuredMotion {
 /// add() every sample, finish() once. Memory: 5 numbers per knot.
 class MeasuredMotionFit {
  public:
-  /// The knot interval: h = max(knot_interval_s, 16 sample intervals), shortened so that the planned span
+  /// The knot interval: h = max(knot_interval_s, 8 sample intervals), shortened so that the planned span
   /// (the measured part's planned duration; 0: none) holds a whole number of intervals. theta is fitted as
-  /// its deviation from reference(x). The reducer takes half a revolution of gamma
+  /// its deviation from reference(x). The reducer takes a quarter of a revolution of gamma
   /// (kMeasuredKnotRevolutions): the readings' scatter near the revolution's harmonics, which a reduced value
   /// picks up through the centripetal force, is what the measured rate must not carry (a cubic B-spline's
-  /// response vanishes at multiples of 1/h), while a rate change over a few revolutions is followed.
+  /// response vanishes at multiples of 1/h: a quarter revolution puts the first at the fourth harmonic,
+  /// beyond the fit's third), while a rate change over a revolution is followed.
   MeasuredMotionFit(double grid_interval_s, double origin_s, double origin_rad, double reference_rate_rad_s,
                     double knot_interval_s, double span_s = 0.0);
   void begin_phase(double x_s);
@@ -110,13 +111,18 @@ class MeasuredMotionFit {
   std::vector<Phase> phases_;
 };
 
-/// The spline's knot interval in revolutions of gamma (MeasuredMotionFit): half a revolution puts the
-/// B-splines' first zero of response at the revolution's second harmonic and follows a ripple of four
-/// revolutions' period to ~1 %; a whole revolution (zero at the first harmonic) followed a 0.37 Hz ripple at
-/// 1.6 revolutions a second too coarsely (tests/test_measured_rate.cpp: 5e-5 g reduced with exact encoders,
-/// against 4e-6 g at half a revolution and 2e-7 g at a quarter, whose noise with 2^16-count encoders was
-/// three times the half's).
-inline constexpr double kMeasuredKnotRevolutions = 0.5;
+/// The spline's knot interval in revolutions of gamma (MeasuredMotionFit, at least 8 sample intervals): a
+/// quarter of a revolution. The channels' exactness on a rippling drive is the spline's approximation of the
+/// ripple: on the tests' rig-like records (a ripple of 2e-4 at 0.37 Hz, 6 and 12 rad/s, 50 Hz, 8
+/// revolutions, 2^32-count encoders; tests/test_accelerometer_rig.cpp) half a revolution with a floor of 16
+/// samples missed the specific force by up to 3e-5 g a sample and left 6e-3 ug/g^2 on Kio and 7e-3 urad on
+/// delta_p; a quarter with a floor of 8 leaves 1.0e-3 ug/g^2 on Kip, 5e-4 urad on delta_p and below 1.3e-4
+/// of their units on the others. An eighth with a floor of 4 left 2.6e-4 urad on delta_p and below 6e-5 on
+/// the others, but then the F-test took a smooth simulated record with large machine errors for a ripple
+/// (tests/test_channels_fourier.cpp): not taken until that is understood. The spline's noise grows as
+/// h^-3/2; an accelerometer's stated std is taken from the scatter of the output minus the model, which
+/// holds it (docs/accelerometer.md).
+inline constexpr double kMeasuredKnotRevolutions = 0.25;
 
 // Inline: a sample of every spinning dwell of a record goes through it (a call a sample was measurable).
 inline void MeasuredMotionFit::add(double x_s, double theta_rad) {

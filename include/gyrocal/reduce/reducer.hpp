@@ -39,6 +39,19 @@ struct TimeStretch {
   double counter_at_first_rad = 0.0;  ///< psi_r on the dwell's line at first_time_s
 };
 
+/// A piece of the angle the output's harmonic fit took as its basis through a spinning dwell: from its
+/// `first_sample`-th measured sample on (counted over the stretches in order), the counter platform's angle
+/// psi_r = at_rad + rate_rad_s (t - t0_s) on the dwell's clock, gamma = -psi_r (rad, unwrapped as the output
+/// had it). The reducer takes the counter encoder's line of its last rate window, and after a gap, until a
+/// window has closed, each reading itself (one piece a sample, rate 0). The model's channels that follow a
+/// dwell's measured motion take the same angle (identify/channels.hpp, basis_counter_angle), so that data and
+/// model are reduced by one operator when a drive's ripple bends the counter encoder's line window by window.
+struct BasisAngle {
+  std::size_t first_sample = 0;
+  double t0_s = 0.0, at_rad = 0.0, rate_rad_s = 0.0;
+  double at(double t_s) const { return at_rad + rate_rad_s * (t_s - t0_s); }
+};
+
 /// What a dwell's steady run held and what of it was dropped, and why (docs/contract.md, data_quality).
 struct DwellQuality {
   double run_start_s = 0.0, run_end_s = 0.0;  ///< the steady run, record time
@@ -79,6 +92,9 @@ struct Dwell {
   /// record; empty otherwise): what the channels follow where it departs from the line `main`
   /// (identify/channels.hpp, docs/calibration.md).
   MeasuredMotion measured;
+  /// The output's basis angle through the measured part, piece by piece (a spinning dwell of a record; empty
+  /// otherwise).
+  std::vector<BasisAngle> basis_angle;
   DwellQuality quality;
 
   /// The i-th of `samples` evenly spaced instants of the measured part (a dwell without stretches).
