@@ -240,7 +240,15 @@ MeasuredMotion MeasuredMotionFit::finish() {
   const double s2 = n > parameters ? rss_spline / (n - parameters) : 0.0;
   out.residual_rad = std::sqrt(s2);
   out.dof = dof;
-  out.chi2 = s2 > 0.0 ? (rss_line - rss_spline) / s2 : 0.0;
+  // The residual sum about the spline comes from syy - 2 c.r + c M c, whose rounding is ~1e-14 of syy: an
+  // arm followed to within that (noise-free readings of a fine encoder, a ripple the spline holds whole)
+  // leaves a scatter of 0 or of rounding, which would make the F-test 0 / 0 (a rippled record of 100
+  // revolutions at 200 Hz read as unresolved and left on its lines: Kio missed by 0.5 ug/g^2). The scatter is
+  // taken as at least that rounding.
+  double syy_all = 0.0;
+  for (const Phase& p : phases_) syy_all += p.syy;
+  const double s2_test = n > 0.0 ? std::max(s2, 1e-14 * syy_all / n) : 0.0;
+  out.chi2 = s2_test > 0.0 ? (rss_line - rss_spline) / s2_test : 0.0;
   out.resolved = dof > 0.0 && out.chi2 > dof + 8.0 * std::sqrt(2.0 * dof);
   out.quanta_resolved = out.max_angle_deviation_rad > 0.6 * out.count_bound_rad;
   // The spline's own noise at the middle of the longest phase's middle interval: s^2 b^T (M + P)^-1 b.
