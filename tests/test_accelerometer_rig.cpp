@@ -226,6 +226,27 @@ TEST_F(AccelerometerRig, NoisyZScoresOfTheElevenAndTheRadiusErrorHaveUnitSpread)
   expect_unit_spread(z_scores(dir_, 0.0, 200), "smooth");
 }
 
+/// Calibrates the noise-free rig record of `s` with a drive ripple of 2e-4 (encoders of 2^32 counts, every
+/// exactly modelled imperfection) and checks every coefficient against the truth: within `tolerance` of its
+/// unit, K1 within 1e-9 relative.
+void expect_rippled_record_recovered(const fs::path& dir, const Scenario& s, double tolerance) {
+  const double counts = 4294967296.0;
+  testing::RigImperfections imp = exactly_modelled(counts);
+  imp.ripple = 2e-4;
+  const fs::path path = dir / "rippled.csv";
+  write_rig_record(path, s, imp, 1, counts);
+  const CalibrationResult clean = calibrate_rig(path, s, counts);
+  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
+    const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
+    ASSERT_TRUE(c.identifiable) << c.name;
+    std::printf("noise-free rippled, %d revolutions at %g Hz, %s: error %.3g (std %.3g)\n",
+                s.test.revolutions, s.test.sample_rate_hz, c.name.c_str(),
+                c.value - s.accelerometer.coefficients.values[k], c.std);
+    EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], k == 1 ? noise_free_tolerance(k) : tolerance)
+        << c.name;
+  }
+}
+
 TEST_F(AccelerometerRig, ARippledRecordOfTheDefaultTestsDwellsGivesAllElevenWithinTheIssuesTolerance) {
   // The same noise-free rippled rig record as below, but with the dwells of `gyrocal init --sensor
   // accelerometer` (100 revolutions at 200 Hz) instead of the small test's 8 at 50 Hz: what the spline's
@@ -234,23 +255,11 @@ TEST_F(AccelerometerRig, ARippledRecordOfTheDefaultTestsDwellsGivesAllElevenWith
   // (delta_p, urad; Kip 1.3e-5 ug/g^2), K1 4e-12 relative. This record found the spline's F-test reading a
   // ripple the spline holds whole as unresolved (its scatter 0 by rounding; reduce/measured_rate.cpp), which
   // left the dwells on their lines and missed Kio by 0.5 ug/g^2.
-  const double counts = 4294967296.0;
   Scenario s = rig_accelerometer(false);
   const Scenario defaults = default_accelerometer_scenario();
   s.test.revolutions = defaults.test.revolutions;
   s.test.sample_rate_hz = defaults.test.sample_rate_hz;
-  testing::RigImperfections imp = exactly_modelled(counts);
-  imp.ripple = 2e-4;
-  const fs::path path = dir_ / "rippled_long.csv";
-  write_rig_record(path, s, imp, 1, counts);
-  const CalibrationResult clean = calibrate_rig(path, s, counts);
-  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
-    ASSERT_TRUE(c.identifiable) << c.name;
-    std::printf("noise-free rippled, %d revolutions at %g Hz, %s: error %.3g\n", s.test.revolutions,
-                s.test.sample_rate_hz, c.name.c_str(), c.value - s.accelerometer.coefficients.values[k]);
-    EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], noise_free_tolerance(k)) << c.name;
-  }
+  expect_rippled_record_recovered(dir_, s, 1e-4);
 }
 
 TEST_F(AccelerometerRig, ADriveRippleNeitherBiasesNorInflates) {
@@ -262,22 +271,9 @@ TEST_F(AccelerometerRig, ADriveRippleNeitherBiasesNorInflates) {
   // ripple (reduce/measured_rate.hpp): measured 1.0e-3 ug/g^2 on Kip, 4.9e-4 urad on delta_p and below
   // 1.3e-4 of their units on the others (K1 2e-12 relative), against 6e-3 and 7e-3 with the dwell's one line
   // as the operator's angle and 2.8 ug/g^2 and 2.2 urad before that: within 1.5e-3 of each unit, K1 within
-  // 1e-9. The issue's 1e-4 is not yet met for Kip and delta_p.
-  const double counts = 4294967296.0;
-  const Scenario s = rig_accelerometer(false);
-  testing::RigImperfections imp = exactly_modelled(counts);
-  imp.ripple = 2e-4;
-  const fs::path path = dir_ / "rippled.csv";
-  write_rig_record(path, s, imp, 1, counts);
-  const CalibrationResult clean = calibrate_rig(path, s, counts);
-  for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
-    ASSERT_TRUE(c.identifiable) << c.name;
-    std::printf("noise-free rippled %s: error %.3g (std %.3g)\n", c.name.c_str(),
-                c.value - s.accelerometer.coefficients.values[k], c.std);
-    EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], k == 1 ? noise_free_tolerance(k) : 1.5e-3)
-        << c.name;
-  }
+  // 1e-9. The issue's 1e-4 is not met for Kip and delta_p on these short dwells (it is on the default test's:
+  // ARippledRecordOfTheDefaultTestsDwellsGivesAllElevenWithinTheIssuesTolerance).
+  expect_rippled_record_recovered(dir_, rig_accelerometer(false), 1.5e-3);
   // Noisy, 200 seeds: the std is the residual's after the model, so z spreads as a unit normal, and the
   // stated std is the smooth records' (the same 20 seeds without the ripple: within 1.2x).
   const ZScores rippled = z_scores(dir_, 2e-4, 200);
