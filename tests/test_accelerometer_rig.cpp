@@ -228,14 +228,26 @@ TEST_F(AccelerometerRig, NoisyZScoresOfTheElevenAndTheRadiusErrorHaveUnitSpread)
 
 /// Calibrates the noise-free rig record of `s` with a drive ripple of 2e-4 (encoders of 2^32 counts, every
 /// exactly modelled imperfection) and checks every coefficient against the truth: within `tolerance` of its
-/// unit, K1 within 1e-9 relative.
-void expect_rippled_record_recovered(const fs::path& dir, const Scenario& s, double tolerance) {
+/// unit, K1 within 1e-9 relative; with `radius`, the truth's arm is 30 um long and its error, estimated
+/// (--estimate radius_error), within a nanometre.
+void expect_rippled_record_recovered(const fs::path& dir, const Scenario& s, double tolerance,
+                                     bool radius = false) {
   const double counts = 4294967296.0;
   testing::RigImperfections imp = exactly_modelled(counts);
   imp.ripple = 2e-4;
   const fs::path path = dir / "rippled.csv";
-  write_rig_record(path, s, imp, 1, counts);
-  const CalibrationResult clean = calibrate_rig(path, s, counts);
+  Scenario truth = s;
+  if (radius) truth.errors.radius_error_m = 30e-6;
+  write_rig_record(path, truth, imp, 1, counts);
+  const CalibrationResult clean = calibrate_rig(
+      path, s, counts, radius ? std::vector<std::string>{"radius_error"} : std::vector<std::string>{});
+  if (radius) {
+    ASSERT_EQ(clean.machine_errors.size(), 1u);
+    std::printf("noise-free rippled, radius_error: error %.3g m\n", clean.machine_errors[0].value - 30e-6);
+    // Measured 4.4e-10 m with the ripple (1e-10 m on a smooth record): a nanometre, a thousandth of the
+    // sigma of a noisy record's estimate (~0.6 um).
+    EXPECT_NEAR(clean.machine_errors[0].value, 30e-6, 1e-9);
+  }
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
     const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
     ASSERT_TRUE(c.identifiable) << c.name;
@@ -252,14 +264,14 @@ TEST_F(AccelerometerRig, ARippledRecordOfTheDefaultTestsDwellsGivesAllElevenWith
   // accelerometer` (100 revolutions at 200 Hz) instead of the small test's 8 at 50 Hz: what the spline's
   // approximation of the ripple leaves near a dwell's ends shrinks with the dwell's length, and every
   // coefficient comes back within 1e-4 of its unit, K1 within 1e-9 (issue 19): measured at most 2.7e-5
-  // (delta_p, urad; Kip 1.3e-5 ug/g^2), K1 4e-12 relative. This record found the spline's F-test reading a
-  // ripple the spline holds whole as unresolved (its scatter 0 by rounding; reduce/measured_rate.cpp), which
-  // left the dwells on their lines and missed Kio by 0.5 ug/g^2.
+  // (delta_p, urad; Kip 1.3e-5 ug/g^2), K1 4e-12 relative; a 30 um radius error within 4.4e-10 m. This record
+  // found the spline's F-test reading a ripple the spline holds whole as unresolved (its scatter 0 by
+  // rounding; reduce/measured_rate.cpp), which left the dwells on their lines and missed Kio by 0.5 ug/g^2.
   Scenario s = rig_accelerometer(false);
   const Scenario defaults = default_accelerometer_scenario();
   s.test.revolutions = defaults.test.revolutions;
   s.test.sample_rate_hz = defaults.test.sample_rate_hz;
-  expect_rippled_record_recovered(dir_, s, 1e-4);
+  expect_rippled_record_recovered(dir_, s, 1e-4, true);
 }
 
 TEST_F(AccelerometerRig, ADriveRippleNeitherBiasesNorInflates) {
