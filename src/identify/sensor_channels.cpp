@@ -10,6 +10,28 @@
 #include "gyrocal/core/units.hpp"
 
 namespace gyrocal {
+namespace {
+
+/// The joints on a dwell's lines: the main and counter angles given (rad), their rates the lines', beta the
+/// dwell's.
+JointState line_joints(const Dwell& d, double main_rad, double counter_rad) {
+  JointState j;
+  j.main_angle_rad = main_rad;
+  j.main_rate_rad_s = d.main.rate_rad_s;
+  j.counter_angle_rad = counter_rad;
+  j.counter_rate_rad_s = d.counter.rate_rad_s;
+  j.position_angle_rad = d.beta_rad;
+  return j;
+}
+
+/// The sensor's design row at the joints as the reduction's columns: the known part, then the regressors.
+void design_columns(const Sensor& sensor, const CentrifugeModel& model, const JointState& j, double* out) {
+  const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
+  out[0] = row.known;
+  for (std::size_t k = 0; k < row.size; ++k) out[k + 1] = row.regressors[k];
+}
+
+}  // namespace
 
 std::vector<double> harmonic_content_gammas_rad(int harmonic_order) {
   const int n = 2 * std::max(harmonic_order, 0) + 1;
@@ -58,15 +80,7 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
                                  (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
     if (!follow && exact_requested && route == ChannelRoute::kExact) {
       const DwellChannelEvaluator evaluate = [&](double main_rad, double counter_rad, double* row_out) {
-        JointState j;
-        j.main_angle_rad = main_rad;
-        j.main_rate_rad_s = d.main.rate_rad_s;
-        j.counter_angle_rad = counter_rad;
-        j.counter_rate_rad_s = d.counter.rate_rad_s;
-        j.position_angle_rad = d.beta_rad;
-        const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
-        row_out[0] = row.known;
-        for (std::size_t k = 0; k < row.size; ++k) row_out[k + 1] = row.regressors[k];
+        design_columns(sensor, model, line_joints(d, main_rad, counter_rad), row_out);
       };
       if (reduce_dwell_by_fourier(model, d, options, acc, columns, rate_columns, evaluate, chosen[di])) {
         for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
@@ -98,26 +112,18 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       rev_fit.reset();
     };
     const auto add_joints = [&](double t, const JointState& j, double gamma_rad) {
-      const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
-      v[0] = row.known;
-      for (std::size_t k = 0; k < row.size; ++k) v[k + 1] = row.regressors[k];
+      design_columns(sensor, model, j, v.data());
       acc.add(t, gamma_rad, v.data());
       if (!per_rev) return;
       if (acc.samples() == 1) gamma_first = gamma_rad;
-      const int rev = static_cast<int>(std::abs(gamma_rad - gamma_first) / (2.0 * kPi));
+      const int rev = DwellAccumulator::revolution(gamma_rad, gamma_first);
       if (rev != revolution) close_revolution();
       revolution = rev;
       if (!rev_fit) rev_fit.emplace(d.gammas_rad, options.harmonic_order, false, columns, false);
       rev_fit->add(0.0, gamma_rad, v.data());
     };
     const auto add_sample = [&](double t, double main_rad, double counter_rad) {
-      JointState j;
-      j.main_angle_rad = main_rad;
-      j.main_rate_rad_s = d.main.rate_rad_s;
-      j.counter_angle_rad = counter_rad;
-      j.counter_rate_rad_s = d.counter.rate_rad_s;
-      j.position_angle_rad = d.beta_rad;
-      add_joints(t, j, -counter_rad);
+      add_joints(t, line_joints(d, main_rad, counter_rad), -counter_rad);
     };
     std::size_t stride = 1;
     const bool sweeps = d.planned_counter_rate_offset_rad_s != 0.0 && d.planned_rate_rad_s != 0.0;

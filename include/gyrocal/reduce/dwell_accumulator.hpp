@@ -210,6 +210,16 @@ class DwellAccumulator {
   /// The time series breaks here (a gap): the revolution in progress is incomplete, so it does not count in
   /// the scatter between revolutions (its samples still enter the dwell's fit).
   void break_revolution();
+  /// The revolution of gamma (rad) counted from a dwell's first gamma, in either sense of rotation: the
+  /// periods of a spinning dwell's scatter, and so of any reduction that must cut a dwell where it does
+  /// (identify/sensor_channels.cpp). The quotient is >= 0, so the conversion's truncation is its floor
+  /// (std::floor is a call of libm on the baseline x86-64 and was 4 % of a calibration's time); a product by
+  /// 1 / (2 pi), not a division (a sample within a rounding of a whole turn may fall in either revolution,
+  /// the same one for every caller).
+  static int revolution(double gamma_rad, double first_gamma_rad) {
+    constexpr double kTurnsPerRad = 0.15915494309189533577;  // 1 / (2 pi)
+    return static_cast<int>(std::abs(gamma_rad - first_gamma_rad) * kTurnsPerRad);
+  }
   /// The method reducing this dwell (make_dwell_reduction's choice).
   const DwellReduction& reduction() const { return reduction_; }
   /// out's covariance, std_err, level, dof and revolutions from `scatter` about out's fit in time
@@ -235,14 +245,7 @@ class DwellAccumulator {
   /// A block never holds more samples than this (a revolution of more samples is tested in parts): it bounds
   /// the memory of the outlier rule to a few MB whatever the plan.
   static constexpr std::size_t kMaxBlockSamples = std::size_t{1} << 15;
-  /// Revolutions counted from the first sample's gamma, in either sense of rotation. The quotient is >= 0, so
-  /// the conversion's truncation is its floor (std::floor is a call of libm on the baseline x86-64 and was 4
-  /// % of a calibration's time); a product by 1 / (2 pi), not a division (a sample within a rounding of a
-  /// whole turn may fall in either revolution).
-  int revolution_of(double gamma_rad) const {
-    constexpr double kTurnsPerRad = 0.15915494309189533577;  // 1 / (2 pi)
-    return static_cast<int>(std::abs(gamma_rad - gamma_first_) * kTurnsPerRad);
-  }
+  int revolution_of(double gamma_rad) const { return revolution(gamma_rad, gamma_first_); }
   int period_of(double time_s, double gamma_rad) const;
   bool last_revolution_complete() const;
   double scaled_time(double time_s) const { return (time_s - t_first_) / duration_s_ - 0.5; }
