@@ -18,6 +18,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/plan/positions.hpp"
+#include "gyrocal/reduce/accumulator_feed.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/reduce/record_summary.hpp"
 
@@ -376,6 +377,9 @@ struct Reducer::State {
   // What the record holds, for the refusal of a record without a dwell for a planned position.
   RecordSummary summary;
   std::optional<RecordLayout> layout;
+  // The measured samples go to the run's accumulator on a thread of its own (reduce/accumulator_feed.hpp).
+  // Last: destroyed first, so that its worker has stopped before the run it feeds is destroyed.
+  AccumulatorFeed feed;
 
   double hold_duration() const { return static_hold_duration_s(plan, reference_rate); }
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
@@ -734,7 +738,7 @@ struct Reducer::State {
       }
       if (gap) {
         ++r.gaps;
-        r.acc->break_revolution();
+        feed.break_revolution(*r.acc);
         r.phase_theta.emplace_back();
         r.phase_psi.emplace_back();
         r.phase_rel.emplace_back();
@@ -789,7 +793,7 @@ struct Reducer::State {
         r.basis_turns = turns;
       }
     }
-    r.acc->add(u.t, -psi * kDegToRad, &u.y);
+    feed.add(*r.acc, u.t, -psi * kDegToRad, u.y);
   }
 
   void reject(const Run& r, std::string reason) {
@@ -852,6 +856,8 @@ struct Reducer::State {
                        : run->quality.before_leaving_rows);
     });
     run->guard.clear();
+    // The run's accumulator is moved and read below: the samples handed to the feed go in first.
+    feed.sync();
     Run r = std::move(*run);
     run.reset();
     r.quality.ended = std::move(reason);

@@ -1,0 +1,114 @@
+// The accumulation on a thread of its own (reduce/accumulator_feed.hpp): an accumulator fed through the
+// worker thread gives the very numbers it gives when fed on the caller's thread, whatever the batches' cuts,
+// with the outlier rule, gaps and several dwells' accumulators in turn.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "gyrocal/core/units.hpp"
+#include "gyrocal/reduce/accumulator_feed.hpp"
+#include "gyrocal/reduce/dwell_accumulator.hpp"
+
+namespace gyrocal {
+namespace {
+
+struct Sample {
+  double t, gamma, value;
+  bool gap_before;
+};
+
+/// A spinning dwell's output: harmonics of gamma, a drift, white noise, a few spikes and gaps.
+std::vector<Sample> dwell_samples(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  std::vector<Sample> out;
+  const double dt = 0.005, rate = 9.9;
+  double t = 100.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool gap = i > 0 && i % 7919 == 0;
+    t += gap ? 3.0 * dt : dt;
+    const double gamma = rate * (t - 100.0);
+    double v = 12.0 + 3.0 * std::cos(gamma) - 2.0 * std::sin(2.0 * gamma) + 0.7 * std::cos(3.0 * gamma) +
+               0.01 * (t - 100.0) + noise(rng);
+    if (i % 10007 == 5000) v += 40.0;  // a spike
+    out.push_back({t, gamma, v, gap});
+  }
+  return out;
+}
+
+DwellAccumulator make_accumulator(const std::vector<Sample>& s) {
+  const std::vector<double> gammas = {0.0, kPi / 2, kPi, 3 * kPi / 2};
+  const double duration = s.back().t - s.front().t + 0.005;
+  return DwellAccumulator(ReduceOptions{}, gammas, false, 1, duration, true);
+}
+
+void expect_same(const DwellValues& a, const DwellValues& b) {
+  ASSERT_EQ(a.value.size(), b.value.size());
+  for (std::size_t k = 0; k < a.value.size(); ++k) {
+    EXPECT_EQ(a.value[k], b.value[k]) << k;
+    EXPECT_EQ(a.std_err[k], b.std_err[k]) << k;
+    EXPECT_EQ(a.samples[k], b.samples[k]) << k;
+  }
+  EXPECT_EQ(a.outliers, b.outliers);
+  EXPECT_EQ(a.outlier_samples, b.outlier_samples);
+  EXPECT_EQ(a.revolutions, b.revolutions);
+  EXPECT_EQ(a.dof, b.dof);
+  EXPECT_EQ(a.level, b.level);
+}
+
+TEST(AccumulatorFeed, GivesTheSameNumbersAsTheCallersThreadForSeveralDwellsInTurn) {
+  const std::vector<Sample> first = dwell_samples(50000, 1), second = dwell_samples(30001, 2);
+  DwellAccumulator direct_a = make_accumulator(first), direct_b = make_accumulator(second);
+  DwellAccumulator fed_a = make_accumulator(first), fed_b = make_accumulator(second);
+  const auto feed_directly = [](DwellAccumulator& acc, const std::vector<Sample>& s) {
+    for (const Sample& x : s) {
+      if (x.gap_before) acc.break_revolution();
+      acc.add(x.t, x.gamma, &x.value);
+    }
+  };
+  feed_directly(direct_a, first);
+  feed_directly(direct_b, second);
+  {
+    AccumulatorFeed feed;
+    // The two dwells' samples alternate in runs that do not match the feed's batches, as they would if a
+    // reducer fed two accumulators in turn.
+    std::size_t i = 0, j = 0;
+    while (i < first.size() || j < second.size()) {
+      for (std::size_t k = 0; k < 3001 && i < first.size(); ++k, ++i) {
+        if (first[i].gap_before) feed.break_revolution(fed_a);
+        feed.add(fed_a, first[i].t, first[i].gamma, first[i].value);
+      }
+      for (std::size_t k = 0; k < 5003 && j < second.size(); ++k, ++j) {
+        if (second[j].gap_before) feed.break_revolution(fed_b);
+        feed.add(fed_b, second[j].t, second[j].gamma, second[j].value);
+      }
+    }
+    feed.sync();
+    EXPECT_EQ(fed_a.samples(), first.size());
+    EXPECT_EQ(fed_b.samples(), second.size());
+  }
+  const DwellValues a = direct_a.finish(0), b = direct_b.finish(0);
+  EXPECT_GT(a.outliers, 0u);  // the spikes were found, so the outlier rule ran on the worker
+  expect_same(fed_a.finish(0), a);
+  expect_same(fed_b.finish(0), b);
+}
+
+TEST(AccumulatorFeed, CanBeDestroyedWithWorkInFlight) {
+  // The reducer's feed is destroyed first when a record is refused mid-dwell: its worker stops before the
+  // accumulators it was feeding go away (the sanitizer build checks that nothing is touched after).
+  const std::vector<Sample> s = dwell_samples(40000, 3);
+  auto acc = std::make_unique<DwellAccumulator>(make_accumulator(s));
+  {
+    AccumulatorFeed feed;
+    for (const Sample& x : s) feed.add(*acc, x.t, x.gamma, x.value);
+  }
+  acc.reset();
+  SUCCEED();
+}
+
+}  // namespace
+}  // namespace gyrocal
