@@ -278,25 +278,44 @@ void DwellAccumulator::test_block() {
     detection_basis(cos_g, sin_g, scaled_time(pending_[i].t), &scratch_basis_[i * pp]);
   }
   const auto basis_of = [&](std::size_t i) { return &scratch_basis_[i * pp]; };
-  // Where the harmonic fit's basis is the detection basis (harmonics and drift, no sweep), the sums of b b'
-  // both fits need are formed once, per run of samples in one period (the fit's revolution sums need them
-  // apart), instead of an outer product per sample for each fit.
+  // Where the harmonic fit's basis is the detection basis (harmonics and drift, no sweep: the default), the
+  // sums of b b' and b v both fits need are formed once, per run of samples in one period (the fit's
+  // revolution sums need them apart), instead of per sample for each fit; the fit then takes each run's
+  // sums whole (HarmonicFit::add_run) when the block has no outlier.
   auto* const fit = std::get_if<HarmonicFit>(&reduction_);
-  const bool shared = fit != nullptr && spinning_ && fit->basis_size() == p;
-  std::vector<std::size_t> segment_first;
-  std::vector<double> segment_normal;
+  const bool shared = fit != nullptr && spinning_ && fit->basis_size() == p && fit->fits_drift();
+  std::vector<BlockRun>& runs = scratch_runs_;
+  runs.clear();
+  scratch_run_normal_.clear();
+  scratch_run_rhs_.clear();
   Eigen::MatrixXd block_normal;
+  Eigen::VectorXd block_rhs;
   if (shared) {
+    double* normal_sum = nullptr;
+    double* rhs_sum = nullptr;
     for (std::size_t i = 0; i < n; ++i) {
-      if (i == 0 || pending_[i].period != pending_[i - 1].period) {
-        segment_first.push_back(i);
-        segment_normal.resize(segment_first.size() * pp * pp, 0.0);
+      const Pending& s = pending_[i];
+      if (i == 0 || s.period != pending_[i - 1].period) {
+        runs.push_back({i, 0, s.period, false, 0.0});
+        scratch_run_normal_.resize(runs.size() * pp * pp, 0.0);
+        scratch_run_rhs_.resize(runs.size() * pp, 0.0);
+        normal_sum = &scratch_run_normal_[(runs.size() - 1) * pp * pp];
+        rhs_sum = &scratch_run_rhs_[(runs.size() - 1) * pp];
       }
-      add_outer_product(&segment_normal[(segment_first.size() - 1) * pp * pp], basis_of(i), p);
+      const double* b = basis_of(i);
+      add_outer_product(normal_sum, b, p);
+      for (int k = 0; k < p; ++k) rhs_sum[k] += b[k] * s.value;
+      BlockRun& run = runs.back();
+      ++run.count;
+      run.t_scaled_sum += b[p - 1];  // the drift's term: the scaled time
+      run.after_break = run.after_break || s.after_break;
     }
     block_normal = Eigen::MatrixXd::Zero(p, p);
-    for (std::size_t k = 0; k < segment_first.size(); ++k)
-      block_normal += Eigen::Map<const Eigen::MatrixXd>(&segment_normal[k * pp * pp], p, p);
+    block_rhs = Eigen::VectorXd::Zero(p);
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      block_normal += Eigen::Map<const Eigen::MatrixXd>(&scratch_run_normal_[k * pp * pp], p, p);
+      block_rhs += Eigen::Map<const Eigen::VectorXd>(&scratch_run_rhs_[k * pp], p);
+    }
   }
   const auto fit_at = [&](std::size_t i, const Eigen::VectorXd& x) {
     const double* b = basis_of(i);
@@ -347,12 +366,16 @@ void DwellAccumulator::test_block() {
     normal = ref_normal_;
     rhs = ref_rhs_;
     const bool any_out = std::find(out.begin(), out.end(), 1) != out.end();
-    if (shared && !any_out) normal += block_normal;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (out[i]) continue;
-      const double* b = basis_of(i);
-      if (!shared || any_out) add_outer_product(normal.data(), b, p);
-      for (int j = 0; j < p; ++j) rhs[j] += b[j] * pending_[i].value;
+    if (shared && !any_out) {
+      normal += block_normal;
+      rhs += block_rhs;
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (out[i]) continue;
+        const double* b = basis_of(i);
+        add_outer_product(normal.data(), b, p);
+        for (int j = 0; j < p; ++j) rhs[j] += b[j] * pending_[i].value;
+      }
     }
     const Eigen::MatrixXd full = normal.selfadjointView<Eigen::Lower>();
     x = full.ldlt().solve(rhs);
@@ -407,13 +430,21 @@ void DwellAccumulator::test_block() {
   // fit's value it would be the same for a signal the fit holds whole, but a drive's ripple moves an
   // accelerometer's output by far more than the fit holds (docs/accelerometer.md), and the model's channels
   // that follow the measured motion leave out the same samples (outlier_samples), so the two stay one
-  // operator. A gap's mark passes to the next sample kept.
-  bool carry_break = false;
-  // Without outliers the block's sums of b b' (per period) serve the reference sums and the fit; a block
-  // with outliers adds its kept samples one by one.
+  // operator. Without outliers the block's runs serve the reference sums and the fit whole; a block with
+  // outliers adds its kept samples one by one, and a gap's mark passes to the next sample kept.
   const bool use_shared = shared && std::find(out.begin(), out.end(), 1) == out.end();
-  if (use_shared) ref_normal_ = ref_normal_before + block_normal;
-  std::size_t segment = 0;
+  if (use_shared) {
+    ref_normal_ = ref_normal_before + block_normal;
+    if (!settled) ref_rhs_ += block_rhs;
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      enter_period(runs[k].period, runs[k].after_break);
+      fit->add_run(runs[k].count, runs[k].t_scaled_sum, &scratch_run_normal_[k * pp * pp],
+                   &scratch_run_rhs_[k * pp]);
+    }
+    pending_.clear();
+    return;
+  }
+  bool carry_break = false;
   for (std::size_t i = 0; i < n; ++i) {
     const Pending& s = pending_[i];
     if (out[i]) {
@@ -424,14 +455,11 @@ void DwellAccumulator::test_block() {
     }
     if (!settled) {
       const double* b = basis_of(i);
-      if (!use_shared) add_outer_product(ref_normal_.data(), b, p);
+      add_outer_product(ref_normal_.data(), b, p);
       for (int j = 0; j < p; ++j) ref_rhs_[j] += b[j] * s.value;
     }
-    accumulate(s.t, s.gamma, s.period, &s.value, s.after_break || carry_break, basis_of(i), !use_shared);
+    accumulate(s.t, s.gamma, s.period, &s.value, s.after_break || carry_break, basis_of(i));
     carry_break = false;
-    // A period's sums join the fit's once its first sample is in (after the period before was closed).
-    if (use_shared && segment < segment_first.size() && segment_first[segment] == i)
-      fit->add_normal_sum(&segment_normal[segment++ * pp * pp]);
   }
   pending_.clear();
 }
@@ -472,31 +500,33 @@ int DwellAccumulator::complete_revolutions() const {
   return seen_revolution_ + (last_revolution_complete() ? 1 : 0);
 }
 
-void DwellAccumulator::accumulate(double t, double gamma, int period, const double* values, bool after_break,
-                                  const double* basis, bool with_normal) {
-  if (with_std_err_) {
-    if (period != period_) {
-      scatter_.index = period_;
-      std::visit(
-          [&](auto& method) {
-            if (period_broken_)
-              method.discard_period();
-            else
-              method.close_period(scatter_);
-          },
-          reduction_);
-      period_broken_ = false;
-    }
-    period_ = period;
-    // A gap inside this revolution: it is incomplete, so it counts in the dwell's fit but not in the scatter.
-    if (after_break && spinning_) period_broken_ = true;
+void DwellAccumulator::enter_period(int period, bool after_break) {
+  if (!with_std_err_) return;
+  if (period != period_) {
+    scatter_.index = period_;
+    std::visit(
+        [&](auto& method) {
+          if (period_broken_)
+            method.discard_period();
+          else
+            method.close_period(scatter_);
+        },
+        reduction_);
+    period_broken_ = false;
   }
+  period_ = period;
+  // A gap inside this revolution: it is incomplete, so it counts in the dwell's fit but not in the scatter.
+  if (after_break && spinning_) period_broken_ = true;
+}
+
+void DwellAccumulator::accumulate(double t, double gamma, int period, const double* values, bool after_break,
+                                  const double* basis) {
+  enter_period(period, after_break);
   const double ts = scaled_time(t);
   // The outlier rule's basis begins with the harmonic fit's (harmonic_basis at gamma, then the scaled time):
   // evaluated once, not twice.
   if (basis != nullptr) {
-    if (auto* fit = std::get_if<HarmonicFit>(&reduction_))
-      return fit->add_basis(ts, basis, values, with_normal);
+    if (auto* fit = std::get_if<HarmonicFit>(&reduction_)) return fit->add_basis(ts, basis, values);
   }
   std::visit([&](auto& method) { method.add(ts, gamma, values); }, reduction_);
 }

@@ -245,11 +245,17 @@ void HarmonicFit::add_basis(double t_scaled, const double* b, const double* valu
   rev_time_sum_ += t_scaled;
 }
 
-void HarmonicFit::add_normal_sum(const double* lower) {
+void HarmonicFit::add_run(std::size_t samples, double t_scaled_sum, const double* lower, const double* rhs) {
   const int n = basis_size();
+  samples_ += samples;
   double* normal = with_periods_ ? period_normal_.data() : normal_.data();
   for (int j = 0; j < n; ++j)
     for (int i = j; i < n; ++i) normal[i + j * n] += lower[i + j * n];
+  double* own_rhs = with_periods_ ? period_rhs_.data() : rhs_.data();
+  for (int i = 0; i < n * columns_; ++i) own_rhs[i] += rhs[i];
+  if (!with_periods_) return;
+  rev_samples_ += samples;
+  rev_time_sum_ += t_scaled_sum;
 }
 
 void HarmonicFit::add_sums(std::size_t samples, const Eigen::MatrixXd& normal, const Eigen::MatrixXd& rhs) {

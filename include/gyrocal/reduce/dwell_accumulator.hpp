@@ -235,10 +235,19 @@ class DwellAccumulator {
     std::size_t index;  // the sample's number in the dwell
   };
   /// period: period_of(time_s, gamma_rad). basis: the outlier rule's detection basis at the sample (its first
-  /// terms are a harmonic fit's basis), or null; with_normal false: the fit's b b' term is added by the
-  /// caller (HarmonicFit::add_normal_sum).
+  /// terms are a harmonic fit's basis), or null.
   void accumulate(double time_s, double gamma_rad, int period, const double* values, bool after_break,
-                  const double* basis = nullptr, bool with_normal = true);
+                  const double* basis = nullptr);
+  /// The period bookkeeping of a sample (or a run of samples) of `period`: the period before closes into the
+  /// scatter (or is discarded, if broken) when this one begins; after_break marks this one broken.
+  void enter_period(int period, bool after_break);
+  /// A run of a block's samples in one period, by the sums the outlier rule formed (test_block).
+  struct BlockRun {
+    std::size_t first = 0, count = 0;
+    int period = 0;
+    bool after_break = false;
+    double t_scaled_sum = 0.0;
+  };
   void test_block();
   void flush();
   void add_general(double time_s, double gamma_rad, const double* values);
@@ -292,6 +301,9 @@ class DwellAccumulator {
   std::size_t outliers_ = 0;
   std::vector<std::size_t> outlier_samples_;
   std::vector<double> scratch_basis_;  // the block's detection basis, sample by sample
+  // The block's runs of samples in one period and their sums of b b' (lower triangles) and b v (test_block).
+  std::vector<BlockRun> scratch_runs_;
+  std::vector<double> scratch_run_normal_, scratch_run_rhs_;
 };
 
 }  // namespace gyrocal

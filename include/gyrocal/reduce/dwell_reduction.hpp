@@ -107,12 +107,14 @@ class HarmonicFit {
   void add(double t_scaled, double gamma_rad, const double* values);
   /// add() with the basis at the sample already evaluated: b = basis(gamma_rad, t_scaled), basis_size()
   /// values (the outlier rule evaluates it for its own fit, whose first terms are these: DwellAccumulator).
-  /// with_normal false: the sample's b b' is left out, for the caller to add it with others through
-  /// add_normal_sum (the outlier rule forms the same sums for its own fit: DwellAccumulator::test_block).
+  /// with_normal false: the sample's b b' is left out (its caller adds it otherwise).
   void add_basis(double t_scaled, const double* b, const double* values, bool with_normal = true);
-  /// Adds `lower` (basis_size() square, column-major, lower triangle read) to the sums of b b' of the period
-  /// in progress: samples given to add_basis without their normal term.
-  void add_normal_sum(const double* lower);
+  /// A run of `samples` samples of the period in progress at once, by their sums: t_scaled_sum = sum of
+  /// t_scaled, `lower` = sum b b' (basis_size() square, column-major, lower triangle read), `rhs` = sum b v'
+  /// (basis_size() x columns, column-major). The outlier rule forms these sums for its own fit, whose basis
+  /// this is (DwellAccumulator::test_block): the same as add_basis on each, but for the order of the sums'
+  /// additions.
+  void add_run(std::size_t samples, double t_scaled_sum, const double* lower, const double* rhs);
   /// `samples` samples at once, given by their sums: `normal` = sum b b' (basis_size() square, the lower
   /// triangle is read) and `rhs` = sum b v' (basis_size() x columns), b = basis(gamma, t_scaled) (identify/
   /// channels.hpp: the model's channels summed in closed form). No periods.
