@@ -139,6 +139,30 @@ TEST(DwellReduction, HarmonicFitEqualsADirectLeastSquaresSolve) {
   }
 }
 
+TEST(DwellReduction, HarmonicMomentsGiveTheSumsOfTheBasisOuterProducts) {
+  // The outlier rule's sums of b b' from the harmonics' moments (products of harmonics as harmonics of the
+  // sum and difference) against the products of the basis from std::cos(k g) and std::sin(k g).
+  for (const int order : {0, 1, 3, 5, HarmonicMoments::kMaxOrder}) {
+    SCOPED_TRACE(::testing::Message() << "order " << order);
+    const auto samples = spinning_samples(3.61, 700, 1, 31U + static_cast<unsigned>(order));
+    const int p = 2 * order + 2;
+    HarmonicMoments moments(order);
+    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(p, p);
+    std::vector<double> b(static_cast<std::size_t>(p));
+    for (const Sample& s : samples) {
+      moments.add(std::cos(s.gamma_rad), std::sin(s.gamma_rad), s.t_scaled, b.data());
+      const Eigen::RowVectorXd row = design_row(s.gamma_rad, s.t_scaled, order, true);
+      for (int k = 0; k < p; ++k) EXPECT_NEAR(b[static_cast<std::size_t>(k)], row[k], 1e-13) << k;
+      expected += row.transpose() * row;
+    }
+    EXPECT_EQ(moments.count(), static_cast<double>(samples.size()));
+    Eigen::MatrixXd got = Eigen::MatrixXd::Zero(p, p);
+    moments.lower(got.data());
+    for (int j = 0; j < p; ++j)
+      for (int i = j; i < p; ++i) EXPECT_NEAR(got(i, j), expected(i, j), 1e-11) << i << ", " << j;
+  }
+}
+
 TEST(DwellReduction, HarmonicFitPerRevolutionIsTheFitWithoutDriftOfThatRevolution) {
   // One revolution, then a part of a second too short to fit (fewer than two samples per parameter).
   const int order = 3;

@@ -243,9 +243,9 @@ void DwellAccumulator::break_revolution() {
 
 // docs/physics.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
 // outlier_threshold robust standard deviations of the block's residuals it is an outlier, the fit is
-// repeated without the outliers and the test with it, until the outliers do not change. Outliers are
-// replaced by the final fit's value at their instant, so the reduction operator (which samples, which
-// weights) stays the one the model's channels go through (docs/calibration.md, "Spikes").
+// repeated without the outliers and the test with it, until the outliers do not change. Outliers are left
+// out of the fit, and their numbers kept, so that the model's channels go through the same operator
+// (docs/calibration.md, "Spikes").
 void DwellAccumulator::test_block() {
   const std::size_t n = pending_.size();
   if (n == 0) return;
@@ -258,9 +258,26 @@ void DwellAccumulator::test_block() {
   // kMaxStep and at the block's first sample bounds the rotations' rounding to ~kResync ulps (1e-14).
   constexpr std::size_t kResync = 64;
   constexpr double kMaxStep = 0.05;  // rad: the series below are then exact to 1e-17
+  // Where the harmonic fit's basis is the detection basis (harmonics and drift, no sweep: the default), the
+  // sums of b b' and b v both fits need are formed once, per run of samples in one period (the fit's
+  // revolution sums need them apart), instead of per sample for each fit, and the sums of b b' from the
+  // harmonics' moments (HarmonicMoments, about half the operations of the products); the fit then takes
+  // each run's sums whole (HarmonicFit::add_run) when the block has no outlier.
+  auto* const fit = std::get_if<HarmonicFit>(&reduction_);
+  const bool shared = fit != nullptr && spinning_ && fit->basis_size() == p && fit->fits_drift();
+  std::vector<BlockRun>& runs = scratch_runs_;
+  runs.clear();
+  scratch_run_normal_.clear();
+  scratch_run_rhs_.clear();
+  HarmonicMoments moments(options_.harmonic_order);
+  const auto close_run = [&] {
+    if (!runs.empty()) moments.lower(&scratch_run_normal_[(runs.size() - 1) * pp * pp]);
+  };
+  double* rhs_sum = nullptr;
   double cos_g = 0.0, sin_g = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double gamma = pending_[i].gamma;
+    const Pending& sample = pending_[i];
+    const double gamma = sample.gamma;
     const double step = i > 0 ? gamma - pending_[i - 1].gamma : 0.0;
     if (!spinning_) {
       cos_g = 1.0, sin_g = 0.0;  // a static hold's basis is the mean and the drift
@@ -275,41 +292,32 @@ void DwellAccumulator::test_block() {
       sin_g = sin_g * cd + cos_g * sd;
       cos_g = cn;
     }
-    detection_basis(cos_g, sin_g, scaled_time(pending_[i].t), &scratch_basis_[i * pp]);
+    double* const b = &scratch_basis_[i * pp];
+    if (!shared) {
+      detection_basis(cos_g, sin_g, scaled_time(sample.t), b);
+      continue;
+    }
+    if (i == 0 || sample.period != pending_[i - 1].period) {
+      close_run();
+      runs.push_back({i, 0, sample.period, false, 0.0});
+      scratch_run_normal_.resize(runs.size() * pp * pp, 0.0);
+      scratch_run_rhs_.resize(runs.size() * pp, 0.0);
+      rhs_sum = &scratch_run_rhs_[(runs.size() - 1) * pp];
+      moments = HarmonicMoments(options_.harmonic_order);
+    }
+    const double t_scaled = scaled_time(sample.t);
+    moments.add(cos_g, sin_g, t_scaled, b);
+    for (int k = 0; k < p; ++k) rhs_sum[k] += b[k] * sample.value;
+    BlockRun& run = runs.back();
+    ++run.count;
+    run.t_scaled_sum += t_scaled;
+    run.after_break = run.after_break || sample.after_break;
   }
+  close_run();
   const auto basis_of = [&](std::size_t i) { return &scratch_basis_[i * pp]; };
-  // Where the harmonic fit's basis is the detection basis (harmonics and drift, no sweep: the default), the
-  // sums of b b' and b v both fits need are formed once, per run of samples in one period (the fit's
-  // revolution sums need them apart), instead of per sample for each fit; the fit then takes each run's
-  // sums whole (HarmonicFit::add_run) when the block has no outlier.
-  auto* const fit = std::get_if<HarmonicFit>(&reduction_);
-  const bool shared = fit != nullptr && spinning_ && fit->basis_size() == p && fit->fits_drift();
-  std::vector<BlockRun>& runs = scratch_runs_;
-  runs.clear();
-  scratch_run_normal_.clear();
-  scratch_run_rhs_.clear();
   Eigen::MatrixXd block_normal;
   Eigen::VectorXd block_rhs;
   if (shared) {
-    double* normal_sum = nullptr;
-    double* rhs_sum = nullptr;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Pending& s = pending_[i];
-      if (i == 0 || s.period != pending_[i - 1].period) {
-        runs.push_back({i, 0, s.period, false, 0.0});
-        scratch_run_normal_.resize(runs.size() * pp * pp, 0.0);
-        scratch_run_rhs_.resize(runs.size() * pp, 0.0);
-        normal_sum = &scratch_run_normal_[(runs.size() - 1) * pp * pp];
-        rhs_sum = &scratch_run_rhs_[(runs.size() - 1) * pp];
-      }
-      const double* b = basis_of(i);
-      add_outer_product(normal_sum, b, p);
-      for (int k = 0; k < p; ++k) rhs_sum[k] += b[k] * s.value;
-      BlockRun& run = runs.back();
-      ++run.count;
-      run.t_scaled_sum += b[p - 1];  // the drift's term: the scaled time
-      run.after_break = run.after_break || s.after_break;
-    }
     block_normal = Eigen::MatrixXd::Zero(p, p);
     block_rhs = Eigen::VectorXd::Zero(p);
     for (std::size_t k = 0; k < runs.size(); ++k) {

@@ -67,6 +67,38 @@ void add_outer_product(double* normal, const double* b, int n) {
   }
 }
 
+void HarmonicMoments::lower(double* out) const {
+  const int p = 2 * order_ + 2;
+  // Sums of cos k g and sin k g for any integer k: cos is even, sin odd, and k = 0 counts the samples.
+  const auto sum_cos = [&](int k) { return k == 0 ? count_ : cos_[k < 0 ? -k : k]; };
+  const auto sum_sin = [&](int k) { return k == 0 ? 0.0 : k < 0 ? -sin_[-k] : sin_[k]; };
+  // Term i of the basis: 0 the constant, 2k - 1 cos k g, 2k sin k g, p - 1 the time.
+  for (int j = 0; j < p; ++j) {
+    for (int i = j; i < p; ++i) {
+      double v = 0.0;
+      if (i == p - 1) {
+        const int b = (j + 1) / 2;  // the harmonic of term j
+        v = j == p - 1 ? tt_ : j == 0 ? t_ : j % 2 == 1 ? t_cos_[b] : t_sin_[b];
+      } else if (j == 0) {
+        const int a = (i + 1) / 2;
+        v = i == 0 ? count_ : i % 2 == 1 ? cos_[a] : sin_[a];
+      } else {
+        const int a = (i + 1) / 2, b = (j + 1) / 2;
+        const bool cos_a = i % 2 == 1, cos_b = j % 2 == 1;
+        if (cos_a && cos_b)
+          v = 0.5 * (sum_cos(a - b) + sum_cos(a + b));
+        else if (!cos_a && !cos_b)
+          v = 0.5 * (sum_cos(a - b) - sum_cos(a + b));
+        else if (!cos_a && cos_b)  // sin a cos b
+          v = 0.5 * (sum_sin(a + b) + sum_sin(a - b));
+        else  // cos a sin b
+          v = 0.5 * (sum_sin(a + b) - sum_sin(a - b));
+      }
+      out[i + j * p] = v;
+    }
+  }
+}
+
 // ---- RevolutionSums ---------------------------------------------------------------------------------------
 
 void RevolutionSums::add(double ti, const Eigen::VectorXd& vi) {

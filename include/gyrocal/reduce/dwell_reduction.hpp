@@ -32,6 +32,54 @@ void harmonic_basis(double cos_gamma, double sin_gamma, int order, double* out);
 /// products, added in the same order); the usual sizes (harmonic order 3: 7, 8, 10) are unrolled.
 void add_outer_product(double* normal, const double* b, int n);
 
+/// The sums of b b' over a run of samples for the harmonic basis with drift, b = (1, cos g, sin g, ..., cos
+/// Ng, sin Ng, t_scaled) (2N + 2 terms), gathered as 6N + 4 moments instead of (N + 1)(2N + 3) products a
+/// sample: a product of two harmonics is half the sum of the harmonics of their sum and difference (cos a cos
+/// b = (cos(a - b) + cos(a + b)) / 2, ...), so the sums of cos k g and sin k g for k <= 2N, of t cos k g and
+/// t sin k g for k <= N, and of t and t^2 give every element. The elements equal add_outer_product's sums up
+/// to rounding (the harmonics come from one angle-addition recurrence; tests/test_dwell_reduction.cpp).
+class HarmonicMoments {
+ public:
+  static constexpr int kMaxOrder = 12;  ///< ReduceOptions::harmonic_order's limit
+  explicit HarmonicMoments(int order) : order_(order) {}
+  /// One sample at cos g, sin g and t_scaled; writes its basis b (2N + 2 values, as harmonic_basis and then
+  /// t_scaled) to `basis`.
+  void add(double cos_gamma, double sin_gamma, double t_scaled, double* basis) {
+    const int n = order_, m = 2 * order_;
+    double c = cos_gamma, s = sin_gamma;
+    basis[0] = 1.0;
+    ++count_;
+    t_ += t_scaled;
+    tt_ += t_scaled * t_scaled;
+    for (int k = 1; k <= m; ++k) {
+      if (k > 1) {
+        const double cn = c * cos_gamma - s * sin_gamma;
+        s = s * cos_gamma + c * sin_gamma;
+        c = cn;
+      }
+      cos_[k] += c;
+      sin_[k] += s;
+      if (k <= n) {
+        basis[2 * k - 1] = c;
+        basis[2 * k] = s;
+        t_cos_[k] += t_scaled * c;
+        t_sin_[k] += t_scaled * s;
+      }
+    }
+    basis[m + 1] = t_scaled;
+  }
+  /// The samples added.
+  double count() const { return count_; }
+  /// The run's sums of b b' into `lower` (2N + 2 square, column-major; the lower triangle is written).
+  void lower(double* lower) const;
+
+ private:
+  int order_;
+  double count_ = 0.0, t_ = 0.0, tt_ = 0.0;
+  double cos_[2 * kMaxOrder + 1] = {}, sin_[2 * kMaxOrder + 1] = {};  // index k: sum cos k g, sum sin k g
+  double t_cos_[kMaxOrder + 1] = {}, t_sin_[kMaxOrder + 1] = {};      // index k: sum t cos k g, t sin k g
+};
+
 /// Per-revolution (or per-batch) values of column 0 at every gamma of a dwell, as sums for straight-line fits
 /// in time and their cross products: their scatter is the level of the reduced values' covariance
 /// (docs/calibration.md).
