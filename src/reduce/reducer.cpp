@@ -1217,12 +1217,12 @@ constexpr std::size_t kReadAheadBatches = 4;
 
 /// The reader on a thread of its own, a few batches of rows ahead of the caller's thread (docs/
 /// performance.md): parsing and reducing overlap. Rows arrive in the record's order; an error of the reader
-/// (gyrocal::Error naming the file and line) is rethrown by next() where its row would have been.
+/// (gyrocal::Error naming the file and line) is rethrown by next() where its row would have been. The
+/// thread parses only: with the accumulation on a third thread, parsing is the longest of the three, so the
+/// record's summary and the caller's observer run on the caller's thread (docs/performance.md).
 class ReadAhead {
  public:
-  /// observe (may be empty) sees each batch on the reader's thread, before the caller does.
-  ReadAhead(RecordReader& reader, const std::function<void(std::span<const RecordSample>)>& observe)
-      : reader_(reader), observe_(observe), batches_(kReadAheadBatches) {
+  explicit ReadAhead(RecordReader& reader) : reader_(reader), batches_(kReadAheadBatches) {
     for (auto& b : batches_) b.rows.resize(kReadAheadRows);
     thread_ = std::thread([this] { produce(); });
   }
@@ -1236,10 +1236,6 @@ class ReadAhead {
   }
   ReadAhead(const ReadAhead&) = delete;
   ReadAhead& operator=(const ReadAhead&) = delete;
-
-  /// What the rows handed out so far hold, once next() returned the end of the record (the reader's thread
-  /// has stopped by then: the empty batch is its last).
-  const RecordSummary& summary() const { return summary_; }
 
   /// The next batch of rows (empty at the end of the record); valid until the next call.
   std::span<const RecordSample> next() {
@@ -1286,16 +1282,6 @@ class ReadAhead {
       } catch (...) {
         b.error = std::current_exception();
       }
-      // The record's summary and the observer's work (e.g. the output's range) are done here, beside the
-      // parsing, rather than on the reducer's thread, which is the slower of the two (docs/performance.md).
-      for (std::size_t i = 0; i < b.count; ++i) summary_.add(b.rows[i]);
-      if (observe_ && b.count > 0) {
-        try {
-          observe_(std::span<const RecordSample>(b.rows.data(), b.count));
-        } catch (...) {
-          if (!b.error) b.error = std::current_exception();
-        }
-      }
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++filled_;
@@ -1308,8 +1294,6 @@ class ReadAhead {
   }
 
   RecordReader& reader_;
-  const std::function<void(std::span<const RecordSample>)>& observe_;
-  RecordSummary summary_;  // of every row read, written by the reader's thread only
   std::vector<Batch> batches_;
   std::thread thread_;
   std::mutex mutex_;
@@ -1325,10 +1309,14 @@ Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const Reduce
                         const std::function<void(std::span<const RecordSample>)>& observe) {
   Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
   reducer.set_record_layout(reader.layout());
-  ReadAhead ahead(reader, observe);
-  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next())
+  RecordSummary summary;  // of every row read
+  ReadAhead ahead(reader);
+  for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next()) {
+    for (const RecordSample& s : rows) summary.add(s);
+    if (observe) observe(rows);
     for (const RecordSample& s : rows) reducer.push_unsummarised(s);
-  reducer.set_summary(ahead.summary());
+  }
+  reducer.set_summary(summary);
   return reducer.finish();
 }
 

@@ -198,9 +198,10 @@ class Reducer {
   std::unique_ptr<State> state_;
 };
 
-/// Reduce a whole record file (streaming; the rows are read ahead on a thread of their own). `observe`, when
-/// given, sees every batch of rows, in order, on the reader's thread (e.g. the output's range,
-/// identify/misfit.hpp): what it writes must not be read before reduce_record returns.
+/// Reduce a whole record file (streaming; the rows are read ahead on a thread of their own, and each dwell's
+/// accumulation runs on another, reduce/accumulator_feed.hpp). `observe`, when given, sees every batch of
+/// rows, in order, on the caller's thread, before the reducer does (e.g. the output's range,
+/// identify/misfit.hpp).
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s,
                         const std::function<void(std::span<const RecordSample>)>& observe = {});
