@@ -235,12 +235,16 @@ MeasuredMotion MeasuredMotionFit::finish() {
         dof += static_cast<double>(k) - 2.0;
         if (static_cast<std::size_t>(p.n) > longest_n)
           longest = pi, longest_n = static_cast<std::size_t>(p.n);
-        // The largest deviation from the phase's line, 8 points an interval over the sampled span.
+        // The largest deviation from the phase's line, 8 points an interval over the sampled span (the
+        // basis at those 9 places is the same in every interval: evaluated once).
         const std::size_t intervals = k - 3;
+        double qb[9][4], qd1[9][4], qd2[9][4];
+        for (int q = 0; q <= 8; ++q) basis(q / 8.0, qb[q], qd1[q], qd2[q]);
         for (std::size_t j = 0; j < intervals; ++j)
           for (int q = 0; q <= 8; ++q) {
-            double b[4], d1[4], d2[4];
-            basis(q / 8.0, b, d1, d2);
+            const double* b = qb[q];
+            const double* d1 = qd1[q];
+            const double* d2 = qd2[q];
             double a = 0.0, r = 0.0, acc = 0.0;
             for (std::size_t m = 0; m < 4; ++m) {
               a += mp.coefficients[j + m] * b[m];
