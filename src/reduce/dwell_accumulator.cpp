@@ -299,7 +299,7 @@ void DwellAccumulator::test_block() {
     }
     if (i == 0 || sample.period != pending_[i - 1].period) {
       close_run();
-      runs.push_back({i, 0, sample.period, false, 0.0});
+      runs.push_back({0, sample.period, false, 0.0});
       scratch_run_normal_.resize(runs.size() * pp * pp, 0.0);
       scratch_run_rhs_.resize(runs.size() * pp, 0.0);
       rhs_sum = &scratch_run_rhs_[(runs.size() - 1) * pp];

@@ -243,7 +243,7 @@ class DwellAccumulator {
   void enter_period(int period, bool after_break);
   /// A run of a block's samples in one period, by the sums the outlier rule formed (test_block).
   struct BlockRun {
-    std::size_t first = 0, count = 0;
+    std::size_t count = 0;
     int period = 0;
     bool after_break = false;
     double t_scaled_sum = 0.0;
