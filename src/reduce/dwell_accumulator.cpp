@@ -307,7 +307,11 @@ void DwellAccumulator::test_block() {
     }
     const double t_scaled = scaled_time(sample.t);
     moments.add(cos_g, sin_g, t_scaled, b);
-    for (int k = 0; k < p; ++k) rhs_sum[k] += b[k] * sample.value;
+    if (p == 8) {  // the default order 3, unrolled
+      for (int k = 0; k < 8; ++k) rhs_sum[k] += b[k] * sample.value;
+    } else {
+      for (int k = 0; k < p; ++k) rhs_sum[k] += b[k] * sample.value;
+    }
     BlockRun& run = runs.back();
     ++run.count;
     run.t_scaled_sum += t_scaled;
@@ -328,7 +332,11 @@ void DwellAccumulator::test_block() {
   const auto fit_at = [&](std::size_t i, const Eigen::VectorXd& x) {
     const double* b = basis_of(i);
     double v = 0.0;
-    for (int k = 0; k < p; ++k) v += b[k] * x[k];
+    if (p == 8) {  // the default order 3, unrolled
+      for (int k = 0; k < 8; ++k) v += b[k] * x[k];
+    } else {
+      for (int k = 0; k < p; ++k) v += b[k] * x[k];
+    }
     return v;
   };
 

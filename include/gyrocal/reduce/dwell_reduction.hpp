@@ -45,7 +45,20 @@ class HarmonicMoments {
   /// One sample at cos g, sin g and t_scaled; writes its basis b (2N + 2 values, as harmonic_basis and then
   /// t_scaled) to `basis`.
   void add(double cos_gamma, double sin_gamma, double t_scaled, double* basis) {
-    const int n = order_, m = 2 * order_;
+    // The default order, unrolled by the compiler (a sample of every spinning dwell of a record comes here).
+    if (order_ == 3) return add_order<3>(cos_gamma, sin_gamma, t_scaled, basis);
+    add_order<0>(cos_gamma, sin_gamma, t_scaled, basis);
+  }
+  /// The samples added.
+  double count() const { return count_; }
+  /// The run's sums of b b' into `lower` (2N + 2 square, column-major; the lower triangle is written).
+  void lower(double* lower) const;
+
+ private:
+  /// add() for order N (N = 0: the object's order, not known at compile time).
+  template <int N>
+  void add_order(double cos_gamma, double sin_gamma, double t_scaled, double* basis) {
+    const int n = N > 0 ? N : order_, m = 2 * n;
     double c = cos_gamma, s = sin_gamma;
     basis[0] = 1.0;
     ++count_;
@@ -68,12 +81,6 @@ class HarmonicMoments {
     }
     basis[m + 1] = t_scaled;
   }
-  /// The samples added.
-  double count() const { return count_; }
-  /// The run's sums of b b' into `lower` (2N + 2 square, column-major; the lower triangle is written).
-  void lower(double* lower) const;
-
- private:
   int order_;
   double count_ = 0.0, t_ = 0.0, tt_ = 0.0;
   double cos_[2 * kMaxOrder + 1] = {}, sin_[2 * kMaxOrder + 1] = {};  // index k: sum cos k g, sum sin k g
