@@ -97,6 +97,24 @@ TEST(AccumulatorFeed, GivesTheSameNumbersAsTheCallersThreadForSeveralDwellsInTur
   expect_same(fed_b.finish(0), b);
 }
 
+TEST(AccumulatorFeed, WithoutAThreadMakesTheCallsAtOnce) {
+  // The Monte Carlo's reducers (one a trial, the trials on every core) feed their accumulators inline.
+  const std::vector<Sample> s = dwell_samples(20000, 4);
+  DwellAccumulator direct = make_accumulator(s), fed = make_accumulator(s);
+  AccumulatorFeed feed(false);
+  for (const Sample& x : s) {
+    if (x.gap_before) {
+      direct.break_revolution();
+      feed.break_revolution(fed);
+    }
+    direct.add(x.t, x.gamma, &x.value);
+    feed.add(fed, x.t, x.gamma, x.value);
+    ASSERT_EQ(fed.samples(), direct.samples());  // no sync needed: nothing waits
+  }
+  feed.sync();
+  expect_same(fed.finish(0), direct.finish(0));
+}
+
 TEST(AccumulatorFeed, CanBeDestroyedWithWorkInFlight) {
   // The reducer's feed is destroyed first when a record is refused mid-dwell: its worker stops before the
   // accumulators it was feeding go away (the sanitizer build checks that nothing is touched after).

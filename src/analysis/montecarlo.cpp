@@ -299,6 +299,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     // harmonic content).
     Reducer reducer(reduction_plan(s.test, s.sensor_kind, m.calibration.reduce), m.calibration.reduce,
                     "Monte Carlo trial", s.centrifuge.rate_rad_s);
+    reducer.set_threaded_accumulation(false);  // the trials already run on every core
     SimulationOptions so;
     so.seed = rng.next_u64();
     simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });

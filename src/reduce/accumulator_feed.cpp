@@ -34,6 +34,7 @@ void AccumulatorFeed::hand_over(DwellAccumulator* next) {
 }
 
 void AccumulatorFeed::sync() {
+  if (!threaded_) return;
   hand_over(nullptr);
   std::unique_lock<std::mutex> lock(mutex_);
   changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
@@ -67,7 +68,10 @@ void AccumulatorFeed::work() {
     }
     b.items.clear();
     lock.lock();
-    spare_.push_back(std::move(b.items));
+    try {
+      spare_.push_back(std::move(b.items));  // reused; if that fails, a new batch allocates its own
+    } catch (...) {
+    }
     busy_ = false;
     changed_.notify_all();
   }

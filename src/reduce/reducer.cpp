@@ -379,7 +379,7 @@ struct Reducer::State {
   std::optional<RecordLayout> layout;
   // The measured samples go to the run's accumulator on a thread of its own (reduce/accumulator_feed.hpp).
   // Last: destroyed first, so that its worker has stopped before the run it feeds is destroyed.
-  AccumulatorFeed feed;
+  std::optional<AccumulatorFeed> feed{std::in_place};
 
   double hold_duration() const { return static_hold_duration_s(plan, reference_rate); }
   std::string at(double t) const { return fmt::format("{}: at t = {:.6f} s", source, t); }
@@ -738,7 +738,7 @@ struct Reducer::State {
       }
       if (gap) {
         ++r.gaps;
-        feed.break_revolution(*r.acc);
+        feed->break_revolution(*r.acc);
         r.phase_theta.emplace_back();
         r.phase_psi.emplace_back();
         r.phase_rel.emplace_back();
@@ -793,7 +793,7 @@ struct Reducer::State {
         r.basis_turns = turns;
       }
     }
-    feed.add(*r.acc, u.t, -psi * kDegToRad, u.y);
+    feed->add(*r.acc, u.t, -psi * kDegToRad, u.y);
   }
 
   void reject(const Run& r, std::string reason) {
@@ -857,7 +857,7 @@ struct Reducer::State {
     });
     run->guard.clear();
     // The run's accumulator is moved and read below: the samples handed to the feed go in first.
-    feed.sync();
+    feed->sync();
     Run r = std::move(*run);
     run.reset();
     r.quality.ended = std::move(reason);
@@ -1061,6 +1061,11 @@ Reducer::Reducer(const PlannedTest& plan, const ReduceOptions& options, std::str
 }
 
 Reducer::~Reducer() = default;
+
+void Reducer::set_threaded_accumulation(bool threaded) {
+  if (state_->rows > 0) throw Error("Reducer::set_threaded_accumulation: only before the first row.");
+  state_->feed.emplace(threaded);
+}
 
 void Reducer::set_record_layout(const std::optional<RecordLayout>& layout) {
   state_->layout = layout;

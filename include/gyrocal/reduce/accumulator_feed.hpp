@@ -26,18 +26,22 @@ class AccumulatorFeed {
   static constexpr std::size_t kBatchSamples = 4096;
   static constexpr std::size_t kMaxBatches = 8;
 
-  AccumulatorFeed() = default;
+  /// threaded false: every call is made at once on the caller's thread (no worker; sync() does nothing), for
+  /// a caller that already keeps every core busy (the Monte Carlo's trials, one reducer each).
+  explicit AccumulatorFeed(bool threaded = true) : threaded_(threaded) {}
   ~AccumulatorFeed();
   AccumulatorFeed(const AccumulatorFeed&) = delete;
   AccumulatorFeed& operator=(const AccumulatorFeed&) = delete;
 
   /// acc.add(time_s, gamma_rad, &value), on the worker, after every call handed over before it.
   void add(DwellAccumulator& acc, double time_s, double gamma_rad, double value) {
+    if (!threaded_) return acc.add(time_s, gamma_rad, &value);
     if (&acc != target_ || open_.size() >= kBatchSamples) hand_over(acc);
     open_.push_back({time_s, gamma_rad, value, false});
   }
   /// acc.break_revolution(), on the worker, in its place among the samples.
   void break_revolution(DwellAccumulator& acc) {
+    if (!threaded_) return acc.break_revolution();
     if (&acc != target_ || open_.size() >= kBatchSamples) hand_over(acc);
     open_.push_back({0.0, 0.0, 0.0, true});
   }
@@ -59,6 +63,7 @@ class AccumulatorFeed {
   void work();
 
   // The producer's side.
+  bool threaded_;
   DwellAccumulator* target_ = nullptr;
   std::vector<Item> open_;
   // Shared with the worker, under mutex_.

@@ -178,12 +178,16 @@ class Reducer {
           double reference_rate_rad_s)
       : Reducer(PlannedTest{plan, reference_rate_rad_s}, options, std::move(source_name)) {}
   ~Reducer();
+  /// Each dwell's accumulation runs on a thread of its own (reduce/accumulator_feed.hpp), unless this is
+  /// called with false before the first push (a caller whose threads already keep every core busy, such as
+  /// the Monte Carlo's trials). The numbers are the same either way.
+  void set_threaded_accumulation(bool threaded);
   Reducer(const Reducer&) = delete;
   Reducer& operator=(const Reducer&) = delete;
 
   void push(const RecordSample& sample);
-  /// push() for a caller that keeps the record's summary itself (reduce_record does, on its reader's
-  /// thread) and hands it over with set_summary() before finish().
+  /// push() for a caller that keeps the record's summary itself (reduce_record does) and hands it over with
+  /// set_summary() before finish().
   void push_unsummarised(const RecordSample& sample);
   /// What the record holds, for finish()'s refusal (replaces what push() gathered).
   void set_summary(const RecordSummary& summary);
