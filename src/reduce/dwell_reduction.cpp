@@ -262,11 +262,11 @@ void HarmonicFit::add(double t_scaled, double gamma_rad, const double* values) {
   add_basis(t_scaled, b, values);
 }
 
-void HarmonicFit::add_basis(double t_scaled, const double* b, const double* values, bool with_normal) {
+void HarmonicFit::add_basis(double t_scaled, const double* b, const double* values) {
   ++samples_;
   // The hot loop of a calibration: raw column-major storage, lower triangles only.
   const int n = basis_size();
-  if (with_normal) add_outer_product(with_periods_ ? period_normal_.data() : normal_.data(), b, n);
+  add_outer_product(with_periods_ ? period_normal_.data() : normal_.data(), b, n);
   double* __restrict rhs = with_periods_ ? period_rhs_.data() : rhs_.data();
   for (int c = 0; c < columns_; ++c) {
     const double v = values[c];

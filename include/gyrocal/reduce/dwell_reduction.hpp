@@ -162,8 +162,7 @@ class HarmonicFit {
   void add(double t_scaled, double gamma_rad, const double* values);
   /// add() with the basis at the sample already evaluated: b = basis(gamma_rad, t_scaled), basis_size()
   /// values (the outlier rule evaluates it for its own fit, whose first terms are these: DwellAccumulator).
-  /// with_normal false: the sample's b b' is left out (its caller adds it otherwise).
-  void add_basis(double t_scaled, const double* b, const double* values, bool with_normal = true);
+  void add_basis(double t_scaled, const double* b, const double* values);
   /// A run of `samples` samples of the period in progress at once, by their sums: t_scaled_sum = sum of
   /// t_scaled, `lower` = sum b b' (basis_size() square, column-major, lower triangle read), `rhs` = sum b v'
   /// (basis_size() x columns, column-major). The outlier rule forms these sums for its own fit, whose basis
