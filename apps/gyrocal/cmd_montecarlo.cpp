@@ -9,6 +9,7 @@
 #include "cli.hpp"
 #include "gyrocal/analysis/montecarlo.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
@@ -57,8 +58,8 @@ std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
 /// passes), so 1e9 trials take about half an hour a core; memory does not grow with trials. Samples mode:
 /// each trial simulates and reduces the whole test (about 0.1 s on the default scenario), so 1e5 trials
 /// take hours, and every trial's errors are kept for the histograms.
-constexpr long long kMaxFastTrials = 1'000'000'000;
-constexpr long long kMaxSampleTrials = 100'000;
+constexpr long long kMaxFastTrials = limits::kTrials;
+constexpr long long kMaxSampleTrials = limits::kTrialsWithSamples;
 
 }  // namespace
 

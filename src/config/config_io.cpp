@@ -487,7 +487,7 @@ void reject_repeats(const Reader& reader, const toml::node& node, const std::str
 constexpr Range kSampleRate{0.0, 1e6, true};
 /// Counter rate offsets (docs/physics.md section 15): up to the counter platform's plausible top rate.
 constexpr Range kCounterOffset{-100.0, 100.0, false};
-constexpr std::int64_t kMaxRevolutions = 100000000;
+constexpr std::int64_t kMaxRevolutions = limits::kRevolutions;
 
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
   section.number("sample_rate_hz", 1.0, kSampleRate, test.sample_rate_hz);

@@ -22,6 +22,7 @@
 #include <string_view>
 
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/limits.hpp"
 
 namespace gyrocal {
 
@@ -31,8 +32,8 @@ namespace gyrocal {
 /// wrong type, or a value that is not finite or out of its range.
 Scenario parse_scenario(std::string_view toml_text, const std::string& source_name);
 
-/// The largest configuration file load_scenario reads: 16 MiB.
-inline constexpr std::size_t kMaxConfigurationBytes = std::size_t{16} << 20;
+/// The largest configuration file load_scenario reads: 16 MiB (core/limits.hpp).
+inline constexpr std::size_t kMaxConfigurationBytes = limits::kConfigurationBytes;
 
 /// Read and parse the configuration file at path (any readable file: a regular file, a FIFO, /dev/stdin).
 /// Throws Error naming the file if it cannot be read, is a directory, is larger than

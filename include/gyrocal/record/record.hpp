@@ -37,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/record/record_layout.hpp"
 
 namespace gyrocal {
@@ -120,7 +121,7 @@ class RecordReader {
   /// Default read size, bytes.
   static constexpr std::size_t kDefaultChunkBytes = std::size_t{1} << 20;
   /// Longest line accepted, bytes (bounds memory on input that is not a record).
-  static constexpr std::size_t kMaxLineBytes = std::size_t{1} << 16;
+  static constexpr std::size_t kMaxLineBytes = limits::kRecordLineBytes;
 
   /// Opens the record at `path` (gyrocal's own format) and reads its magic line, metadata and header.
   /// Throws gyrocal::Error naming the file (and line) if it cannot be opened or is not a valid record so

@@ -3,6 +3,8 @@
 // predict_calibration), `simulate` and `calibrate` (the reducer), so that the three agree (issue 11, item 6).
 #include <cstdint>
 
+#include "gyrocal/core/limits.hpp"
+
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
@@ -10,7 +12,7 @@ namespace gyrocal {
 
 /// The most samples a test may hold (its measured dwells and holds and their settle intervals): a record of
 /// 1e10 rows is about 0.4 TB and takes hours to simulate or calibrate; beyond it the test is refused.
-inline constexpr double kMaxTestSamples = 1e10;
+inline constexpr double kMaxTestSamples = limits::kTestSamples;
 
 /// The samples per revolution the reduction needs at one rate: 2 (2 harmonic_order + 1), twice the harmonic
 /// fit's unknowns per revolution (the window mean is held to the same, so that both methods see a test
