@@ -15,6 +15,12 @@ inline constexpr std::size_t kConfigurationBytes = std::size_t{16} << 20;
 /// (centrifuge.errors.counter_wobble_x[0].harmonic written as a dotted key); the TOML library parses a dotted
 /// key by recursion, so the text is checked against this before the library sees it.
 inline constexpr std::size_t kConfigurationKeyParts = 32;
+/// The deepest nesting of a configuration's values: each dotted part of a table header or key, each inline
+/// table and each array is one level (gyrocal's deepest value, a harmonic term's amplitude, is 6 down). The
+/// TOML library walks and frees nested tables and arrays by recursion; its own bound (256 nested values)
+/// lets each of them add kConfigurationKeyParts levels, ~8,000 in all, so the text is checked against this
+/// too, in the same scan.
+inline constexpr std::size_t kConfigurationDepth = 64;
 
 // ---- The test plan ----
 
