@@ -23,6 +23,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/model/machine_errors.hpp"
+#include "key_parts.hpp"
 
 namespace gyrocal {
 namespace {
@@ -412,13 +413,19 @@ void read_numbers(Section& section, const NumberKey<S> (&keys)[N], S& target) {
 HarmonicSeries read_series(const Reader& reader, const toml::node& node, const std::string& path,
                            const ErrorKey& key) {
   const toml::array& items = reader.array(node, path);
+  // Each term is a column of the model's work at every sample: the series is bounded (core/limits.hpp).
+  if (items.size() > limits::kHarmonicTerms)
+    reader.fail(node.source(), path + " holds " + std::to_string(items.size()) + " terms; at most " +
+                                   std::to_string(limits::kHarmonicTerms) + " (one per harmonic)");
   HarmonicSeries series;
   for (std::size_t i = 0; i < items.size(); ++i) {
     const std::string item_path = path + "[" + std::to_string(i) + "]";
     Section item(reader, &reader.table(items[i], item_path), item_path);
     HarmonicTerm term;
     if (const toml::node* harmonic = item.find("harmonic")) {
-      term.harmonic = static_cast<int>(reader.integer(*harmonic, item.path("harmonic"), 1, INT_MAX));
+      // A geometric error lives in the first harmonics; the model's time grows with the harmonic.
+      term.harmonic =
+          static_cast<int>(reader.integer(*harmonic, item.path("harmonic"), 1, limits::kHarmonic));
     }
     item.number(key.amplitude_key, key.field->unit_to_si, kNonNegative, term.amplitude);
     item.number("phase_deg", kDegToRad, kAnyValue, term.phase_rad);
@@ -489,6 +496,18 @@ constexpr Range kSampleRate{0.0, 1e6, true};
 constexpr Range kCounterOffset{-100.0, 100.0, false};
 constexpr std::int64_t kMaxRevolutions = limits::kRevolutions;
 
+/// Refuses a [test] list of more than limits::kPlanValuesPerList values, before its repeats are looked for
+/// (which compares every pair): each value multiplies the test's positions, whose number plan's work grows
+/// with the square of.
+void refuse_long_list(const Reader& reader, const toml::node& node, const std::string& path) {
+  const toml::array* items = node.as_array();
+  if (items == nullptr || items->size() <= limits::kPlanValuesPerList) return;
+  reader.fail(node.source(), path + " holds " + std::to_string(items->size()) + " values; at most " +
+                                 std::to_string(limits::kPlanValuesPerList) +
+                                 " (a test's positions are bounded: " + std::to_string(limits::kPositions) +
+                                 " in all)");
+}
+
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
   section.number("sample_rate_hz", 1.0, kSampleRate, test.sample_rate_hz);
   if (const toml::node* node = section.find("revolutions")) {
@@ -497,20 +516,24 @@ void read_test(const Reader& reader, Section& section, TestSpec& test) {
   }
   section.number("settle_s", 1.0, kNonNegative, test.settle_s);
   if (const toml::node* node = section.find("beta_deg")) {
+    refuse_long_list(reader, *node, section.path("beta_deg"));
     const std::vector<double> deg = reader.numbers(*node, section.path("beta_deg"), kAnyValue, 0);
     reject_repeats(reader, *node, section.path("beta_deg"), deg, true);
     test.beta_rad = scaled(deg, kDegToRad);
   }
   if (const toml::node* node = section.find("gamma_deg")) {
+    refuse_long_list(reader, *node, section.path("gamma_deg"));
     const std::vector<double> deg = reader.numbers(*node, section.path("gamma_deg"), kAnyValue, 0);
     reject_repeats(reader, *node, section.path("gamma_deg"), deg, true);
     test.gamma_rad = scaled(deg, kDegToRad);
   }
   if (const toml::node* node = section.find("rates_rad_s")) {
+    refuse_long_list(reader, *node, section.path("rates_rad_s"));
     test.rates_rad_s = reader.numbers(*node, section.path("rates_rad_s"), kAnyValue, 0);
     reject_repeats(reader, *node, section.path("rates_rad_s"), test.rates_rad_s, false);
   }
   if (const toml::node* node = section.find("counter_rate_offsets_rad_s")) {
+    refuse_long_list(reader, *node, section.path("counter_rate_offsets_rad_s"));
     test.counter_rate_offsets_rad_s =
         reader.numbers(*node, section.path("counter_rate_offsets_rad_s"), kCounterOffset, 0);
     reject_repeats(reader, *node, section.path("counter_rate_offsets_rad_s"), test.counter_rate_offsets_rad_s,
@@ -1077,6 +1100,7 @@ std::string toml_float(double v) {
 Scenario parse_scenario(std::string_view toml_text, const std::string& source_name) {
   const Reader reader(source_name);
   refuse_non_ascii(toml_text, source_name);
+  refuse_long_dotted_keys(toml_text, source_name);  // before toml++, which nests a table per part
   toml::table root;
   try {
     root = toml::parse(toml_text, source_name);

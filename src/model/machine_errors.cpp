@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 
 namespace gyrocal {
 namespace {
@@ -187,6 +188,10 @@ std::vector<std::string> split_names(std::string_view list) {
 
 std::vector<MachineErrorParameter> parse_machine_error_names(const std::vector<std::string>& names,
                                                              const std::string& source) {
+  // Each name is one to three columns of the design: their number is bounded (core/limits.hpp).
+  if (names.size() > limits::kEstimatedErrors)
+    throw Error(source + " names " + std::to_string(names.size()) + " machine errors; at most " +
+                std::to_string(limits::kEstimatedErrors) + " can be estimated.");
   std::vector<MachineErrorParameter> out;
   const auto add = [&](const MachineErrorParameter& p, const std::string& name) {
     for (const MachineErrorParameter& q : out)
@@ -225,6 +230,9 @@ std::vector<MachineErrorParameter> parse_machine_error_names(const std::vector<s
       if (colon == std::string::npos || ec != std::errc() || ptr != number.data() + number.size() || n < 1)
         throw Error(source + ": " + name + " is a harmonic series; name one harmonic N >= 1 of it as " +
                     base + ":N (e.g. " + base + ":2).");
+      if (n > limits::kHarmonic)
+        throw Error(source + ": " + name + " names harmonic " + std::to_string(n) + "; the highest is " +
+                    std::to_string(limits::kHarmonic) + " (a geometric error lives in the first harmonics).");
       p.harmonic = n;
       p.part = HarmonicPart::kCos;
       add(p, name);
