@@ -18,6 +18,7 @@
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/model/nominal.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 
 namespace gyrocal {
 namespace {
@@ -297,12 +298,15 @@ void refuse_repeated_positions(const Reduction& reduction) {
                         describe_position(reduction, i), describe_position(reduction, j)));
 }
 
-/// Refuses a covariance of the reduced positions that cannot weight a fit, naming the dwell at fault.
-void refuse_covariance(const Reduction& reduction) {
+/// Refuses a covariance of the reduced positions that cannot weight a fit, naming the dwell at fault, or
+/// [test] gamma_deg and [reduce] harmonic_order when the dwell lists more gamma than the fit resolves.
+void refuse_covariance(const Reduction& reduction, const ReduceOptions& reduce) {
   const auto& ps = reduction.positions;
   for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
     const Eigen::MatrixXd& c = reduction.dwells[d].gyro.covariance;
     if (c.size() == 0 || Eigen::LLT<Eigen::MatrixXd>(c).info() == Eigen::Success) continue;
+    if (!reduction.dwells[d].is_static)
+      refuse_gammas_beyond_fit(reduction.dwells[d].gammas_rad.size(), reduce);
     for (std::size_t i = 0; i < ps.size(); ++i)
       if (static_cast<std::size_t>(ps[i].dwell) == d)
         throw Error(
@@ -497,7 +501,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
   const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
-  if (llt.info() != Eigen::Success) refuse_covariance(reduction);
+  if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
   LeastSquaresOptions lso = options.least_squares;
   lso.rank_tolerance = std::max(lso.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
   lso.estimable_tolerance = std::max(lso.estimable_tolerance, options.estimable_tolerance);
@@ -678,7 +682,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   // freedom").
   const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
-  if (llt.info() != Eigen::Success) refuse_covariance(reduction);
+  if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
   IdentifiabilityOptions io;
   io.least_squares = options.least_squares;
   io.least_squares.rank_tolerance =

@@ -1,6 +1,7 @@
 #pragma once
 // Can a record of this test be calibrated at all? One check, used before anything is done by `plan` (through
 // predict_calibration), `simulate` and `calibrate` (the reducer), so that the three agree (issue 11, item 6).
+#include <cstddef>
 #include <cstdint>
 
 #include "gyrocal/core/limits.hpp"
@@ -24,10 +25,25 @@ int min_samples_per_revolution(const ReduceOptions& options);
 /// test has neither [test] static_hold_s nor a non-zero rate.
 double planned_test_samples(const TestSpec& test, double centrifuge_rate_rad_s);
 
+/// The number of positions of the test, as test_positions (plan/positions.hpp) counts them: at each rate and
+/// counter rate offset, beta x gamma (a spinning set's gamma: spinning_gammas).
+double planned_positions(const TestSpec& test);
+
 /// Throws gyrocal::Error naming the [test] key at fault when a record of `test` cannot be reduced with
-/// `options`: too few samples per revolution at a rate (with the sample rate it needs), a non-zero rate
-/// slower than options.static_rate_tolerance_rad_s (it reads as a stopped main axis), or more than
-/// kMaxTestSamples samples in all.
+/// `options`: more than limits::kPositions positions (checked first, before any work that grows with them),
+/// too few samples per revolution at a rate (with the sample rate it needs), a non-zero rate slower than
+/// options.static_rate_tolerance_rad_s (it reads as a stopped main axis), or more than kMaxTestSamples
+/// samples in all (naming the keys of the test's longest part: revolutions, static_hold_s or settle_s).
 void check_test_feasible(const TestSpec& test, const ReduceOptions& options, double reference_rate_rad_s);
+
+/// Throws gyrocal::Error naming [test] gamma_deg and [reduce] harmonic_order when the harmonic fit reduced a
+/// spinning dwell to `gammas` arm angles, more than its 2 harmonic_order + 1 unknowns per revolution: the
+/// values at those angles are then linear combinations of fewer unknowns and their covariance is singular in
+/// exact arithmetic. Called where that covariance fails to factor (identify/calibration.cpp), not up front:
+/// with many revolutions rounding lets it factor and the fit agrees with a higher order's (8 gamma at order
+/// 3, 200 revolutions: the estimates and standard errors of order 4), so such a test is not refused. An
+/// accelerometer's spinning dwells are reduced to exactly 2 harmonic_order + 1 angles whatever gamma_deg
+/// lists (identify/sensor_channels.hpp), so only the gyro's route meets this; the window mean has no bound.
+void refuse_gammas_beyond_fit(std::size_t gammas, const ReduceOptions& options);
 
 }  // namespace gyrocal
