@@ -37,13 +37,13 @@ std::string too_many_samples(const TestSpec& test, double centrifuge_rate_rad_s,
   const std::string tail = fmt::format("; at most {:.0e} can be simulated or calibrated", kMaxTestSamples);
   if (settles_s >= spinning_s && settles_s >= holds_s)
     return fmt::format(
-        "{}, most of them in the settle intervals ([test] settle_s = {} s after each dwell){}: "
+        "{}, most of them in the settle intervals ([test] settle_s = {:.6g} s after each dwell){}: "
         "a shorter settle_s or a lower sample rate.",
         head, test.settle_s, tail);
   if (holds_s >= spinning_s) {
     if (test.static_hold_s > 0.0)
       return fmt::format(
-          "{}, most of them in the {:.0f} static holds ([test] static_hold_s = {} s each){}: a "
+          "{}, most of them in the {:.0f} static holds ([test] static_hold_s = {:.6g} s each){}: a "
           "shorter static_hold_s, fewer static positions or a lower sample rate.",
           head, holds, test.static_hold_s, tail);
     return fmt::format(
