@@ -25,27 +25,6 @@
 namespace gyrocal {
 namespace {
 
-/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
-/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
-/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
-/// a / 360 or one off it, and a k that the quotient's rounding put on the wrong side of a half turn is
-/// corrected. Only exactly +-180 may come out with the other sign than remainder's. The common case is an
-/// unwrapped prediction minus a wrapped reading, out of range: k comes from a truncating conversion (a call
-/// of libm's nearbyint was 3 % of a calibration's time), nearbyint only beyond 2^50 turns.
-[[gnu::always_inline]] inline double wrap_deg_quick(double a) {
-  if (std::abs(a) <= 180.0) return a;
-  const double q = a * (1.0 / 360.0);
-  const double k = std::abs(q) < 0x1p50
-                       ? static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)))
-                       : std::nearbyint(q);
-  double r = a - 360.0 * k;
-  if (r > 180.0)
-    r -= 360.0;
-  else if (r < -180.0)
-    r += 360.0;
-  return r;
-}
-
 /// A first-in first-out queue on one growing ring of slots: std::deque allocates a block every few elements
 /// of a large type (four of Run::Waiting), and the guard pushes and pops every row of a record.
 template <class T>
