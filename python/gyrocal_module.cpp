@@ -19,6 +19,7 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
@@ -73,7 +74,8 @@ CalibrationOptions python_calibration_options(const Scenario& scenario, const st
 }
 
 /// Checks that a dict's columns make a record the reader would accept: one dimension, the same length, finite
-/// values, time strictly increasing. `name` stands for the record in messages; rows are counted from 0.
+/// values, the output (the last column) within limits::kOutputMagnitude, time strictly increasing. `name`
+/// stands for the record in messages; rows are counted from 0.
 void check_columns(const std::vector<const Column*>& columns, const std::vector<std::string>& names,
                    const std::string& name) {
   const py::ssize_t n = columns.front()->size();
@@ -85,9 +87,18 @@ void check_columns(const std::vector<const Column*>& columns, const std::vector<
       throw Error(fmt::format("{}: column {} has {} values but column {} has {}.", name, names[c],
                               columns[c]->size(), names.front(), n));
     const double* v = columns[c]->data();
-    for (py::ssize_t i = 0; i < n; ++i)
+    // The output (the last column) within limits::kOutputMagnitude, as the record reader holds it.
+    const bool output = c + 1 == columns.size();
+    for (py::ssize_t i = 0; i < n; ++i) {
       if (!std::isfinite(v[i]))
         throw Error(fmt::format("{}, row {}: {} is {}, not a finite number.", name, i, names[c], v[i]));
+      if (output && !(std::abs(v[i]) <= limits::kOutputMagnitude))
+        throw Error(fmt::format(
+            "{}, row {}: {} is {}; an output is at most {} in magnitude (limits::kOutputMagnitude): no "
+            "sensor "
+            "writes such a value, and the squares a calibration sums of it would leave a double's range.",
+            name, i, names[c], v[i], limits::kOutputMagnitude));
+    }
   }
   const double* t = columns.front()->data();
   for (py::ssize_t i = 1; i < n; ++i)

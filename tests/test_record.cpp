@@ -17,6 +17,7 @@
 
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/record/record.hpp"
 
 namespace gyrocal {
@@ -100,7 +101,11 @@ TEST(Record, RoundTripIsBitForBit) {
       sample.main_angle_deg = random_double(random);
       sample.counter_angle_deg = random_double(random);
       sample.position_angle_deg = random_double(random);
-      sample.output = random_double(random);
+      // The output within its bound (limits::kOutputMagnitude; beyond it the reader refuses the row, as
+      // test_numeric_bounds checks), over the whole range of magnitudes below it.
+      do {
+        sample.output = random_double(random);
+      } while (!(std::abs(sample.output) <= limits::kOutputMagnitude));
       sample.extra[0] = random_double(random);
       sample.extra[1] = random_double(random);
       writer.write(sample);

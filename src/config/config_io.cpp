@@ -21,6 +21,7 @@
 #include <toml++/toml.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "key_parts.hpp"
@@ -38,6 +39,8 @@ struct Range {
   double min = -kInf;
   double max = kInf;
   bool min_exclusive = false;
+  /// Why a finite range bounds it, said in the refusal (limits.hpp gives the value's reason in full).
+  const char* reason = nullptr;
 };
 
 constexpr Range kAnyValue{};
@@ -47,6 +50,28 @@ constexpr Range kLatitude{-90.0, 90.0, false};
 /// A gyro's scale-factor error (ppm) or input-axis misalignment (arcsec): within 10 % (1e5 ppm, 5.7 deg),
 /// where the first-order model of docs/physics.md section 15 still describes a gyro.
 constexpr Range kRateError{-1e5, 1e5, false};
+// Physically generous ranges (core/limits.hpp): beyond them the model's products leave a double's range
+// ([gyro] dF = 1e308 made `plan` say "Observation 0 is not finite").
+constexpr Range kGravity{0.0, limits::kGravityMS2, true, "limits::kGravityMS2, ten times the Earth's"};
+constexpr Range kEarthRate{0.0, limits::kEarthRateRadS, false, "limits::kEarthRateRadS"};
+constexpr Range kRadius{0.0, limits::kRadiusM, true,
+                        "limits::kRadiusM, 100 times the largest centrifuge's arm"};
+/// An encoder angle the simulation writes or a layout subtracts, deg.
+constexpr Range kEncoderAngle{-limits::kEncoderAngleDeg, limits::kEncoderAngleDeg, false,
+                              "limits::kEncoderAngleDeg, no encoder reads beyond it"};
+constexpr Range kGyroCoefficientRange{-limits::kGyroCoefficient, limits::kGyroCoefficient, false,
+                                      "limits::kGyroCoefficient, beyond any gyro's range"};
+constexpr Range kGyroNoiseRange{0.0, limits::kGyroNoise, false,
+                                "limits::kGyroNoise, beyond any gyro's noise"};
+constexpr Range kAccelerometerCoefficientRange{-limits::kAccelerometerCoefficient,
+                                               limits::kAccelerometerCoefficient, false,
+                                               "limits::kAccelerometerCoefficient, 10 g per g^n"};
+constexpr Range kAccelerometerScaleRange{-limits::kAccelerometerScale, limits::kAccelerometerScale, false,
+                                         "limits::kAccelerometerScale, output units per g"};
+constexpr Range kAccelerometerAngleRange{-1e6 * limits::kMachineErrorSi, 1e6 * limits::kMachineErrorSi, false,
+                                         "1 rad, limits::kMachineErrorSi"};
+constexpr Range kAccelerometerNoiseRange{0.0, limits::kAccelerometerCoefficient, false,
+                                         "limits::kAccelerometerCoefficient, 10 g"};
 
 /// A number key of section struct S: the file holds member / to_si.
 template <class S>
@@ -60,30 +85,28 @@ struct NumberKey {
 
 constexpr NumberKey<Site> kSiteKeys[] = {
     {"latitude_deg", &Site::latitude_rad, kDegToRad, kLatitude, "geodetic latitude, deg, in [-90, 90]"},
-    {"gravity_m_s2", &Site::gravity_m_s2, 1.0, kPositive,
-     "local gravity, m/s^2; specific force is in this g"},
-    {"earth_rate_rad_s", &Site::earth_rate_rad_s, 1.0, kNonNegative, "Earth rate magnitude, rad/s"},
+    {"gravity_m_s2", &Site::gravity_m_s2, 1.0, kGravity, "local gravity, m/s^2; specific force is in this g"},
+    {"earth_rate_rad_s", &Site::earth_rate_rad_s, 1.0, kEarthRate, "Earth rate magnitude, rad/s"},
 };
 
 constexpr NumberKey<CentrifugeGeometry> kCentrifugeKeys[] = {
-    {"radius_m", &CentrifugeGeometry::radius_m, 1.0, kPositive,
-     "R0, nominal arm radius to the gyro centre, m"},
+    {"radius_m", &CentrifugeGeometry::radius_m, 1.0, kRadius, "R0, nominal arm radius to the gyro centre, m"},
     {"rate_rad_s", &CentrifugeGeometry::rate_rad_s, 1.0, kAnyValue,
      "main-axis rate, rad/s, signed: + is counter-clockwise seen from above"},
     {"heading_deg", &CentrifugeGeometry::heading_rad, kDegToRad, kAnyValue,
      "psi0: direction of I at beta = 0, from North toward West, deg"},
-    {"initial_main_angle_deg", &CentrifugeGeometry::initial_main_angle_rad, kDegToRad, kAnyValue,
+    {"initial_main_angle_deg", &CentrifugeGeometry::initial_main_angle_rad, kDegToRad, kEncoderAngle,
      "theta0: main-axis angle at t = 0, deg"},
 };
 
 constexpr NumberKey<GyroNoise> kNoiseKeys[] = {
-    {"angle_random_walk_deg_rt_h", &GyroNoise::angle_random_walk_deg_rt_h, 1.0, kNonNegative,
+    {"angle_random_walk_deg_rt_h", &GyroNoise::angle_random_walk_deg_rt_h, 1.0, kGyroNoiseRange,
      "white rate noise, deg/sqrt(h)"},
-    {"bias_instability_deg_h", &GyroNoise::bias_instability_deg_h, 1.0, kNonNegative,
+    {"bias_instability_deg_h", &GyroNoise::bias_instability_deg_h, 1.0, kGyroNoiseRange,
      "flat Allan deviation floor, deg/h"},
-    {"rate_random_walk_deg_h_rt_h", &GyroNoise::rate_random_walk_deg_h_rt_h, 1.0, kNonNegative,
+    {"rate_random_walk_deg_h_rt_h", &GyroNoise::rate_random_walk_deg_h_rt_h, 1.0, kGyroNoiseRange,
      "rate random walk, deg/h/sqrt(h)"},
-    {"quantization_deg_h", &GyroNoise::quantization_deg_h, 1.0, kNonNegative,
+    {"quantization_deg_h", &GyroNoise::quantization_deg_h, 1.0, kGyroNoiseRange,
      "output quantization step, deg/h (0 = none)"},
     {"output_lag_s", &GyroNoise::output_lag_s, 1.0, kNonNegative,
      "first-order output lag time constant, s (0 = none)"},
@@ -231,10 +254,21 @@ double in_file_unit(double si, double to_si) {
 // Reading.
 
 std::string describe(const Range& range) {
+  const std::string why = range.reason != nullptr ? std::string(" (") + range.reason + ")" : "";
   if (range.max < kInf && range.min_exclusive)
-    return "> " + shortest(range.min) + " and <= " + shortest(range.max);
-  if (range.max < kInf) return "between " + shortest(range.min) + " and " + shortest(range.max);
-  return (range.min_exclusive ? "> " : ">= ") + shortest(range.min);
+    return "> " + shortest(range.min) + " and <= " + shortest(range.max) + why;
+  if (range.max < kInf) return "between " + shortest(range.min) + " and " + shortest(range.max) + why;
+  return (range.min_exclusive ? "> " : ">= ") + shortest(range.min) + why;
+}
+
+/// A machine error's range in its key's unit: `sign`'s lower end (any sign, or >= 0 for an uncertainty), and
+/// limits::kMachineErrorSi in SI, rounded down to one significant digit in the key's unit (200000 arcsec).
+Range machine_error_range(const Range& sign, double unit_to_si) {
+  const double max = limits::kMachineErrorSi / unit_to_si;
+  const double step = std::pow(10.0, std::floor(std::log10(max)));
+  const double rounded = std::floor(max / step) * step;
+  return {sign.min == 0.0 ? 0.0 : -rounded, rounded, false,
+          "about 1 rad or 1 m, limits::kMachineErrorSi: no machine error is that large"};
 }
 
 bool contains(const Range& range, double v) {
@@ -412,6 +446,7 @@ void read_numbers(Section& section, const NumberKey<S> (&keys)[N], S& target) {
 /// A harmonic series: an array of tables { harmonic, <amplitude_key>, phase_deg }.
 HarmonicSeries read_series(const Reader& reader, const toml::node& node, const std::string& path,
                            const ErrorKey& key) {
+  const Range amplitude = machine_error_range(kNonNegative, key.field->unit_to_si);
   const toml::array& items = reader.array(node, path);
   // Each term is a column of the model's work at every sample: the series is bounded (core/limits.hpp).
   if (items.size() > limits::kHarmonicTerms)
@@ -427,7 +462,7 @@ HarmonicSeries read_series(const Reader& reader, const toml::node& node, const s
       term.harmonic =
           static_cast<int>(reader.integer(*harmonic, item.path("harmonic"), 1, limits::kHarmonic));
     }
-    item.number(key.amplitude_key, key.field->unit_to_si, kNonNegative, term.amplitude);
+    item.number(key.amplitude_key, key.field->unit_to_si, amplitude, term.amplitude);
     item.number("phase_deg", kDegToRad, kAnyValue, term.phase_rad);
     item.reject_unknown();
     series.terms.push_back(term);
@@ -442,15 +477,16 @@ void read_errors(const Reader& reader, Section& section, const Range& range, Cen
     if (node == nullptr) continue;
     const std::string path = section.path(key.key);
     const MachineErrorField& f = *key.field;
+    const Range bounded = machine_error_range(range, f.unit_to_si);
     switch (f.kind) {
       case MachineErrorKind::kConstant:
-        errors.*f.scalar = reader.number(*node, path, range) * f.unit_to_si;
+        errors.*f.scalar = reader.number(*node, path, bounded) * f.unit_to_si;
         break;
       case MachineErrorKind::kSeries:
         errors.*f.series = read_series(reader, *node, path, key);
         break;
       case MachineErrorKind::kVector: {
-        const std::vector<double> values = reader.numbers(*node, path, range, 3);
+        const std::vector<double> values = reader.numbers(*node, path, bounded, 3);
         errors.*f.vector = Eigen::Vector3d(values[0], values[1], values[2]) * f.unit_to_si;
         break;
       }
@@ -684,8 +720,10 @@ RecordLayout read_record(const Reader& reader, Section& section, const toml::tab
   }
   // Any finite number: the layout's check refuses a zero scale, naming the key.
   for (const auto& [key, member] : kRecordNumberKeys) {
+    // An encoder zero is an encoder angle (a larger one would put every reading beyond it).
     if (const toml::node* node = section.find(key))
-      layout.*member = reader.number(*node, section.path(key), kAnyValue);
+      layout.*member = reader.number(*node, section.path(key),
+                                     key.ends_with("_angle_offset_deg") ? kEncoderAngle : kAnyValue);
   }
   if (const toml::node* node = section.find("skip_rows"))
     layout.skip_rows = reader.integer(*node, section.path("skip_rows"), 0, INT64_MAX);
@@ -955,7 +993,10 @@ void read_sensor(const Reader& reader, Section& top, Scenario& s) {
   const toml::table* noise_table = accelerometer.table("noise");
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
     const SensorParameter& p = kAccelerometerParameters[k];
-    accelerometer.number(p.key, 1.0, kAnyValue, s.accelerometer.coefficients.values[k]);
+    const Range& range = p.name == "K1"     ? kAccelerometerScaleRange
+                         : p.unit == "urad" ? kAccelerometerAngleRange
+                                            : kAccelerometerCoefficientRange;
+    accelerometer.number(p.key, 1.0, range, s.accelerometer.coefficients.values[k]);
     if (p.name == "K1" && s.accelerometer.coefficients.values[k] == 0.0)
       reader.fail(accelerometer_table->get(p.key)->source(),
                   "accelerometer.K1 must be a non-zero scale factor (output units per g), not 0");
@@ -963,7 +1004,7 @@ void read_sensor(const Reader& reader, Section& top, Scenario& s) {
   accelerometer.reject_unknown();
   Section noise(reader, noise_table, "accelerometer.noise");
   for (const AccelerometerNoiseKey& k : kAccelerometerNoiseKeys)
-    noise.number(k.key, 1.0, kNonNegative, s.accelerometer.noise.*k.member);
+    noise.number(k.key, 1.0, kAccelerometerNoiseRange, s.accelerometer.noise.*k.member);
   noise.reject_unknown();
 }
 
@@ -1126,7 +1167,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   Section gyro(reader, top.table("gyro"), "gyro");
   const toml::table* noise_table = gyro.table("noise");
   for (std::size_t i = 0; i < kNumCoefficients; ++i)
-    gyro.number(kCoefficientNames[i], 1.0, kAnyValue, s.gyro.values[i]);
+    gyro.number(kCoefficientNames[i], 1.0, kGyroCoefficientRange, s.gyro.values[i]);
   // docs/physics.md section 15: the scale-factor error and the input axis' tilts toward O and S.
   gyro.number("scale_factor_error_ppm", 1.0, kRateError, s.gyro_rate.scale_factor_error_ppm);
   if (const toml::node* node = gyro.find("input_axis_misalignment_arcsec")) {

@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/closed_form.hpp"
 #include "gyrocal/identify/identifiability.hpp"
@@ -285,6 +286,25 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
   }
 }
 
+/// Refuses, naming the position, an observation that leaves a double's range once whitened (divided by its
+/// standard error) to weight the fit: the solver's own check would only say "Observation 0 is not finite".
+/// `unit` is the output's (deg/h or g); `limit` the configuration's bound on what predicts it.
+void refuse_overflowing_weighting(const Reduction& reduction, const Eigen::VectorXd& observations,
+                                  const Eigen::VectorXd& whitened, std::string_view unit,
+                                  std::string_view limit) {
+  for (Eigen::Index i = 0; i < whitened.size(); ++i) {
+    if (std::isfinite(whitened[i])) continue;
+    const auto k = static_cast<std::size_t>(i);
+    throw Error(fmt::format(
+        "the output minus the model's at {}, {:g} {}, leaves a double's range once divided by its standard "
+        "error ({:g} {}) to weight the fit: the outputs, or the configured coefficients that predict them, "
+        "are "
+        "too large ({}).",
+        describe_position(reduction, k), observations[i], unit, reduction.positions[k].std_err_deg_h, unit,
+        limit));
+  }
+}
+
 /// Refuses two positions of the plan that are one measurement (a repeated rate, beta or gamma), naming them.
 /// Checked before any weighting: their covariance is singular, but rounding may let a factorisation pass it.
 void refuse_repeated_positions(const Reduction& reduction) {
@@ -508,6 +528,11 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   LeastSquaresProblem problem;
   problem.design = llt.matrixL().solve(design);
   problem.observations = llt.matrixL().solve(observations);
+  refuse_overflowing_weighting(
+      reduction, observations, problem.observations, "g",
+      fmt::format("an output is at most {:g} g, limits::kOutputMagnitude; K0 and K2 ... Koo at most {:g} ug "
+                  "per g^n, limits::kAccelerometerCoefficient",
+                  limits::kOutputMagnitude, limits::kAccelerometerCoefficient));
   problem.weights = Eigen::VectorXd::Ones(m);
   problem.names = names;
   const LeastSquaresSolution sol = solve_least_squares(problem, lso);
@@ -692,9 +717,14 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   io.min_regressor_level = options.min_regressor_level;
   io.named_tolerance = options.estimable_tolerance;
   const Eigen::MatrixXd whitened_design = llt.matrixL().solve(design);
-  const CoefficientFit fit =
-      fit_coefficients(design.leftCols(nc), whitened_design, llt.matrixL().solve(observations), r.g_level,
-                       reduction.positions, model, io, names);
+  const Eigen::VectorXd whitened_observations = llt.matrixL().solve(observations);
+  refuse_overflowing_weighting(
+      reduction, observations, whitened_observations, "deg/h",
+      fmt::format("an output is at most {:g} deg/h, limits::kOutputMagnitude; [gyro] dF ... dOS at most {:g} "
+                  "deg/h per g^n, limits::kGyroCoefficient",
+                  limits::kOutputMagnitude, limits::kGyroCoefficient));
+  const CoefficientFit fit = fit_coefficients(design.leftCols(nc), whitened_design, whitened_observations,
+                                              r.g_level, reduction.positions, model, io, names);
   const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
   r.unknowns = static_cast<int>(n);

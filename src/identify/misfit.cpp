@@ -209,7 +209,9 @@ void refuse_constant_output(const Reduction& reduction, const OutputConfiguratio
   if (reduction.positions.size() < 2) return;
   const double v0 = reduction.positions.front().mean_deg_h;
   for (const ReducedPosition& p : reduction.positions)
-    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(1.0, std::abs(v0))) ||
+    // Constant relative to the values' own magnitude: outputs of 1e-299 deg/h that differ by a third between
+    // positions vary (a scale wrong by 1e300), and were called constant against an absolute 1e-9.
+    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean_deg_h))) ||
         !without_noise(p.std_err_deg_h))
       return;
   throw Error(fmt::format(

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/record/decimal.hpp"
 #include "gyrocal/record/record.hpp"
@@ -607,6 +608,26 @@ struct RecordReader::State {
                      printable(layout->time_column), time_s, previous_time_s));
   }
 
+  /// Refuses the output of the row just read, beyond limits::kOutputMagnitude in magnitude (or not finite
+  /// after a layout's conversion): `raw` as the field read, `output` in deg/h or g. Names the line and the
+  /// column, and for a layout the conversion that gave the value.
+  [[noreturn, gnu::noinline, gnu::cold]] void fail_output(double raw, double output) const {
+    const auto column = static_cast<std::size_t>(std::find(slot.begin(), slot.end(), 4) - slot.begin());
+    const std::string_view unit =
+        layout ? layout->output_unit() : (output_name == kLoneOutputColumns[1] ? "g" : "deg/h");
+    const std::string conversion =
+        layout ? fmt::format(
+                     ", which reads as {} {} ((value - record.output_offset) / record.{})", output, unit,
+                     layout->output_quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g"
+                                                                               : "output_scale_per_deg_h")
+               : std::string();
+    fail(fmt::format(
+        "column {} ({}) is {}{}; an output is at most {} {} in magnitude (limits::kOutputMagnitude): no "
+        "sensor "
+        "writes such a value, and the squares a calibration sums of it would leave a double's range",
+        column + 1, printable(columns[column]), raw, conversion, limits::kOutputMagnitude, unit));
+  }
+
   /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
   template <bool kBlankDelimited>
   bool parse_row(std::string_view text, double* values) {
@@ -774,6 +795,9 @@ bool RecordReader::next(RecordSample& sample) {
   }
   sample.time_s = values[0];
   if (!s.layout) {
+    // An output whose square a calibration's sums cannot hold (limits.hpp); one compare a row.
+    if (!(std::abs(values[4]) <= limits::kOutputMagnitude)) [[unlikely]]
+      s.fail_output(values[4], values[4]);
     if (s.lone_output) {
       constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
       sample.main_angle_deg = sample.counter_angle_deg = sample.position_angle_deg = kNaN;
@@ -796,6 +820,8 @@ bool RecordReader::next(RecordSample& sample) {
                      : std::numeric_limits<double>::quiet_NaN();
   }
   sample.output = (values[4] - s.output_offset) / s.output_divisor;
+  if (!(std::abs(sample.output) <= limits::kOutputMagnitude)) [[unlikely]]
+    s.fail_output(values[4], sample.output);
   return true;
 }
 

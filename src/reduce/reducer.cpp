@@ -11,11 +11,13 @@
 #include <mutex>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <thread>
 
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/reduce/accumulator_feed.hpp"
@@ -24,27 +26,6 @@
 
 namespace gyrocal {
 namespace {
-
-/// wrap_deg's value, a reduced to [-180, 180], at a fraction of std::remainder's cost (it was a tenth of a
-/// calibration's time, docs/performance.md): an angle already in range is returned as is, as remainder does;
-/// otherwise a - 360 k is exact (Sterbenz: 360 k is within a factor of two of a), k the nearest integer to
-/// a / 360 or one off it, and a k that the quotient's rounding put on the wrong side of a half turn is
-/// corrected. Only exactly +-180 may come out with the other sign than remainder's. The common case is an
-/// unwrapped prediction minus a wrapped reading, out of range: k comes from a truncating conversion (a call
-/// of libm's nearbyint was 3 % of a calibration's time), nearbyint only beyond 2^50 turns.
-[[gnu::always_inline]] inline double wrap_deg_quick(double a) {
-  if (std::abs(a) <= 180.0) return a;
-  const double q = a * (1.0 / 360.0);
-  const double k = std::abs(q) < 0x1p50
-                       ? static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)))
-                       : std::nearbyint(q);
-  double r = a - 360.0 * k;
-  if (r > 180.0)
-    r -= 360.0;
-  else if (r < -180.0)
-    r += 360.0;
-  return r;
-}
 
 /// A first-in first-out queue on one growing ring of slots: std::deque allocates a block every few elements
 /// of a large type (four of Run::Waiting), and the guard pushes and pops every row of a record.
@@ -103,6 +84,21 @@ struct Row {
   double theta = 0.0, psi = 0.0, beta = 0.0;  // deg
   double y = 0.0;                             // gyro output, deg/h
 };
+
+/// The encoder of a row's first reading (main, counter, position) that no encoder writes: beyond
+/// limits::kEncoderAngleDeg in magnitude, or not a number; nullptr when all three are readings. Such a value
+/// cannot be wrapped onto a turn (1e308 lies nowhere on it): it is a glitch, never a reading on the line.
+const char* unreadable_encoder(const Row& r) {
+  constexpr double kMax = limits::kEncoderAngleDeg;
+  if (std::abs(r.theta) <= kMax && std::abs(r.psi) <= kMax && std::abs(r.beta) <= kMax) [[likely]]
+    return nullptr;
+  return !(std::abs(r.theta) <= kMax) ? "main" : !(std::abs(r.psi) <= kMax) ? "counter" : "position";
+}
+
+/// The reading of `encoder` ("main", "counter" or "position") in r.
+double encoder_reading(const Row& r, std::string_view encoder) {
+  return encoder == "main" ? r.theta : encoder == "counter" ? r.psi : r.beta;
+}
 
 /// A line angle(t) = at + rate * (t - t0), deg and deg/s, with the largest residual of the rows it was
 /// fitted to.
@@ -388,6 +384,10 @@ struct Reducer::State {
   // ---- Looking for a steady state -------------------------------------------------------------------
   /// Takes a row (raw encoder readings) while no run is in progress.
   void look(const Row& raw) {
+    // A reading no encoder writes (a corrupt field) is skipped: the window's lines and unwrapping go on from
+    // the last readable row.
+    if (unreadable_encoder(raw) != nullptr) [[unlikely]]
+      return;
     Row r = raw;
     if (!window.empty()) {
       const Row& p = window.back();
@@ -582,7 +582,12 @@ struct Reducer::State {
       dev.hold = std::max(std::abs(wrap_deg_quick(u.theta - r.hold_theta)),
                           std::abs(wrap_deg_quick(u.psi - r.hold_psi)));
     std::string off;
-    if (std::abs(db) > options.beta_tolerance_deg)
+    if (const char* encoder = unreadable_encoder(raw)) [[unlikely]]
+      off = fmt::format(
+          "the {} encoder reads {:g} deg at t = {:.3f} s, beyond any encoder's {:g} deg "
+          "(limits::kEncoderAngleDeg)",
+          encoder, encoder_reading(raw, encoder), raw.t, limits::kEncoderAngleDeg);
+    else if (std::abs(db) > options.beta_tolerance_deg)
       off = fmt::format("beta moves by {:.3g} deg at t = {:.3f} s", db, raw.t);
     else if (!gap && std::abs(u.theta - th_pred) > options.angle_tolerance_deg)
       off = fmt::format("the main axis leaves its steady rate at t = {:.3f} s (its encoder {:.3g} deg off)",
@@ -1173,6 +1178,21 @@ Reduction Reducer::finish() {
             : (st.options.linear_drift ? 3 : 2) +
                   (heading_sweep_rad_s(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s) != 0.0 ? 2
                                                                                                          : 0);
+    if (d.gyro.revolutions >= needed) {
+      // Enough revolutions, but their scatter overflowed: outputs whose squares leave a double's range (a
+      // record's reader refuses them, limits::kOutputMagnitude; a caller pushing samples may not have).
+      double largest = 0.0;
+      for (double v : d.gyro.value)
+        if (!(std::abs(v) <= largest)) largest = std::abs(v);
+      throw Error(fmt::format(
+          "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, but the scatter "
+          "between "
+          "them is not a finite number: its outputs reach {:g}, whose squares leave a double's range (an "
+          "output is at most {:g} in magnitude, limits::kOutputMagnitude).",
+          st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
+          d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", largest,
+          limits::kOutputMagnitude));
+    }
     throw Error(fmt::format(
         "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
         "error from the scatter between them; it needs at least {}{}.",

@@ -499,3 +499,18 @@ def test_an_accelerometer_simulates_and_calibrates_as_the_command_line(tmp_path)
     assert abs(from_arrays["coefficients"]["K1"]["value"] - 1.0) < 1e-4
     assert [e["error"] for e in from_arrays["machine_errors"]] == ["radius_error"]
     assert from_arrays["coefficients"]["delta_p"]["unit"] == "urad"
+
+
+def test_an_output_beyond_the_bound_is_refused_naming_the_row():
+    # issue 29, D13: the arrays' output is held to limits::kOutputMagnitude (1e50) as the record reader holds it;
+    # a 1e308 sample made noise ask "is the output constant?", a dwell of them calibrate say "too few revolutions".
+    rng = np.random.default_rng(1)
+    t = np.arange(1000) * 0.01
+    w = rng.standard_normal(1000)
+    w[417] = 1e308
+    with pytest.raises(ValueError, match=r"<arrays>, row 417: gyro_deg_h is 1e\+308; an output is at most 1e\+50"):
+        gyrocal.noise({"time_s": t, "gyro_deg_h": w})
+    zeros = np.zeros(1000)
+    with pytest.raises(ValueError, match=r"row 417: gyro_deg_h is 1e\+308"):
+        gyrocal.calibrate({"time_s": t, "main_angle_deg": zeros, "counter_angle_deg": zeros,
+                           "position_angle_deg": zeros, "gyro_deg_h": w}, gyrocal.Scenario())

@@ -58,6 +58,49 @@ inline constexpr std::size_t kRecordMetadataLines = 4096;
 /// The most bytes of metadata held (keys and values together).
 inline constexpr std::size_t kRecordMetadataBytes = std::size_t{1} << 20;
 
+/// The largest magnitude of a record's output, in its unit (deg/h, or g for an accelerometer; a layout's
+/// after its offset and scale): 1e50. No sensor writes a value within many orders of magnitude of it; the
+/// bound keeps what the reduction and the noise fit form of the outputs inside a double's range: the fourth
+/// power (the Allan variance's variance) is 1e200, times the most samples a test may hold (kTestSamples)
+/// 1e210, far below the largest double, 1.8e308 (a dwell of 1e200 was refused as "too few revolutions", a
+/// static record with one 1e308 sample as "no combination of noise terms fits"). A larger output is refused
+/// naming its line and column.
+inline constexpr double kOutputMagnitude = 1e50;
+/// The largest magnitude of an encoder angle, deg (a layout's counts or radians after their conversion):
+/// 1e10 deg, 2.8e7 turns, which an unwrapped angle or an accumulating counter reaches after 200 days of
+/// spinning at 10 rad/s; a double still resolves 2e-6 deg (0.007 arcsec) there, below any encoder's count.
+/// A reading beyond it (a corrupt field such as 1e308, which wrapping cannot place) is no encoder's: inside a
+/// dwell it is an encoder glitch, dropped and counted (more than reduce.encoder_glitch_rows in a row end the
+/// dwell); outside, it is skipped (docs/records.md).
+inline constexpr double kEncoderAngleDeg = 1e10;
+
+// ---- Configuration values: physically generous ranges, each refused naming its key ----
+
+/// |SI value| of a machine error ([centrifuge.errors]) and of its uncertainty ([uncertainty]): about 1 rad,
+/// 1 m, 1 rad/s or 1 m/(rad/s)^2 (in the key's unit, rounded down to one significant digit: 200000 arcsec).
+/// A machine's errors are arcsec and micrometres (docs/sensitivity.md); beyond a radian or a metre the
+/// model's errors are no longer small, and their products can leave a double's range (issue 29, D13).
+inline constexpr double kMachineErrorSi = 1.0;
+/// |gyro drift coefficient| ([gyro] dF, deg/h; dI, dO, dS, deg/h/g; dII ... dOS, deg/h/g^2): 1e7, 2800 deg/s,
+/// beyond any gyro's range ([gyro] dF = 1e308 gave "Observation 0 is not finite (inf)" in `plan`).
+inline constexpr double kGyroCoefficient = 1e7;
+/// The gyro's noise levels ([gyro.noise] angle random walk deg/sqrt(h), bias instability deg/h, rate random
+/// walk deg/h/sqrt(h), quantization deg/h): up to 1e7 in the key's unit, as the coefficients (a random walk
+/// of 1e300 gave a record of overflowing outputs).
+inline constexpr double kGyroNoise = 1e7;
+/// |accelerometer coefficient| other than K1 ([accelerometer] K0, ug; K2 ... Koo, ug/g^n): 1e7 ug, 10 g per
+/// g^n; and its noise levels ([accelerometer.noise], ug/sqrt(Hz), ug). The misalignments (urad) are held to
+/// kMachineErrorSi (1e6 urad).
+inline constexpr double kAccelerometerCoefficient = 1e7;
+/// |accelerometer K1|, output units per g: 1e12 (a 24-bit converter gives ~1e7 counts per g).
+inline constexpr double kAccelerometerScale = 1e12;
+/// The centrifuge's arm radius ([centrifuge] radius_m), m: the largest test centrifuges have arms of ~10 m.
+inline constexpr double kRadiusM = 1000.0;
+/// Local gravity ([site] gravity_m_s2), m/s^2: ten times the Earth's.
+inline constexpr double kGravityMS2 = 100.0;
+/// The Earth rate ([site] earth_rate_rad_s), rad/s: 1.4e4 times the Earth's.
+inline constexpr double kEarthRateRadS = 1.0;
+
 // ---- Results given to `report` ----
 
 /// The largest result file `report` reads, bytes. A calibration result is ~100 kB; a Monte Carlo result
