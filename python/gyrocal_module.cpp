@@ -170,10 +170,11 @@ py::object calibrate_path_py(const std::string& path, const Scenario& scenario, 
   nlohmann::ordered_json j;
   {
     py::gil_scoped_release release;
-    // The record's output must be the scenario's sensor's, as `gyrocal calibrate` checks.
-    require_output_for_sensor(RecordReader(path, scenario.record), scenario.sensor_kind, kScenarioName);
-    j = calibration_to_json(
-        calibrate_record(path, scenario.model(), scenario.test, options, scenario.record));
+    // The record's output must be the scenario's sensor's, as `gyrocal calibrate` checks. One reader checks
+    // it and reads the rows: a pipe or a FIFO can be opened only once.
+    RecordReader reader(path, scenario.record);
+    require_output_for_sensor(reader, scenario.sensor_kind, kScenarioName);
+    j = calibration_to_json(calibrate_record(reader, scenario.model(), scenario.test, options));
   }
   j["record"] = path;  // as `gyrocal calibrate --json` writes it
   return json_to_python(j);

@@ -54,15 +54,16 @@ void register_calibrate(CLI::App& app) {
     const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
     require_angle_columns(s.record, opt->record);
-    // The record's output column and metadata against the configuration, before the record is read
-    // (docs/interface.md).
+    // The record's output column and metadata against the configuration, before its rows are read
+    // (docs/interface.md). The record is opened once: the reader that read its head reads its rows (a pipe,
+    // a FIFO or /dev/stdin can be read only once).
     const std::string config_name = opt->config.empty() ? "the built-in scenario" : opt->config;
-    const RecordReader head(opt->record, s.record);
-    require_output_for_sensor(head, s.sensor_kind, config_name);
+    RecordReader reader(opt->record, s.record);
+    require_output_for_sensor(reader, s.sensor_kind, config_name);
     const std::vector<std::string> metadata_warnings =
-        check_record_metadata(head.metadata(), opt->record, s, config_name);
+        check_record_metadata(reader.metadata(), opt->record, s, config_name);
     for (const std::string& w : metadata_warnings) fmt::print(stderr, "gyrocal: warning: {}\n", w);
-    CalibrationResult r = calibrate_record(opt->record, s.model(), s.test, options, s.record);
+    CalibrationResult r = calibrate_record(reader, s.model(), s.test, options);
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
     if (!opt->json.empty()) {
       nlohmann::ordered_json j = calibration_to_json(r);

@@ -1533,7 +1533,13 @@ CalibrationResult calibrate_record(const std::string& record_path, const Centrif
                                    const std::optional<RecordLayout>& layout) {
   require_angle_columns(layout, record_path);
   RecordReader reader(record_path, layout);
+  return calibrate_record(reader, model, plan, options);
+}
+
+CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& model, const TestSpec& plan,
+                                   const CalibrationOptions& options) {
   reader.require_angles();  // a record of the output alone, or a layout's angle column missing
+  const std::optional<RecordLayout>& layout = reader.layout();
   CalibrationOptions o = options;
   if (layout) {
     o.output.scale_key = std::string(layout->output_scale_key());

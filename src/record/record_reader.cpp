@@ -89,6 +89,7 @@ struct RecordReader::State {
   bool line_unterminated = false;  ///< the last line returned had no newline (end of file)
 
   RecordMetadata metadata;
+  std::size_t metadata_bytes = 0;  ///< of the keys and values in `metadata`
   std::vector<std::string> columns;
   double previous_time_s = 0.0;
   bool have_previous = false;
@@ -273,13 +274,51 @@ struct RecordReader::State {
     read_header(text);
   }
 
-  /// A metadata line's text after its comment prefix: `key = value`, or a comment without '='.
+  /// A metadata line's text after its comment prefix: `key = value`, or a comment without '='. What is held
+  /// is bounded (limits::kRecordMetadataLines lines, limits::kRecordMetadataBytes bytes of keys and values):
+  /// metadata is read before the rows, whole, so a record of endless metadata must be refused, not held.
   void add_metadata(std::string_view body) {
     const std::size_t equals = body.find('=');
     if (equals == std::string_view::npos) return;  // a comment
     const std::string_view key = trim(body.substr(0, equals));
     if (key.empty()) fail("the metadata line has no key before '='");
-    metadata.emplace_back(key, trim(body.substr(equals + 1)));
+    const std::string_view value = trim(body.substr(equals + 1));
+    if (metadata.size() >= limits::kRecordMetadataLines) {
+      fail(fmt::format(
+          "the record holds more than {} metadata lines ('key = value') before its header, the limit "
+          "(gyrocal writes about 40); is the header line missing?",
+          limits::kRecordMetadataLines));
+    }
+    metadata_bytes += key.size() + value.size();
+    if (metadata_bytes > limits::kRecordMetadataBytes) {
+      fail(fmt::format(
+          "the record's metadata lines before its header hold more than {} bytes of keys and values, the "
+          "limit (gyrocal writes about 1 kB)",
+          limits::kRecordMetadataBytes));
+    }
+    metadata.emplace_back(key, value);
+  }
+
+  /// True when `name` is a column of gyrocal's own format (kRecordColumns, or accel_g).
+  static bool is_own_column(std::string_view name) {
+    return std::find(kRecordColumns.begin(), kRecordColumns.end(), name) != kRecordColumns.end() ||
+           std::find(kLoneOutputColumns.begin(), kLoneOutputColumns.end(), name) != kLoneOutputColumns.end();
+  }
+
+  /// Refuses a header of gyrocal's own format that names one of the format's columns (columns[i]) out of
+  /// its place: the format reads its columns by place (docs/records.md), a [record] section by name.
+  [[noreturn]] void fail_out_of_place(std::size_t i) const {
+    const auto own = std::find(kRecordColumns.begin(), kRecordColumns.end(), columns[i]);
+    const std::string place =
+        own != kRecordColumns.end()
+            ? fmt::format("column {}", own - kRecordColumns.begin() + 1)
+            : fmt::format("column {} (or 2 in a record of the output alone)", kRecordColumns.size());
+    fail(fmt::format(
+        "column {} of the header is {}, a column of gyrocal's own format out of its place ({}): its header "
+        "must begin with {} in this order (or time_s,gyro_deg_h, or time_s,accel_g, for a record of the "
+        "output alone); to read the columns by name in another order, give the configuration a [record] "
+        "section (an empty one reads gyrocal's column names in any order)",
+        i + 1, quote(columns[i]), place, fmt::join(kRecordColumns, ",")));
   }
 
   void read_header(std::string_view text) {
@@ -314,6 +353,7 @@ struct RecordReader::State {
                            columns.size(), columns.size() == 1 ? "" : "s", alone));
         }
         if (columns[i] != kRecordColumns[i]) {
+          if (is_own_column(columns[i])) fail_out_of_place(i);
           fail(fmt::format("the header must begin with {}, but column {} is {}{}", header_text, i + 1,
                            quote(columns[i]), alone));
         }
@@ -325,6 +365,9 @@ struct RecordReader::State {
     }
     for (std::size_t i = required; i < columns.size(); ++i) {
       if (columns[i].empty()) fail(fmt::format("column {} of the header has no name", i + 1));
+      // An extra column named as one of the format's own (time_s,gyro_deg_h,main_angle_deg,... read as a
+      // record of the output alone) would pass an angle through as an extra value, unread (issue 29, D7).
+      if (is_own_column(columns[i])) fail_out_of_place(i);
       if (std::find(columns.begin(), columns.begin() + static_cast<std::ptrdiff_t>(i), columns[i]) !=
           columns.begin() + static_cast<std::ptrdiff_t>(i)) {
         fail(fmt::format("column {} of the header repeats the name {}", i + 1, quote(columns[i])));

@@ -153,4 +153,30 @@ void refuse_gammas_beyond_fit(std::size_t gammas, const ReduceOptions& options) 
       gammas, options.harmonic_order, unknowns, unknowns, unknowns, gammas / 2));
 }
 
+void check_calibration_memory(const TestSpec& test, const ReduceOptions& options) {
+  double dwells = 0.0, seconds = 0.0;
+  const double betas = static_cast<double>(test.beta_rad.size());
+  for (double r : test.rates_rad_s)
+    for (double o : test.counter_rate_offsets_rad_s) {
+      if (r == 0.0 && o == 0.0) continue;  // a static hold keeps its batches only
+      dwells += betas;
+      seconds += betas * static_cast<double>(test.revolutions) * 2.0 * kPi / std::abs(r - o);
+    }
+  const double revolutions = dwells * static_cast<double>(test.revolutions);
+  if (revolutions > limits::kCalibrationRevolutions)
+    throw Error(fmt::format(
+        "the test's spinning dwells hold {:.4g} revolutions together ([test] revolutions = {} x {} spinning "
+        "dwells); a calibration holds a few numbers a revolution until the end, and at most {:.0f} keep it "
+        "within its memory (64 MB): fewer revolutions or fewer dwells.",
+        revolutions, test.revolutions, dwells, limits::kCalibrationRevolutions));
+  const double windows = seconds / options.window_s;
+  if (windows > limits::kCalibrationRateWindows)
+    throw Error(fmt::format(
+        "the test's spinning dwells last {:.4g} s together ([test] revolutions = {} at rates_rad_s), {:.4g} "
+        "rate windows of [reduce] window_s = {} s; a calibration holds a few numbers a window until the end, "
+        "and at most {:.0f} keep it within its memory (64 MB): fewer revolutions, faster rates or a longer "
+        "window_s.",
+        seconds, test.revolutions, windows, options.window_s, limits::kCalibrationRateWindows));
+}
+
 }  // namespace gyrocal

@@ -135,11 +135,21 @@ MeasuredMotionFit::MeasuredMotionFit(double grid_interval_s, double origin_s, do
   out_.origin_s = origin_s;
   out_.origin_rad = origin_rad;
   out_.reference_rate_rad_s = reference_rate_rad_s;
+  span_s_ = span_s;
 }
 
 void MeasuredMotionFit::begin_phase(double x_s) {
   phases_.emplace_back();
-  phases_.back().first_knot = x_s;
+  Phase& p = phases_.back();
+  p.first_knot = x_s;
+  // The first phase spans the planned span (the reducer measures no further): its knots are known, and held
+  // in arrays of their size, not in arrays doubled as they grow (twice the memory, three times while one is
+  // copied to the next; docs/performance.md).
+  if (phases_.size() == 1 && span_s_ > 0.0 && std::isfinite(span_s_ * inverse_knot_interval_)) {
+    const auto knots = static_cast<std::size_t>(std::ceil(span_s_ * inverse_knot_interval_)) + 4;
+    p.rhs.reserve(knots);
+    p.band.reserve(4 * knots);
+  }
 }
 
 namespace {

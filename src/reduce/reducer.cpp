@@ -13,6 +13,7 @@
 #include <span>
 #include <string_view>
 #include <thread>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -136,6 +137,76 @@ double median_of(std::vector<double> v) {
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
+}
+
+/// The reducer's warnings in the order they arise, those of one kind aggregated (issue 29): a record that
+/// repeats its test a thousand times would otherwise give a line per dwell. Up to kWarningsPerKind warnings
+/// of a kind are given as they are; beyond that the kind's warnings become one line, the first in full, then
+/// their count and the places of the next few. Memory is bounded by the kinds, whatever the record's length.
+class WarningLog {
+ public:
+  /// Given as they are up to this many of a kind; more are summarised in one line.
+  static constexpr std::size_t kWarningsPerKind = 3;
+  /// A summary names the places of this many warnings after its first.
+  static constexpr std::size_t kPlacesShown = 3;
+
+  /// A warning of `kind` (a short tag, e.g. "outliers"): its sentence and its place in the record (e.g.
+  /// "the dwell at 9.9 rad/s, beta 0.0000 deg at t = 12.345 s"), for a summary.
+  void add(std::string_view kind, std::string message, std::string place) {
+    auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const Kind& k) { return k.name == kind; });
+    if (it == kinds_.end()) {
+      kinds_.push_back({std::string(kind), 0, {}, {}});
+      it = std::prev(kinds_.end());
+    }
+    ++it->count;
+    if (it->messages.size() < kWarningsPerKind) {
+      order_.emplace_back(static_cast<std::size_t>(it - kinds_.begin()), it->messages.size());
+      it->messages.push_back(std::move(message));
+    }
+    if (it->places.size() < kPlacesShown + 1) it->places.push_back(std::move(place));
+  }
+  /// Warnings added so far, of every kind.
+  std::size_t count() const {
+    std::size_t n = 0;
+    for (const Kind& k : kinds_) n += k.count;
+    return n;
+  }
+  /// The lines, in the order of the warnings they stand for: a kind with more than kWarningsPerKind
+  /// warnings as one line where its first warning was.
+  std::vector<std::string> lines() const {
+    std::vector<std::string> out;
+    for (const auto& [kind, index] : order_) {
+      const Kind& k = kinds_[kind];
+      if (k.count <= kWarningsPerKind) {
+        out.push_back(k.messages[index]);
+      } else if (index == 0) {
+        std::string places;
+        for (std::size_t i = 1; i < k.places.size(); ++i) places += (i > 1 ? "; " : "") + k.places[i];
+        out.push_back(fmt::format("{} The same warning {} more times ({} in all): {}{}.", k.messages[0],
+                                  k.count - 1, k.count, places, k.count > k.places.size() ? "; …" : ""));
+      }
+    }
+    return out;
+  }
+
+ private:
+  struct Kind {
+    std::string name;
+    std::size_t count = 0;
+    std::vector<std::string> messages;  ///< the first kWarningsPerKind
+    std::vector<std::string> places;    ///< the first kPlacesShown + 1
+  };
+  std::vector<Kind> kinds_;
+  /// (kind, message) of the messages kept, in order.
+  std::vector<std::pair<std::size_t, std::size_t>> order_;
+};
+
+/// The key of a dwell in the plan: rate, counter rate offset (docs/physics.md section 15), beta and a static
+/// hold's gamma. A record holds one dwell a key; of repeats the longest is used.
+using DwellKey = std::tuple<double, double, double, double>;
+DwellKey dwell_key(const Dwell& d) {
+  return {d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, d.beta_rad,
+          d.is_static ? d.gammas_rad[0] : 0.0};
 }
 
 /// Steady runs that gave no dwell are kept, the longest first, up to this many (bounded memory).
@@ -360,9 +431,15 @@ struct Reducer::State {
   double window_tested_at = -std::numeric_limits<double>::infinity();
   double raw_theta_prev = 0.0, raw_psi_prev = 0.0;
   std::optional<Run> run;
+  // The dwells found, one a key (dwell_key): a repeat replaces the one kept only if it holds more samples
+  // (the first of the longest is used), so that a record repeating its test keeps one test's dwells.
   std::vector<Dwell> dwells;
+  std::vector<std::size_t> dwell_serial;  ///< per kept dwell: its number among all found, in time order
+  std::map<DwellKey, std::size_t> dwell_of_key;
+  std::size_t dwells_found = 0;
   std::vector<RejectedRun> rejected;
-  std::vector<std::string> warnings;
+  WarningLog warnings;  ///< each dwell's
+  WarningLog repeats;   ///< "the record repeats the dwell …"
   double worst_rate_offset = 0.0;
   int offset_dwells = 0;
   double last_run_start_s = -std::numeric_limits<double>::infinity();
@@ -971,6 +1048,7 @@ struct Reducer::State {
       d.measured = r.motion->finish();
       for (const StretchSums& st : r.stretches) d.measured.stretch_phase.push_back(st.phase);
       d.basis_angle = std::move(r.basis);
+      d.basis_angle.shrink_to_fit();  // held to the end: its size, not the capacity its growth left
     }
     const double beta_deg = d.beta_rad * kRadToDeg;
     const std::string what =
@@ -983,19 +1061,23 @@ struct Reducer::State {
     d.gyro = r.acc->finish(0);
     // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
     // at which clean noise reaches the rule's threshold).
+    const std::string place = fmt::format("the {} at t = {:.3f} s", what, d.first_time_s);
     if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
-      warnings.push_back(fmt::format(
-          "{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} robust standard "
-          "deviations of the dwell's fit) and left out of it.",
-          at(d.first_time_s), what, d.gyro.outliers, d.samples,
-          100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
-          options.outlier_threshold));
+      warnings.add("outliers",
+                   fmt::format("{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} "
+                               "robust standard deviations of the dwell's fit) and left out of it.",
+                               at(d.first_time_s), what, d.gyro.outliers, d.samples,
+                               100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
+                               options.outlier_threshold),
+                   place);
     // Checks a test engineer wants to hear about.
     const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
     if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
-      warnings.push_back(fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions): {}.",
-                                     at(d.first_time_s), what, measured, d.planned_duration_s,
-                                     plan.revolutions, r.quality.ended));
+      warnings.add("short",
+                   fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions): {}.",
+                               at(d.first_time_s), what, measured, d.planned_duration_s, plan.revolutions,
+                               r.quality.ended),
+                   place);
     }
     // A rate that wanders: the main encoder's scatter about its line beyond its white part (half the mean
     // square of successive differences: quantisation and stamp jitter), which the channels' constant-rate
@@ -1004,11 +1086,11 @@ struct Reducer::State {
         r.diff_n > 0 ? 0.5 * (r.diff_yy - 2.0 * bt * r.diff_yt + bt * bt * r.diff_tt) / r.diff_n : 0.0;
     const double wander_deg = std::sqrt(std::max(res_t / nd - white2, 0.0));
     if (wander_deg > options.wander_warning_deg) {
-      warnings.push_back(
-          fmt::format("{}: the rate wanders during the {}: the main encoder leaves a constant-rate line by "
-                      "{:.4f} deg RMS "
-                      "beyond its sample-to-sample scatter.",
-                      at(d.first_time_s), what, wander_deg));
+      warnings.add("wander",
+                   fmt::format("{}: the rate wanders during the {}: the main encoder leaves a constant-rate "
+                               "line by {:.4f} deg RMS beyond its sample-to-sample scatter.",
+                               at(d.first_time_s), what, wander_deg),
+                   place);
     }
     if (!d.is_static && d.planned_rate_rad_s != 0.0) {
       const double rel = std::abs(d.main.rate_rad_s - d.planned_rate_rad_s) / std::abs(d.planned_rate_rad_s);
@@ -1017,7 +1099,28 @@ struct Reducer::State {
         worst_rate_offset = std::max(worst_rate_offset, rel);
       }
     }
-    dwells.push_back(std::move(d));
+    keep(std::move(d));
+  }
+
+  /// Keeps a found dwell: the first of its key, or a repeat holding more samples than the one kept.
+  void keep(Dwell d) {
+    const std::size_t serial = dwells_found++;
+    const auto [it, first] = dwell_of_key.emplace(dwell_key(d), dwells.size());
+    if (first) {
+      dwells.push_back(std::move(d));
+      dwell_serial.push_back(serial);
+      return;
+    }
+    repeats.add("repeat",
+                fmt::format("{}: the record repeats the dwell at {} rad/s, beta {:.4f} deg; the "
+                            "longer one is used.",
+                            source, d.planned_rate_rad_s, d.beta_rad * kRadToDeg),
+                fmt::format("the dwell at {} rad/s, beta {:.4f} deg at t = {:.3f} s", d.planned_rate_rad_s,
+                            d.beta_rad * kRadToDeg, d.first_time_s));
+    if (d.samples > dwells[it->second].samples) {
+      dwells[it->second] = std::move(d);
+      dwell_serial[it->second] = serial;
+    }
   }
 
   /// The most telling rejected run for a planned position that has no dwell.
@@ -1063,6 +1166,7 @@ Reducer::Reducer(const PlannedTest& plan, const ReduceOptions& options, std::str
         "the plan has no non-zero rate, no [test] static_hold_s and no reference rate to size the static "
         "holds.");
   check_test_feasible(plan.spec, options, state_->reference_rate);
+  check_calibration_memory(plan.spec, options);
 }
 
 Reducer::~Reducer() = default;
@@ -1090,6 +1194,10 @@ void Reducer::push_unsummarised(const RecordSample& s) {
   st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output});
 }
 
+std::size_t Reducer::dwells_held() const {
+  return state_->dwells.size();
+}
+
 void Reducer::set_summary(const RecordSummary& summary) {
   state_->summary = summary;
 }
@@ -1099,43 +1207,32 @@ Reduction Reducer::finish() {
   while (st.run) st.end_run("the record ends", State::Ending::kRecordEnds);
   Reduction out;
   out.samples_read = st.rows;
-  out.warnings = st.warnings;
+  out.warnings = st.warnings.lines();
   if (st.offset_dwells > 0)
     out.warnings.push_back(
         fmt::format("{}: in {} dwell{} the main axis turned up to {:.2e} (relative) off the planned rate; "
                     "the measured rates "
                     "are used.",
                     st.source, st.offset_dwells, st.offset_dwells > 1 ? "s" : "", st.worst_rate_offset));
-  // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several.
-  // The key of a dwell: rate, counter rate offset (docs/physics.md section 15), beta and a hold's gamma.
-  std::map<std::tuple<double, double, double, double>, int> chosen;
-  for (std::size_t i = 0; i < st.dwells.size(); ++i) {
-    const Dwell& d = st.dwells[i];
-    const auto key = std::make_tuple(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, d.beta_rad,
-                                     d.is_static ? d.gammas_rad[0] : 0.0);
-    auto it = chosen.find(key);
-    if (it == chosen.end()) {
-      chosen[key] = static_cast<int>(i);
-    } else {
-      out.warnings.push_back(
-          fmt::format("{}: the record repeats the dwell at {} rad/s, beta {:.4f} deg; the "
-                      "longer one is used.",
-                      st.source, d.planned_rate_rad_s, d.beta_rad * kRadToDeg));
-      if (d.samples > st.dwells[it->second].samples) it->second = static_cast<int>(i);
-    }
-  }
-  std::vector<int> in_time_order;
-  for (const auto& [key, i] : chosen) in_time_order.push_back(i);
-  std::sort(in_time_order.begin(), in_time_order.end());
-  std::map<int, int> renumber;
-  for (int i : in_time_order) {
-    renumber[i] = static_cast<int>(out.dwells.size());
-    out.dwells.push_back(st.dwells[static_cast<std::size_t>(i)]);
+  // One dwell per (rate, beta) or (0, beta, gamma): the longest if the record has several (kept as they were
+  // found, State::keep), in time order.
+  for (std::string& w : st.repeats.lines()) out.warnings.push_back(std::move(w));
+  std::vector<std::size_t> in_time_order(st.dwells.size());
+  for (std::size_t i = 0; i < in_time_order.size(); ++i) in_time_order[i] = i;
+  std::sort(in_time_order.begin(), in_time_order.end(),
+            [&](std::size_t a, std::size_t b) { return st.dwell_serial[a] < st.dwell_serial[b]; });
+  std::map<DwellKey, int> chosen;  // the dwell of each key, numbered as in out.dwells
+  for (std::size_t i : in_time_order) {
+    // Moved, not copied: a dwell holds a few numbers a revolution (docs/performance.md).
+    chosen[dwell_key(st.dwells[i])] = static_cast<int>(out.dwells.size());
+    out.dwells.push_back(std::move(st.dwells[i]));
     out.samples_used += out.dwells.back().samples;
     out.outliers += out.dwells.back().gyro.outliers;
     out.gaps += out.dwells.back().gaps;
     out.encoder_glitch_rows += out.dwells.back().quality.encoder_glitch_rows;
   }
+  st.dwells.clear();
+  st.dwell_of_key.clear();
   out.rejected = st.rejected;
   std::sort(out.rejected.begin(), out.rejected.end(),
             [](const RejectedRun& a, const RejectedRun& b) { return a.start_s < b.start_s; });
@@ -1154,7 +1251,7 @@ Reduction Reducer::finish() {
                       p.beta_rad * kRadToDeg, p.gamma_rad * kRadToDeg, st.why_missing(p)));
       continue;
     }
-    const int di = renumber[it->second];
+    const int di = it->second;
     out.positions.push_back(reduced_position(p, out.dwells[static_cast<std::size_t>(di)], di));
   }
   if (!missing.empty()) {
@@ -1163,7 +1260,7 @@ Reduction Reducer::finish() {
     if (missing.size() > 4) list += fmt::format("; and {} more", missing.size() - 4);
     throw Error(fmt::format("{}: the record has no usable dwell for {} planned position{}: {}. {}", st.source,
                             missing.size(), missing.size() > 1 ? "s" : "", list,
-                            st.summary.describe(st.plan, st.layout, st.rejected, st.dwells.size())));
+                            st.summary.describe(st.plan, st.layout, st.rejected, st.dwells_found)));
   }
   // A standard error is the scatter between revolutions (or batches) about a line: without a degree of
   // freedom left there is no measurement of the noise, and no number may stand in for one

@@ -52,10 +52,11 @@ inline constexpr std::size_t kEstimatedErrors = 64;
 
 /// The longest line of a record, bytes (bounds memory on input that is not a record).
 inline constexpr std::size_t kRecordLineBytes = std::size_t{1} << 16;
-/// The most metadata and preamble lines before a record's header. gyrocal writes ~60; a logger's preamble
-/// a few dozen.
+/// The most metadata lines (`# key = value`, held in memory) before a record's header. gyrocal writes ~40; a
+/// logger's preamble a few dozen. Comment and blank lines, and a layout's skip_rows, are not held and do not
+/// count (they stream past like rows).
 inline constexpr std::size_t kRecordMetadataLines = 4096;
-/// The most bytes of metadata held (keys and values together).
+/// The most bytes of metadata held (keys and values together). gyrocal writes ~1 kB.
 inline constexpr std::size_t kRecordMetadataBytes = std::size_t{1} << 20;
 
 /// The largest magnitude of a record's output, in its unit (deg/h, or g for an accelerometer; a layout's
@@ -100,6 +101,20 @@ inline constexpr double kRadiusM = 1000.0;
 inline constexpr double kGravityMS2 = 100.0;
 /// The Earth rate ([site] earth_rate_rad_s), rad/s: 1.4e4 times the Earth's.
 inline constexpr double kEarthRateRadS = 1.0;
+
+// ---- What a calibration holds of a record ----
+
+/// The most revolutions of gamma a calibration holds, over all the spinning dwells of its test together
+/// ([test] revolutions x the spinning dwells). A calibration keeps, per revolution of a spinning dwell until
+/// the model's channels are evaluated, the measured-motion spline's 4 knots and the revolution's values for
+/// the residual levels: ~150 B held, ~450 B more for the dwell being fitted; measured 240 B a revolution of
+/// RSS at 9.9 rad/s (issue 29, D19). 150 000 keep calibrate near 50 MB, under its 64 MB target
+/// (docs/performance.md); `plan` and `simulate` hold no such state and are not bounded by it.
+inline constexpr double kCalibrationRevolutions = 150000;
+/// The most rate windows ([reduce] window_s) over the spinning dwells of a test together: a calibration keeps
+/// one piece of the output's basis angle (32 B) a window (Dwell::basis_angle); 300 000 are ~10 MB. At 9.9
+/// rad/s a revolution holds 1.3 windows of 0.5 s; this bounds a slow rate's many windows a revolution.
+inline constexpr double kCalibrationRateWindows = 300000;
 
 // ---- Results given to `report` ----
 

@@ -221,6 +221,12 @@ std::vector<PositionChannels> calibration_channels(const Reduction& reduction, c
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
                                    const TestSpec& plan, const CalibrationOptions& options,
                                    const std::optional<RecordLayout>& layout = std::nullopt);
+/// The same on a record already opened (its head read: the metadata and the header), read from its next row
+/// on through its own layout (RecordReader::layout()): a caller that checks the record's metadata first
+/// takes them from the reader that then reads the rows, so that the record is opened once (a pipe or a FIFO
+/// can be read only once). A record without all three angles is refused (RecordReader::require_angles).
+CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& model, const TestSpec& plan,
+                                   const CalibrationOptions& options);
 
 /// The 16 positions of docs/physics.md section 7 in the plan, at its first spinning rate and counter rate
 /// offset 0: for k = 1..16 the index into reduction.positions, or an empty vector when the plan does not

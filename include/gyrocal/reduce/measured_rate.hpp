@@ -108,6 +108,7 @@ class MeasuredMotionFit {
   static void fold(Phase& p);
   MeasuredMotion out_;
   double inverse_knot_interval_ = 0.0;
+  double span_s_ = 0.0;  ///< the planned span (0: none)
   std::vector<Phase> phases_;
 };
 

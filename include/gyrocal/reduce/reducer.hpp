@@ -196,6 +196,10 @@ class Reducer {
   void set_record_layout(const std::optional<RecordLayout>& layout);
   /// Match the dwells to the plan; an error if a planned position has no dwell.
   Reduction finish();
+  /// The dwells held so far: one a planned place (rate, counter rate offset, beta, a static hold's gamma),
+  /// the longest of a record that repeats it (the first of equal length), so that memory does not grow with
+  /// repeats; 0 after finish(), which moves them into the Reduction.
+  std::size_t dwells_held() const;
 
  private:
   struct State;
