@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -31,6 +33,69 @@ const CLI::Validator kFinite(
     },
     "FINITE", "FINITE");
 
+namespace {
+
+/// A value as the user gave it, for a refusal: '' for an empty one.
+std::string as_given(const std::string& text) {
+  return text.empty() ? std::string("''") : text;
+}
+
+bool all_digits(std::string_view text, std::size_t from) {
+  if (text.size() <= from) return false;
+  for (std::size_t i = from; i < text.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(text[i]))) return false;
+  return true;
+}
+
+}  // namespace
+
+const CLI::Validator kPositiveFinite(
+    [](std::string& text) -> std::string {
+      double value = 0.0;
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
+        return "must be a finite number > 0, not " + as_given(text);
+      return {};
+    },
+    "NUMBER > 0", "POSITIVE_FINITE");
+
+const CLI::Validator kSeed(
+    [](std::string& text) -> std::string {
+      std::uint64_t value = 0;
+      const char* end = text.data() + text.size();
+      if (!all_digits(text, 0) || std::from_chars(text.data(), end, value).ec != std::errc())
+        return fmt::format("must be an integer from 0 to {}, not {}", UINT64_MAX, as_given(text));
+      text = std::to_string(value);  // in decimal for CLI11, which reads a leading 0 as octal
+      return {};
+    },
+    "INTEGER 0..2^64-1", "SEED");
+
+CLI::Validator integer_between(long long least, long long most) {
+  return CLI::Validator(
+      [least, most](std::string& text) -> std::string {
+        const std::string refusal =
+            fmt::format("must be an integer from {} to {}, not {}", least, most, as_given(text));
+        long long value = 0;
+        const char* end = text.data() + text.size();
+        const std::size_t digits_from = !text.empty() && text[0] == '-' ? 1 : 0;
+        if (all_digits(text, digits_from)) {
+          if (std::from_chars(text.data(), end, value).ec != std::errc()) return refusal;
+        } else {
+          // An exact integer in exponent form ("1e6"); the range check below bounds it.
+          if (text.find_first_not_of("0123456789+-.eE") != std::string::npos) return refusal;
+          char* parsed = nullptr;
+          const double number = text.empty() ? NAN : std::strtod(text.c_str(), &parsed);
+          if (parsed != end || !std::isfinite(number) || number != std::floor(number) ||
+              std::fabs(number) > 9e18)
+            return refusal;
+          value = static_cast<long long>(number);
+        }
+        if (value < least || value > most) return refusal;
+        text = std::to_string(value);
+        return {};
+      },
+      fmt::format("INTEGER {}..{}", least, most), "INTEGER_BETWEEN");
+}
+
 const char* const kCompensationHelp =
     "What is subtracted from each measurement before the fit: none; seed, the correction of the seed paper "
     "this method comes from (Wang & Meng 2017, docs/physics.md section 8): the counter platform's "
@@ -57,6 +122,8 @@ bool is_earlier_output(const std::string& path, OutputKind kind) {
       return is_earlier_result(path);
     case OutputKind::kReport:
       return is_earlier_report(path);
+    case OutputKind::kDemoRecord:
+      return is_simulated_record(path);
     case OutputKind::kRecord:
     case OutputKind::kConfiguration:
       break;
@@ -66,20 +133,35 @@ bool is_earlier_output(const std::string& path, OutputKind kind) {
 
 }  // namespace
 
+bool may_replace(const std::string& path, OutputKind kind, bool force, std::string_view option) {
+  if (force || is_earlier_output(path, kind)) return true;
+  std::error_code ec;
+  if (kind == OutputKind::kRecord || kind == OutputKind::kConfiguration ||
+      !std::filesystem::is_regular_file(path, ec))
+    return false;
+  const char* what = kind == OutputKind::kResult   ? "result"
+                     : kind == OutputKind::kReport ? "report"
+                                                   : "record";
+  const char* earlier = kind == OutputKind::kResult ? "a JSON object with gyrocal's \"gyrocal\" marker"
+                        : kind == OutputKind::kReport
+                            ? "an HTML file that starts with gyrocal's report comment"
+                            : "a record gyrocal simulated, whose metadata says '# generator = gyrocal "
+                              "simulate'";
+  throw Error(fmt::format(
+      "refusing to replace '{}' ({}): it exists and is not an earlier gyrocal {} ({}); give --force to "
+      "replace it.",
+      path, option, what, earlier));
+}
+
+void check_output(const std::string& path, OutputKind kind, bool force, std::string_view option) {
+  if (path.empty() || path == "-") return;
+  AtomicOutputFile::check(path, may_replace(path, kind, force, option));
+}
+
 std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, OutputKind kind, bool force,
                                               std::string_view option) {
   if (path == "-") return std::make_unique<AtomicOutputFile>(AtomicOutputFile::StandardOutput{});
-  const bool replace = force || is_earlier_output(path, kind);
-  std::error_code ec;
-  if (!replace && (kind == OutputKind::kResult || kind == OutputKind::kReport) &&
-      std::filesystem::is_regular_file(path, ec))
-    throw Error(fmt::format(
-        "refusing to replace '{}' ({}): it exists and is not an earlier gyrocal {} ({}); give --force to "
-        "replace it.",
-        path, option, kind == OutputKind::kResult ? "result" : "report",
-        kind == OutputKind::kResult ? "a JSON object with gyrocal's \"gyrocal\" marker"
-                                    : "an HTML file that starts with gyrocal's report comment"));
-  return std::make_unique<AtomicOutputFile>(path, replace);
+  return std::make_unique<AtomicOutputFile>(path, may_replace(path, kind, force, option));
 }
 
 void write_output(const std::string& path, std::string_view content, OutputKind kind, bool force,
@@ -113,6 +195,28 @@ bool is_earlier_report(const std::string& path) {
   std::string head(kReportMarker.size(), '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   return in.gcount() == static_cast<std::streamsize>(head.size()) && head == kReportMarker;
+}
+
+bool is_simulated_record(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  // The first line and the metadata lines after it, within the first 64 KiB (a file without line ends, or
+  // a long preamble, is not read further).
+  constexpr std::size_t kHeadBytes = std::size_t{64} << 10;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kHeadBytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  std::size_t from = 0;
+  for (std::size_t line = 0;; ++line) {
+    const std::size_t end = head.find('\n', from);
+    if (end == std::string::npos) return false;
+    const std::string_view text = std::string_view(head).substr(from, end - from);
+    if (line == 0 && text != "# gyrocal-record 1") return false;
+    if (line > 0 && (text.empty() || text[0] != '#')) return false;  // the header: no generator line
+    if (text == "# generator = gyrocal simulate") return true;
+    from = end + 1;
+  }
 }
 
 bool is_earlier_result(const std::string& path) {

@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -29,6 +30,7 @@ enum class OutputKind {
   kConfiguration,  ///< init FILE: a configuration the user may have edited
   kResult,         ///< --json FILE: a result (gyrocal's marker, report/html_report.hpp)
   kReport,         ///< --html FILE: a report (kReportMarker)
+  kDemoRecord,     ///< demo --out DIR's record.csv: a record simulated by gyrocal (is_simulated_record)
 };
 
 /// The one rule for every output option (docs/interface.md, "Files"): "-" is standard output; a path that
@@ -39,6 +41,18 @@ enum class OutputKind {
 /// may not replace. Inputs are refused before, by refuse_to_overwrite_input.
 std::unique_ptr<AtomicOutputFile> open_output(const std::string& path, OutputKind kind, bool force,
                                               std::string_view option);
+
+/// open_output's rule applied to `path` before a command's work, creating nothing (AtomicOutputFile::check):
+/// throws the same gyrocal::Error open_output would (a file it may not replace, a folder, a dangling link, a
+/// folder that does not exist or cannot take a file). Nothing for an empty path (no output) or "-".
+/// open_output checks again at the end: the file system may change meanwhile.
+void check_output(const std::string& path, OutputKind kind, bool force, std::string_view option);
+
+/// Whether open_output's rule lets an existing regular file at `path` be replaced: true with `force` or when
+/// it is an earlier output of `kind`; false for a record or a configuration without `force` (the caller
+/// refuses "exists; use --force"); for a result, a report or a demo's record that is not an earlier one,
+/// throws gyrocal::Error naming `option`, the path, what an earlier output is and --force.
+bool may_replace(const std::string& path, OutputKind kind, bool force, std::string_view option);
 
 /// Writes `content` to `path` through open_output and commits it.
 void write_output(const std::string& path, std::string_view content, OutputKind kind, bool force,
@@ -53,6 +67,18 @@ void add_force_flag(CLI::App* sub, bool& force);
 
 /// Refuse an output path that names one of the inputs (no input is ever overwritten).
 void refuse_to_overwrite_input(const std::string& output, const std::string& input);
+
+/// True when `path` is a record simulated by gyrocal: its first line is '# gyrocal-record 1' and a metadata
+/// line before its header says '# generator = gyrocal simulate' (only the first 64 KiB are read).
+bool is_simulated_record(const std::string& path);
+
+/// Text for standard output: every command prints through this (docs/interface.md, "Text output"), so
+/// that a write error (a full disk, /dev/full) fails the command, exit 1, with "Cannot write standard
+/// output: <reason>." (write_standard_output, core/atomic_file.hpp).
+template <typename... Args>
+void print_out(fmt::format_string<Args...> format, Args&&... args) {
+  write_standard_output(fmt::format(format, std::forward<Args>(args)...));
+}
 
 /// True when `path` is an earlier gyrocal report (it starts with kReportMarker, report/html_report.hpp).
 bool is_earlier_report(const std::string& path);
@@ -89,6 +115,20 @@ extern const char* const kCompensationHelp;
 
 /// A check for a numeric option: refuses NaN and infinities ("--beta-deg nan"), which CLI11 parses.
 extern const CLI::Validator kFinite;
+
+/// A floating-point option that must be a finite number > 0 ("--threshold: must be a finite number > 0,
+/// not 0").
+extern const CLI::Validator kPositiveFinite;
+
+/// --seed: a decimal integer from 0 to 2^64 - 1 = 18446744073709551615, refused as given otherwise (a sign,
+/// an empty value, more than 2^64 - 1), as the Python module refuses it.
+extern const CLI::Validator kSeed;
+
+/// An integer option from `least` to `most`, in decimal (or an exact integer in exponent form, "1e6"):
+/// anything else, an empty value included, is refused as given with the range ("--trials: must be an
+/// integer from 2 to 1000000000, not ''"), never read as 0 or as a saturated value. Add it with transform()
+/// (it rewrites the value in plain decimal).
+CLI::Validator integer_between(long long least, long long most);
 
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);

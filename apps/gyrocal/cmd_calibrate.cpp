@@ -43,6 +43,7 @@ void register_calibrate(CLI::App& app) {
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
     // The options as the library builds them for every caller (identify/scenario_options.hpp).
     CalibrationChoices choices;
@@ -74,7 +75,7 @@ void register_calibrate(CLI::App& app) {
       j["plan"] = plan_to_json(s.test);
       write_result(opt->json, std::move(j), "calibration", opt->force);
     }
-    if (opt->json != "-") fmt::print("{}", result_table(r));
+    if (opt->json != "-") print_out("{}", result_table(r));
   });
 }
 

@@ -25,17 +25,43 @@ namespace gyrocal::cli {
 
 namespace {
 
+/// The demo's three files in `folder`, staged (the first three elements) and final: each checked now, before
+/// any work, by the rule of every output (docs/interface.md, "Files"): an existing DIR/record.csv is replaced
+/// only when gyrocal simulated it, DIR/result.json only when it is an earlier gyrocal result, DIR/report.html
+/// only when it is an earlier gyrocal report; any regular file with --force. commit() checks again.
+struct DemoFiles {
+  std::string record_staged, result_staged, report_staged;
+  std::string record, result, report;
+};
+
+DemoFiles stage_demo_files(AtomicOutputFolder& folder, bool force) {
+  const auto rule = [force](OutputKind kind) {
+    return [force, kind](const std::filesystem::path& existing) {
+      may_replace(existing.string(), kind, force, "--out");
+    };
+  };
+  DemoFiles f;
+  f.record_staged = folder.path("record.csv", rule(OutputKind::kDemoRecord)).string();
+  f.result_staged = folder.path("result.json", rule(OutputKind::kResult)).string();
+  f.report_staged = folder.path("report.html", rule(OutputKind::kReport)).string();
+  f.record = folder.final_path("record.csv").string();
+  f.result = folder.final_path("result.json").string();
+  f.report = folder.final_path("report.html").string();
+  return f;
+}
+
 /// `gyrocal demo --sensor accelerometer`: the default accelerometer scenario (docs/accelerometer.md) on an
 /// arm longer than nominal, simulated, calibrated by least squares with full compensation and again with the
 /// radius error and stretch estimated from the sensor's own data, the truth beside the estimates, the error
 /// study and a Monte Carlo budget; the same three files as the gyro's demo.
-void accelerometer_demo(const std::string& out) {
+void accelerometer_demo(const std::string& out, bool force) {
   const Scenario s = demo_accelerometer_scenario();
   AtomicOutputFolder folder(out, "the demo's outputs");
-  const std::string record_staged = folder.path("record.csv").string();
-  const std::string record = folder.final_path("record.csv").string();
+  const DemoFiles files = stage_demo_files(folder, force);
+  const std::string& record_staged = files.record_staged;
+  const std::string& record = files.record;
   const double top_rate = *std::max_element(s.test.rates_rad_s.begin(), s.test.rates_rad_s.end());
-  fmt::print(
+  print_out(
       "gyrocal demo --sensor accelerometer: the default accelerometer scenario (R0 {} m + {:g} um, rates {} "
       "rad/s: up to {:.2f} g; static set, four beta, {} gamma).\n",
       s.centrifuge.radius_m, s.errors.radius_error_m * 1e6, fmt::join(s.test.rates_rad_s, ", "),
@@ -43,7 +69,7 @@ void accelerometer_demo(const std::string& out) {
   AtomicOutputFile file(record_staged, /*overwrite=*/false);
   const SimulationSummary sim = simulate_record(s, SimulationOptions{}, file.stream());
   file.commit();
-  fmt::print("simulated {} samples ({:.0f} s of test) for {}\n\n", sim.samples, sim.duration_s, record);
+  print_out("simulated {} samples ({:.0f} s of test) for {}\n\n", sim.samples, sim.duration_s, record);
 
   std::vector<std::string> labels = {"least squares, full", "radius from the sensor"};
   std::vector<CalibrationResult> results;
@@ -51,17 +77,17 @@ void accelerometer_demo(const std::string& out) {
   results.push_back(calibrate_record(record_staged, s.model(), s.test, calibration_options(s, choices)));
   choices.estimate = std::vector<std::string>{"radius_error", "radius_stretch"};
   results.push_back(calibrate_record(record_staged, s.model(), s.test, calibration_options(s, choices)));
-  fmt::print("{}\n", sensor_comparison_table(labels, results, kAccelerometerParameters,
-                                             s.accelerometer.coefficients.values));
+  print_out("{}\n", sensor_comparison_table(labels, results, kAccelerometerParameters,
+                                            s.accelerometer.coefficients.values));
   const CalibrationResult& main = results.front();
-  fmt::print("{}\n", main.BriefReport());
-  for (const std::string& w : main.warnings) fmt::print("- {}\n", w);
-  fmt::print("\nthe radius from the sensor (true values beside):\n");
+  print_out("{}\n", main.BriefReport());
+  for (const std::string& w : main.warnings) print_out("- {}\n", w);
+  print_out("\nthe radius from the sensor (true values beside):\n");
   for (const MachineErrorEstimate& e : results.back().machine_errors) {
     // In microns (per (rad/s)^2) where the error is a length: the arm is measured to a few microns.
     const double to_um = e.unit.rfind("m", 0) == 0 ? 1e6 : 1.0;
     const std::string unit = to_um == 1e6 ? "u" + e.unit : e.unit;
-    fmt::print(
+    print_out(
         "  {:<16} {:>24} {}   (true {:g})\n", e.parameter.label(),
         e.identifiable ? format_value_std(e.value * to_um, e.std * to_um) : std::string("not identifiable"),
         unit, e.configured * to_um);
@@ -80,27 +106,27 @@ void accelerometer_demo(const std::string& out) {
     j["comparison"].push_back({{"label", labels[i]}, {"coefficients", r["coefficients"]}});
   }
   j["radius_from_the_sensor"] = calibration_to_json(results.back())["machine_errors"];
-  fmt::print("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
+  print_out("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
   const SensitivityResult sensitivity = sensitivity_study(s);
   j["sensitivity"] = sensitivity_to_json(sensitivity);
   MonteCarloOptions mc;
   mc.trials = 20000;
   const MonteCarloResult budget = monte_carlo(s, mc);
   j["montecarlo"] = montecarlo_to_json(budget);
-  fmt::print("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
-             budget.trials, to_string(budget.mode));
+  print_out("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
+            budget.trials, to_string(budget.mode));
 
-  const std::string result_path = folder.final_path("result.json").string();
+  const std::string& result_path = files.result;
   j["config"] = nullptr;  // the built-in accelerometer demo scenario
   mark_result(j, "calibration");
-  write_file_atomically(folder.path("result.json").string(), j.dump(2) + "\n", false);
+  write_file_atomically(files.result_staged, j.dump(2) + "\n", false);
   HtmlReportOptions report;
   report.title = "gyrocal demo: the default accelerometer scenario";
   report.source = result_path;
-  const std::string report_path = folder.final_path("report.html").string();
-  write_file_atomically(folder.path("report.html").string(), render_html_report(j, report), false);
+  const std::string& report_path = files.report;
+  write_file_atomically(files.report_staged, render_html_report(j, report), false);
   folder.commit();
-  fmt::print("\nwrote {}, {} and {}\n", record, result_path, report_path);
+  print_out("\nwrote {}, {} and {}\n", record, result_path, report_path);
 }
 
 }  // namespace
@@ -109,31 +135,36 @@ void register_demo(CLI::App& app) {
   struct Options {
     std::string out = "gyrocal-demo";
     std::string sensor = "gyro";
+    bool force = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("demo", "The main job on the built-in default scenario");
   sub->add_option("--out", opt->out,
                   "Folder for record.csv, result.json and report.html: created, or those three files in it "
-                  "replaced, all together at the end");
+                  "replaced, all together at the end, when they are an earlier demo's (else give --force)");
+  sub->add_flag("--force", opt->force,
+                "Replace an existing record.csv, result.json or report.html in the --out folder that is not "
+                "an earlier output of gyrocal");
   sub->add_option(
          "--sensor", opt->sensor,
          "gyro (default) or accelerometer: the default scenario of that sensor (gyrocal init --sensor)")
       ->check(CLI::IsMember({"gyro", "accelerometer"}));
   sub->callback([opt] {
     if (opt->sensor == "accelerometer") {
-      accelerometer_demo(opt->out);
+      accelerometer_demo(opt->out, opt->force);
       return;
     }
     const Scenario s = demo_scenario();
     // The three files are built in a staging folder and moved into place together at the end: an error or
     // an interruption leaves the folder as it was (docs/interface.md, "Files").
     AtomicOutputFolder folder(opt->out, "the demo's outputs");
-    const std::string record_staged = folder.path("record.csv").string();
-    const std::string result_staged = folder.path("result.json").string();
-    const std::string report_staged = folder.path("report.html").string();
-    const std::string record = folder.final_path("record.csv").string();
+    const DemoFiles files = stage_demo_files(folder, opt->force);
+    const std::string& record_staged = files.record_staged;
+    const std::string& result_staged = files.result_staged;
+    const std::string& report_staged = files.report_staged;
+    const std::string& record = files.record;
 
-    fmt::print(
+    print_out(
         "gyrocal demo: the default scenario of docs/physics.md section 11 (R0 {} m, {} rad/s, Ar {:.3f} "
         "g).\n",
         s.centrifuge.radius_m, s.centrifuge.rate_rad_s,
@@ -141,7 +172,7 @@ void register_demo(CLI::App& app) {
     AtomicOutputFile file(record_staged, /*overwrite=*/false);
     const SimulationSummary sim = simulate_record(s, SimulationOptions{}, file.stream());
     file.commit();
-    fmt::print("simulated {} samples ({:.0f} s of test) for {}\n\n", sim.samples, sim.duration_s, record);
+    print_out("simulated {} samples ({:.0f} s of test) for {}\n\n", sim.samples, sim.duration_s, record);
 
     struct Run {
       std::string label;
@@ -162,10 +193,10 @@ void register_demo(CLI::App& app) {
       labels.push_back(run.label);
       results.push_back(calibrate_record(record_staged, s.model(), s.test, options));
     }
-    fmt::print("{}\n", comparison_table(labels, results, &s.gyro));
+    print_out("{}\n", comparison_table(labels, results, &s.gyro));
     const CalibrationResult& main = results.back();
-    fmt::print("{}\n", main.BriefReport());
-    for (const std::string& w : main.warnings) fmt::print("- {}\n", w);
+    print_out("{}\n", main.BriefReport());
+    for (const std::string& w : main.warnings) print_out("- {}\n", w);
 
     nlohmann::ordered_json j = calibration_to_json(main);
     j["record"] = record;
@@ -176,27 +207,27 @@ void register_demo(CLI::App& app) {
       j["comparison"].push_back(
           {{"label", labels[i]}, {"coefficients", calibration_to_json(results[i])["coefficients"]}});
     // The seed's error study and the uncertainty budget (10% uncertainty on each configured error).
-    fmt::print("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
+    print_out("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
     const SensitivityResult sensitivity = sensitivity_study(s);
     j["sensitivity"] = sensitivity_to_json(sensitivity);
     MonteCarloOptions mc;
     mc.trials = 100000;
     const MonteCarloResult budget = monte_carlo(s, mc);
     j["montecarlo"] = montecarlo_to_json(budget);
-    fmt::print("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
-               budget.trials, to_string(budget.mode));
+    print_out("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
+              budget.trials, to_string(budget.mode));
 
-    const std::string result_path = folder.final_path("result.json").string();
+    const std::string& result_path = files.result;
     j["config"] = nullptr;  // the built-in demo scenario
     mark_result(j, "calibration");
     write_file_atomically(result_staged, j.dump(2) + "\n", false);
     HtmlReportOptions report;
     report.title = "gyrocal demo: the default scenario";
     report.source = result_path;
-    const std::string report_path = folder.final_path("report.html").string();
+    const std::string& report_path = files.report;
     write_file_atomically(report_staged, render_html_report(j, report), false);
     folder.commit();
-    fmt::print("\nwrote {}, {} and {}\n", record, result_path, report_path);
+    print_out("\nwrote {}, {} and {}\n", record, result_path, report_path);
   });
 }
 

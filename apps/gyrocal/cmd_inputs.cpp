@@ -1,7 +1,12 @@
 // gyrocal inputs: exact and nominal inputs to the gyro at one instant.
+#include <climits>
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "cli.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/model/instant.hpp"
 #include "gyrocal/result/inputs_json.hpp"
 
@@ -37,6 +42,24 @@ std::string inputs_table(const InstantInputs& in) {
   return s;
 }
 
+/// True when every number `inputs` shows of `in` is finite.
+bool all_finite(const InstantInputs& in) {
+  const auto& j = in.joints;
+  const double values[] = {in.time_s,
+                           j.main_angle_rad,
+                           j.main_rate_rad_s,
+                           j.counter_angle_rad,
+                           j.counter_rate_rad_s,
+                           j.position_angle_rad,
+                           in.nominal.omega_I_rad_s,
+                           in.nominal.a_I_g,
+                           in.nominal.a_O_g,
+                           in.nominal.a_S_g};
+  for (const double v : values)
+    if (!std::isfinite(v)) return false;
+  return in.exact.rate_rad_s.allFinite() && in.exact.specific_force_g.allFinite();
+}
+
 }  // namespace
 
 void register_inputs(CLI::App& app) {
@@ -59,7 +82,7 @@ void register_inputs(CLI::App& app) {
           ->check(kFinite);
   CLI::Option* rev = sub->add_option("--revolution", opt->revolution,
                                      "Main-axis revolution (from 0) in which gamma is taken")
-                         ->check(CLI::NonNegativeNumber)
+                         ->transform(integer_between(0, INT_MAX))
                          ->needs(gamma);
   time->excludes(gamma)->excludes(rev);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
@@ -67,17 +90,38 @@ void register_inputs(CLI::App& app) {
   sub->callback([opt, time, gamma] {
     if (time->count() == 0 && gamma->count() == 0)
       throw CLI::ValidationError("inputs", "give the instant with --time-s T or --gamma-deg G");
+    refuse_to_overwrite_input(opt->json, opt->config);
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
+    // An instant lies within a test: at most limits::kTestSamples samples at [test] sample_rate_hz (a
+    // larger time would also overflow theta = omega t into inf and every input into NaN).
+    const double longest_s = limits::kTestSamples / s.test.sample_rate_hz;
+    const std::string longest =
+        fmt::format("{:g} s, the longest test gyrocal runs ({:g} samples at [test] sample_rate_hz = {:g} Hz)",
+                    longest_s, limits::kTestSamples, s.test.sample_rate_hz);
+    if (time->count() && !(std::fabs(opt->time_s) <= longest_s))
+      throw Error(
+          fmt::format("--time-s must be between -{:g} s and {}, not {:g}.", longest_s, longest, opt->time_s));
     const CentrifugeModel model = s.model();
     const double rate = s.centrifuge.rate_rad_s, beta = opt->beta_deg * kDegToRad;
     const InstantInputs in =
         time->count() ? inputs_at_time(model, rate, beta, opt->time_s)
                       : inputs_at_gamma(model, rate, beta, opt->gamma_deg * kDegToRad, opt->revolution);
-    if (!opt->json.empty()) {
-      refuse_to_overwrite_input(opt->json, opt->config);
-      write_result(opt->json, inputs_to_json(in), "inputs", opt->force);
-    }
-    if (opt->json != "-") fmt::print("{}", inputs_table(in));
+    if (!time->count() && !(std::fabs(in.time_s) <= longest_s))
+      throw Error(fmt::format(
+          "--gamma-deg {:g} in --revolution {} is {:g} s into the dwell, beyond {}: give a smaller angle or "
+          "revolution.",
+          opt->gamma_deg, opt->revolution, in.time_s, longest));
+    if (!all_finite(in))
+      throw Error(
+          fmt::format("the inputs at --beta-deg {:g} and {} are not finite numbers (they overflow with the "
+                      "configuration's "
+                      "rates and lengths); nothing was written.",
+                      opt->beta_deg,
+                      time->count() ? fmt::format("--time-s {:g}", opt->time_s)
+                                    : fmt::format("--gamma-deg {:g}", opt->gamma_deg)));
+    if (!opt->json.empty()) write_result(opt->json, inputs_to_json(in), "inputs", opt->force);
+    if (opt->json != "-") print_out("{}", inputs_table(in));
   });
 }
 

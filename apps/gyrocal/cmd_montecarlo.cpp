@@ -79,15 +79,17 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--trials", opt->trials,
                   "Number of trials: 2 to 1000000000 (1e9), or to 100000 (1e5) with --samples")
-      ->required();
-  CLI::Option* seed = sub->add_option(
-      "--seed", opt->seed,
-      "Random seed of the trials' draws; default: [test] seed (not --compensation seed, the seed paper's "
-      "correction)");
+      ->required()
+      ->transform(integer_between(2, kMaxFastTrials));
+  CLI::Option* seed = sub->add_option("--seed", opt->seed,
+                                      "Random seed of the trials' draws, 0 to 2^64-1; default: [test] seed "
+                                      "(not --compensation seed, the seed paper's correction)")
+                          ->transform(kSeed);
   sub->add_flag("--samples", opt->samples,
                 "Run the whole time-series pipeline per trial (slow; checks the fast linearised mode)");
-  sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
-      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--threads", opt->threads,
+                  fmt::format("Worker threads, 0 to {}; default (0): all cores", limits::kThreads))
+      ->transform(integer_between(0, limits::kThreads));
   sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation,
@@ -111,6 +113,7 @@ void register_montecarlo(CLI::App& app) {
                 "standard deviation to 0.002%; more would take days for no visible gain."));
     }
     refuse_to_overwrite_input(opt->json, opt->config);
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
     MonteCarloOptions options;
     options.trials = opt->trials;
@@ -131,7 +134,7 @@ void register_montecarlo(CLI::App& app) {
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
       write_result(opt->json, std::move(j), "montecarlo", opt->force);
     }
-    if (opt->json != "-") fmt::print("{}", montecarlo_table(result, seconds));
+    if (opt->json != "-") print_out("{}", montecarlo_table(result, seconds));
   });
 }
 

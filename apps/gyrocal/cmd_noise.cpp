@@ -40,6 +40,8 @@ void register_noise(CLI::App& app) {
       throw Error(fmt::format("--json and --html both name {}: give each its own file.", opt->json));
     if (opt->json == "-" && opt->html == "-")
       throw Error("--json and --html cannot both write to standard output.");
+    check_output(opt->html, OutputKind::kReport, opt->force, "--html");
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
     // With a configuration, its sensor's output is characterised (a record of the other sensor is refused);
     // without one, the record's output column says which sensor (accel_g: an accelerometer).
@@ -74,9 +76,9 @@ void register_noise(CLI::App& app) {
     if (html_file) html_file->commit();
     if (json_file) json_file->commit();
     if (opt->toml) {
-      fmt::print("{}", noise_to_toml(r));
+      print_out("{}", noise_to_toml(r));
     } else if (opt->json != "-" && opt->html != "-") {
-      fmt::print("{}", noise_table(r));
+      print_out("{}", noise_table(r));
     }
   });
 }

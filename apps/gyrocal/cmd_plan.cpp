@@ -33,6 +33,7 @@ void register_plan(CLI::App& app) {
   add_force_flag(sub, opt->force);
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
     // The options as the library builds them for every caller (identify/scenario_options.hpp); the
     // prediction models [reduce] and [calibration] reduction.
@@ -51,20 +52,20 @@ void register_plan(CLI::App& app) {
       write_result(opt->json, std::move(j), "plan", opt->force);
     }
     if (opt->json == "-") return;
-    fmt::print("The configured test: {} positions, {} revolutions per dwell at {} Hz.\n", r.positions.size(),
-               s.test.revolutions, s.test.sample_rate_hz);
+    print_out("The configured test: {} positions, {} revolutions per dwell at {} Hz.\n", r.positions.size(),
+              s.test.revolutions, s.test.sample_rate_hz);
     if (s.sensor_kind == SensorKind::kAccelerometer)
-      fmt::print(
+      print_out(
           "Predicted from the configured noise (white {} ug/sqrt(Hz)); estimates are the configured "
           "truth.\n\n",
           s.accelerometer.noise.velocity_random_walk_ug_rt_hz);
     else
-      fmt::print(
+      print_out(
           "Predicted from the configured noise (angle random walk {} deg/sqrt(h), bias instability {} deg/h, "
           "rate random walk {} deg/h/sqrt(h)); estimates are the configured truth.\n\n",
           s.noise.angle_random_walk_deg_rt_h, s.noise.bias_instability_deg_h,
           s.noise.rate_random_walk_deg_h_rt_h);
-    fmt::print("{}", result_table(r));
+    print_out("{}", result_table(r));
   });
 }
 

@@ -36,6 +36,7 @@ void register_report(CLI::App& app) {
   sub->add_flag("--force", opt->force, "Replace an existing file that is not an earlier gyrocal report");
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->html, opt->result);
+    check_output(opt->html, OutputKind::kReport, opt->force, "--html");
     const nlohmann::json result = read_result(opt->result);
     const std::string kind = result_kind(result);
     if (kind == "inputs")
@@ -60,9 +61,13 @@ void register_report(CLI::App& app) {
     // any other existing file only with --force (docs/report.md).
     write_output(opt->html, html, OutputKind::kReport, opt->force, "--html");
     // What was written, on standard error when the report itself went to standard output.
-    fmt::print(opt->html == "-" ? stderr : stdout, "wrote {}: the {} report of {} ({} sections)\n",
-               opt->html == "-" ? "standard output" : opt->html, kind == "montecarlo" ? "Monte Carlo" : kind,
-               opt->result, sections.size());
+    const std::string line = fmt::format(
+        "wrote {}: the {} report of {} ({} sections)\n", opt->html == "-" ? "standard output" : opt->html,
+        kind == "montecarlo" ? "Monte Carlo" : kind, opt->result, sections.size());
+    if (opt->html == "-")
+      fmt::print(stderr, "{}", line);
+    else
+      print_out("{}", line);
   });
 }
 

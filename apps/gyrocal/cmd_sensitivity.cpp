@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/sensitivity.hpp"
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 
@@ -224,12 +225,14 @@ void register_sensitivity(CLI::App& app) {
   add_force_flag(sub, opt->force);
   sub->add_option("--threshold", opt->threshold,
                   "An estimate is affected when its shift exceeds this many noise std; default 0.1")
-      ->check(kFinite & CLI::PositiveNumber);
-  sub->add_option("--threads", opt->threads, "Worker threads; default: all cores")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kPositiveFinite);
+  sub->add_option("--threads", opt->threads,
+                  fmt::format("Worker threads, 0 to {}; default (0): all cores", limits::kThreads))
+      ->transform(integer_between(0, limits::kThreads));
   add_gyro_model_option(sub, opt->gyro_model);
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->json, opt->config);
+    check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
     SensitivityOptions options;
     options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
@@ -244,8 +247,8 @@ void register_sensitivity(CLI::App& app) {
       write_result(opt->json, std::move(j), "sensitivity", opt->force);
     }
     if (opt->json != "-")
-      fmt::print("{}", result.sensor == SensorKind::kGyro ? sensitivity_table(result)
-                                                          : sensor_sensitivity_table(result));
+      print_out("{}", result.sensor == SensorKind::kGyro ? sensitivity_table(result)
+                                                         : sensor_sensitivity_table(result));
   });
 }
 

@@ -61,13 +61,14 @@ void register_simulate(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("simulate", "Simulate a whole test into a record");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--out", opt->out, "The record to write (CSV; '-' = standard output)")->required();
-  CLI::Option* seed = sub->add_option(
-      "--seed", opt->seed,
-      "Random seed of the noise; default: [test] seed (not --compensation seed, the seed paper's "
-      "correction)");
+  CLI::Option* seed = sub->add_option("--seed", opt->seed,
+                                      "Random seed of the noise, 0 to 2^64-1; default: [test] seed (not "
+                                      "--compensation seed, the seed paper's correction)")
+                          ->transform(kSeed);
   sub->add_flag("--force", opt->force, "Overwrite RECORD if it exists");
   sub->callback([opt, seed] {
     refuse_to_overwrite_input(opt->out, opt->config);
+    check_output(opt->out, OutputKind::kRecord, opt->force, "--out");
     const Scenario scenario = load_configuration(opt->config);
     // A record that calibrate would refuse is not written (the same check as plan's and calibrate's).
     check_feasible(scenario, opt->config, scenario.reduce);
@@ -85,10 +86,14 @@ void register_simulate(CLI::App& app) {
     const std::uint64_t bytes = file->bytes();
     file->commit();
     // With the record on standard output, the summary goes to standard error.
-    std::FILE* summary_stream = opt->out == "-" ? stderr : stdout;
-    fmt::print(summary_stream, "wrote {}: {} samples, test duration {:.1f} s ({:.2f} h), {}, seed {}\n",
-               opt->out == "-" ? "standard output" : opt->out, summary.samples, summary.duration_s,
-               summary.duration_s / 3600.0, size_text(bytes), summary.seed);
+    const std::string line =
+        fmt::format("wrote {}: {} samples, test duration {:.1f} s ({:.2f} h), {}, seed {}\n",
+                    opt->out == "-" ? "standard output" : opt->out, summary.samples, summary.duration_s,
+                    summary.duration_s / 3600.0, size_text(bytes), summary.seed);
+    if (opt->out == "-")
+      fmt::print(stderr, "{}", line);
+    else
+      print_out("{}", line);
   });
 }
 

@@ -1,12 +1,31 @@
 // gyrocal: the command line (docs/contract.md). Parsing arguments and printing only; no physics here.
 #include <exception>
+#include <iostream>
+#include <sstream>
 #include <string>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include "cli.hpp"
+#include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/core/error.hpp"
+
+namespace {
+
+/// The final check of standard output after a command (or CLI11's --help and --version) wrote to it: a write
+/// error that went unseen fails the run (docs/interface.md, "Errors and exit status").
+int checked_exit(int status) {
+  try {
+    gyrocal::check_standard_output();
+  } catch (const gyrocal::Error& e) {
+    fmt::print(stderr, "gyrocal: {}\n", e.what());
+    return status == 0 ? 1 : status;
+  }
+  return status;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -33,7 +52,16 @@ int main(int argc, char** argv) {
       return static_cast<int>(CLI::ExitCodes::RequiredError);
     }
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version print to `out`; it goes to standard output through the one checked writer.
+    std::ostringstream out;
+    const int status = app.exit(e, out, std::cerr);
+    try {
+      gyrocal::write_standard_output(out.str());
+    } catch (const gyrocal::Error& write_error) {
+      fmt::print(stderr, "gyrocal: {}\n", write_error.what());
+      return status == 0 ? 1 : status;
+    }
+    return checked_exit(status);
   } catch (const gyrocal::Error& e) {
     fmt::print(stderr, "gyrocal: {}\n", e.what());
     return 1;
@@ -41,5 +69,5 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "gyrocal: internal error: {}\n", e.what());
     return 2;
   }
-  return 0;
+  return checked_exit(0);
 }

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <mutex>
 #include <random>
 #include <streambuf>
 #include <string>
@@ -160,13 +161,105 @@ class SignalsBlocked {
   sigset_t old_;
 };
 
+// ---- Standard output -------------------------------------------------------------------------------------
+//
+// Every byte gyrocal writes to standard output goes through write_to_standard_output, which sees each
+// failure at once. When standard output is a regular file, where gyrocal's bytes began is remembered, so that
+// a failure can take them back (`>> cfg.toml` on a full disk keeps cfg.toml as it was).
+
+struct StandardOutputState {
+  bool started = false;       ///< the first byte was written (start and regular are known)
+  bool regular = false;       ///< standard output is a regular file whose offset is known
+  off_t start = 0;            ///< the file's length before gyrocal's first byte
+  std::uint64_t written = 0;  ///< bytes gyrocal wrote to it since
+};
+
+std::mutex g_standard_output_mutex;
+StandardOutputState g_standard_output;
+
+const std::string kStandardOutputName = "standard output";
+
+/// Cuts standard output back to where gyrocal's first byte went, when it is a regular file that ends where
+/// gyrocal's last byte went (nothing else wrote to it, and gyrocal wrote at its end).
+void take_back_standard_output() {
+  StandardOutputState& state = g_standard_output;
+  if (!state.regular || state.written == 0) return;
+  struct stat status {};
+  if (::fstat(STDOUT_FILENO, &status) != 0 || !S_ISREG(status.st_mode)) return;
+  if (static_cast<std::uint64_t>(status.st_size) != static_cast<std::uint64_t>(state.start) + state.written)
+    return;
+  if (::ftruncate(STDOUT_FILENO, state.start) != 0) return;
+  const int flags = ::fcntl(STDOUT_FILENO, F_GETFL);
+  if (flags >= 0 && (flags & O_APPEND) == 0) ::lseek(STDOUT_FILENO, state.start, SEEK_SET);
+  state.written = 0;
+}
+
+/// Writes `count` bytes to file descriptor 1 (the caller holds g_standard_output_mutex). Throws
+/// gyrocal::Error naming standard output, after take_back_standard_output, on any failure.
+void write_to_standard_output(const char* bytes, std::size_t count) {
+  StandardOutputState& state = g_standard_output;
+  if (!state.started) {
+    state.started = true;
+    struct stat status {};
+    if (::fstat(STDOUT_FILENO, &status) == 0 && S_ISREG(status.st_mode)) {
+      const int flags = ::fcntl(STDOUT_FILENO, F_GETFL);
+      const off_t start =
+          flags >= 0 && (flags & O_APPEND) != 0 ? status.st_size : ::lseek(STDOUT_FILENO, 0, SEEK_CUR);
+      if (start >= 0) {
+        state.regular = true;
+        state.start = start;
+      }
+    }
+  }
+  while (count > 0) {
+    const ssize_t written = ::write(STDOUT_FILENO, bytes, count);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      take_back_standard_output();
+      throw_io_error("write", kStandardOutputName, error);
+    }
+    bytes += written;
+    count -= static_cast<std::size_t>(written);
+    state.written += static_cast<std::uint64_t>(written);
+  }
+}
+
+/// Flushes std::cout and stdout (what the program printed by other means comes first) and throws if they
+/// failed, now or before (the caller holds g_standard_output_mutex).
+void flush_standard_streams() {
+  std::cout.flush();
+  if (std::fflush(stdout) != 0) {
+    const int error = errno;
+    take_back_standard_output();
+    throw_io_error("write", kStandardOutputName, error);
+  }
+  if (std::ferror(stdout) || !std::cout) {
+    take_back_standard_output();
+    throw Error("Cannot write " + kStandardOutputName + ": an earlier write failed.");
+  }
+}
+
 }  // namespace
+
+void write_standard_output(std::string_view text) {
+  const std::lock_guard<std::mutex> lock(g_standard_output_mutex);
+  flush_standard_streams();
+  write_to_standard_output(text.data(), text.size());
+}
+
+void check_standard_output() {
+  const std::lock_guard<std::mutex> lock(g_standard_output_mutex);
+  flush_standard_streams();
+}
 
 /// The write buffer, as a streambuf so that stream() and write() share it. Errors throw
 /// gyrocal::Error; std::ostream rethrows them because badbit is in its exceptions().
 class AtomicOutputFile::Buffer : public std::streambuf {
  public:
-  Buffer(int fd, const std::string& name) : fd_(fd), name_(name), data_(kBufferBytes) {
+  /// `standard_output`: fd is standard output, written through write_to_standard_output.
+  Buffer(int fd, const std::string& name, bool standard_output = false)
+      : fd_(fd), name_(name), standard_output_(standard_output), data_(kBufferBytes) {
     setp(data_.data(), data_.data() + data_.size());
   }
 
@@ -211,6 +304,18 @@ class AtomicOutputFile::Buffer : public std::streambuf {
  private:
   void write_all(const char* bytes, std::size_t count) {
     if (failed_) throw Error("Cannot write " + name_ + ": an earlier write failed.");
+    if (standard_output_) {
+      // Standard output: the one writer, which takes back a regular file's bytes on failure.
+      const std::lock_guard<std::mutex> lock(g_standard_output_mutex);
+      try {
+        write_to_standard_output(bytes, count);
+      } catch (...) {
+        failed_ = true;
+        throw;
+      }
+      flushed_ += count;
+      return;
+    }
     while (count > 0) {
       const ssize_t written = ::write(fd_, bytes, count);
       if (written < 0) {
@@ -226,52 +331,82 @@ class AtomicOutputFile::Buffer : public std::streambuf {
 
   int fd_;
   const std::string& name_;
+  bool standard_output_;
   std::vector<char> data_;
   std::uint64_t flushed_ = 0;
   bool failed_ = false;
 };
 
-AtomicOutputFile::AtomicOutputFile(std::filesystem::path target, bool overwrite)
-    : target_(std::move(target)), destination_(target_), name_(quoted(target_)), overwrite_(overwrite) {
-  if (target_.filename().empty()) throw Error("Output path " + name_ + " is not a file name.");
+AtomicOutputFile::Inspection AtomicOutputFile::inspect(const std::filesystem::path& target, bool overwrite) {
+  const std::string name = quoted(target);
+  if (target.filename().empty()) throw Error("Output path " + name + " is not a file name.");
+  Inspection found{target, name, false};
   struct stat status {};
-  const bool exists = ::lstat(target_.c_str(), &status) == 0;
-  if (!exists && errno != ENOENT) throw_io_error("write", name_, errno);
-  std::string described = name_;
+  const bool exists = ::lstat(target.c_str(), &status) == 0;
+  if (!exists && errno != ENOENT) throw_io_error("write", name, errno);
   if (exists && S_ISLNK(status.st_mode)) {
     // A link is followed to what it names: the link stays, its target is written (docs/interface.md).
     std::error_code ec;
-    const std::filesystem::path link = std::filesystem::read_symlink(target_, ec);
-    const std::filesystem::path resolved = std::filesystem::canonical(target_, ec);
+    const std::filesystem::path link = std::filesystem::read_symlink(target, ec);
+    const std::filesystem::path resolved = std::filesystem::canonical(target, ec);
     if (ec || ::stat(resolved.c_str(), &status) != 0) {
-      throw Error("Output path " + name_ + " is a symbolic link to " + quoted(link) +
+      throw Error("Output path " + name + " is a symbolic link to " + quoted(link) +
                   ", which does not exist; gyrocal follows a link only to an existing file.");
     }
-    destination_ = resolved;
-    described = name_ + " (a symbolic link to " + quoted(resolved) + ")";
+    found.destination = resolved;
+    found.described = name + " (a symbolic link to " + quoted(resolved) + ")";
   }
   if (exists) {
+    // Written straight through: a device or FIFO is never replaced by a file.
     if (S_ISCHR(status.st_mode) || S_ISFIFO(status.st_mode)) {
-      // Written straight through: a device or FIFO is never replaced by a file.
-      fd_ = ::open(destination_.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
-      if (fd_ < 0) throw_io_error("write", described, errno);
-      struct stat opened {};
-      if (::fstat(fd_, &opened) != 0 || !(S_ISCHR(opened.st_mode) || S_ISFIFO(opened.st_mode))) {
-        ::close(fd_);
-        fd_ = -1;
-        throw Error("Output path " + described + " changed while it was being opened; nothing was written.");
-      }
-      direct_ = true;
-      buffer_ = std::make_unique<Buffer>(fd_, name_);
-      stream_ = std::make_unique<std::ostream>(buffer_.get());
-      stream_->exceptions(std::ios::badbit);
-      return;
+      found.direct = true;
+      return found;
     }
     if (!S_ISREG(status.st_mode)) {
-      throw Error("Output path " + described + " is " + type_text(status.st_mode) + "; " +
+      throw Error("Output path " + found.described + " is " + type_text(status.st_mode) + "; " +
                   std::string(kWhatIsWritten) + ".");
     }
-    if (!overwrite_) throw_exists(target_);
+    if (!overwrite) throw_exists(target);
+  }
+  return found;
+}
+
+void AtomicOutputFile::check(const std::filesystem::path& target, bool overwrite) {
+  const Inspection found = inspect(target, overwrite);
+  if (found.direct) return;  // a device or FIFO is not opened here: opening a FIFO waits for its reader
+  // The temporary goes beside the destination: its folder must exist and take a new file.
+  const std::filesystem::path folder =
+      found.destination.has_parent_path() ? found.destination.parent_path() : std::filesystem::path(".");
+  struct stat status {};
+  int error = 0;
+  if (::stat(folder.c_str(), &status) != 0)
+    error = errno;
+  else if (!S_ISDIR(status.st_mode))
+    error = ENOTDIR;
+  else if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    error = errno;
+  if (error != 0) throw_io_error("create a file beside", quoted(target), error);
+}
+
+AtomicOutputFile::AtomicOutputFile(std::filesystem::path target, bool overwrite)
+    : target_(std::move(target)), destination_(target_), name_(quoted(target_)), overwrite_(overwrite) {
+  const Inspection found = inspect(target_, overwrite_);
+  destination_ = found.destination;
+  if (found.direct) {
+    fd_ = ::open(destination_.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd_ < 0) throw_io_error("write", found.described, errno);
+    struct stat opened {};
+    if (::fstat(fd_, &opened) != 0 || !(S_ISCHR(opened.st_mode) || S_ISFIFO(opened.st_mode))) {
+      ::close(fd_);
+      fd_ = -1;
+      throw Error("Output path " + found.described +
+                  " changed while it was being opened; nothing was written.");
+    }
+    direct_ = true;
+    buffer_ = std::make_unique<Buffer>(fd_, name_);
+    stream_ = std::make_unique<std::ostream>(buffer_.get());
+    stream_->exceptions(std::ios::badbit);
+    return;
   }
   for (int attempt = 0; fd_ < 0; ++attempt) {
     temporary_ = temporary_name(destination_.parent_path(), destination_.filename().string());
@@ -295,12 +430,14 @@ AtomicOutputFile::AtomicOutputFile(std::filesystem::path target, bool overwrite)
 }
 
 AtomicOutputFile::AtomicOutputFile(StandardOutput)
-    : target_("-"), destination_("-"), name_("standard output"), direct_(true), owns_fd_(false) {
-  // Whatever the program printed before comes first.
-  std::cout.flush();
-  std::fflush(stdout);
+    : target_("-"), destination_("-"), name_(kStandardOutputName), direct_(true), owns_fd_(false) {
+  // Whatever the program printed before comes first; a failure there is a failure of this output.
+  {
+    const std::lock_guard<std::mutex> lock(g_standard_output_mutex);
+    flush_standard_streams();
+  }
   fd_ = STDOUT_FILENO;
-  buffer_ = std::make_unique<Buffer>(fd_, name_);
+  buffer_ = std::make_unique<Buffer>(fd_, name_, /*standard_output=*/true);
   stream_ = std::make_unique<std::ostream>(buffer_.get());
   stream_->exceptions(std::ios::badbit);
 }
@@ -450,14 +587,32 @@ AtomicOutputFolder::~AtomicOutputFolder() {
     std::error_code ignored;
     std::filesystem::remove_all(staging_, ignored);
   }
-  for (auto& file : files_) unregister(file.second);
+  for (Staged& file : files_) unregister(file.registration);
   unregister(registration_);
 }
 
-std::filesystem::path AtomicOutputFolder::path(const std::string& name) {
+std::filesystem::path AtomicOutputFolder::path(const std::string& name, ReplaceCheck may_replace) {
+  Staged file{name, -1, std::move(may_replace)};
+  // Before any work: what commit() would refuse is refused now.
+  check_destination(file);
   const std::filesystem::path p = staging_ / name;
-  files_.emplace_back(name, register_for_removal(p, /*directory=*/false));
+  file.registration = register_for_removal(p, /*directory=*/false);
+  files_.push_back(std::move(file));
   return p;
+}
+
+void AtomicOutputFolder::check_destination(const Staged& file) const {
+  if (!target_existed_) return;  // a new folder: nothing in it is replaced
+  struct stat status {};
+  const std::filesystem::path destination = target_ / file.name;
+  if (::lstat(destination.c_str(), &status) != 0) return;
+  if (!S_ISREG(status.st_mode)) {
+    throw Error("Cannot write " + what_ + " into " + quoted(target_) + ": " + quoted(destination) +
+                " exists and is " +
+                (S_ISLNK(status.st_mode) ? std::string("a symbolic link") : type_text(status.st_mode)) +
+                ", which gyrocal does not replace; nothing was changed.");
+  }
+  if (file.may_replace) file.may_replace(destination);
 }
 
 void AtomicOutputFolder::commit() {
@@ -481,30 +636,21 @@ void AtomicOutputFolder::commit() {
     }
   } else {
     // Every file is checked before any is moved, and no signal interrupts the moves.
-    for (const auto& file : files_) {
-      struct stat status {};
-      const std::filesystem::path destination = target_ / file.first;
-      if (::lstat(destination.c_str(), &status) == 0 && !S_ISREG(status.st_mode)) {
-        throw Error("Cannot write " + what_ + " into " + name + ": " + quoted(destination) +
-                    " exists and is " +
-                    (S_ISLNK(status.st_mode) ? std::string("a symbolic link") : type_text(status.st_mode)) +
-                    ", which gyrocal does not replace; nothing was changed.");
-      }
-    }
+    for (const Staged& file : files_) check_destination(file);
     const SignalsBlocked blocked;
-    for (const auto& file : files_) {
-      const std::filesystem::path from = staging_ / file.first, destination = target_ / file.first;
+    for (const Staged& file : files_) {
+      const std::filesystem::path from = staging_ / file.name, destination = target_ / file.name;
       if (::rename(from.c_str(), destination.c_str()) != 0)
         throw Error("Cannot create " + quoted(destination) + ": " + errno_text(errno) + ".");
     }
     ::rmdir(staging_.c_str());
-    for (auto& file : files_) unregister(file.second);
+    for (Staged& file : files_) unregister(file.registration);
     unregister(registration_);
     committed_ = true;
     return;
   }
   committed_ = true;
-  for (auto& file : files_) unregister(file.second);
+  for (Staged& file : files_) unregister(file.registration);
   unregister(registration_);
 }
 

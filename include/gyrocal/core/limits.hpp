@@ -130,5 +130,8 @@ inline constexpr std::size_t kResultNames = 4096;
 inline constexpr long long kTrials = 1000000000;
 /// The most Monte Carlo trials with --samples (each simulates and reduces the whole test).
 inline constexpr long long kTrialsWithSamples = 100000;
+/// The most worker threads of --threads (montecarlo, sensitivity): above the cores of any machine gyrocal
+/// runs on; each thread reserves a stack, so a thread per trial (up to 1e9) would exhaust the process.
+inline constexpr int kThreads = 1024;
 
 }  // namespace gyrocal::limits
