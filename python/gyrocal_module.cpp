@@ -275,12 +275,20 @@ PYBIND11_MODULE(_gyrocal, m) {
                        "A scenario: everything a configuration file describes. Scenario() is the default "
                        "scenario; Scenario.load(path) reads a configuration (TOML).")
       .def(py::init(&default_scenario))
+      // Scenario.load and Scenario.parse are these, with their arguments checked
+      // (python/gyrocal/__init__.py).
       .def_static(
-          "load", [](const std::string& path) { return load_scenario(path); }, py::arg("path"),
+          "_load", [](const std::string& path) { return load_scenario(path); }, py::arg("path"),
           "Read the configuration file (TOML) at path, as --config does.")
       .def_static(
-          "parse",
-          [](const std::string& text, const std::string& name) { return parse_scenario(text, name); },
+          "_parse",
+          [](const std::string& text, const std::string& name) {
+            // The rule load_scenario applies to a file: not empty, not beyond the configuration's limit.
+            check_configuration_text(text, "Configuration " + name,
+                                     "for the default scenario call gyrocal.Scenario() (a configuration of "
+                                     "comments alone also gives it)");
+            return parse_scenario(text, name);
+          },
           py::arg("text"), py::arg("name") = "<string>",
           "Parse a configuration given as TOML text; name stands for the file in messages.")
       .def("to_toml", &scenario_to_toml,

@@ -1,7 +1,4 @@
 // gyrocal report RESULT.json --html FILE: the self-contained HTML report of a result (docs/report.md).
-#include <fstream>
-#include <sstream>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -10,18 +7,6 @@
 #include "gyrocal/report/html_report.hpp"
 
 namespace gyrocal::cli {
-namespace {
-
-nlohmann::json read_result(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(fmt::format("cannot open the result file {}.", path));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) throw Error(fmt::format("cannot read the result file {}.", path));
-  return parse_result_json(bytes.str(), path);
-}
-
-}  // namespace
 
 void register_report(CLI::App& app) {
   struct Options {
@@ -37,7 +22,7 @@ void register_report(CLI::App& app) {
   sub->callback([opt] {
     refuse_to_overwrite_input(opt->html, opt->result);
     check_output(opt->html, OutputKind::kReport, opt->force, "--html");
-    const nlohmann::json result = read_result(opt->result);
+    const nlohmann::json result = read_result_file(opt->result);
     const std::string kind = result_kind(result);
     if (kind == "inputs")
       throw Error(

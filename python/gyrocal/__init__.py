@@ -7,9 +7,13 @@
     res = gyrocal.calibrate(rec, sc, method="least-squares", compensation="full")
     nz = gyrocal.noise("static.csv", sc)               # noise's JSON as a dict
 
-Every error of gyrocal raises ValueError with the command line's sentence.
+Every error of gyrocal raises ValueError with the command line's sentence; an argument of a plainly wrong Python
+type raises ArgumentTypeError, a TypeError that is also a ValueError, naming the argument in one sentence.
 """
 
+import functools
+import inspect
+import numbers
 import operator
 import os
 
@@ -18,7 +22,7 @@ import numpy as np
 from ._gyrocal import Scenario
 from . import _gyrocal
 
-__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "RECORD_COLUMNS"]
+__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "RECORD_COLUMNS", "ArgumentTypeError"]
 
 #: The record's required columns, in order (docs/contract.md, "Record (CSV)").
 RECORD_COLUMNS = ("time_s", "main_angle_deg", "counter_angle_deg", "position_angle_deg", "gyro_deg_h")
@@ -27,16 +31,194 @@ RECORD_COLUMNS = ("time_s", "main_angle_deg", "counter_angle_deg", "position_ang
 _ARRAYS_NAME = "<arrays>"
 
 
-def _is_path(rec):
-    return isinstance(rec, (str, os.PathLike))
+# --- arguments ---------------------------------------------------------------------------------------------------
+# Every public function's arguments are checked here, by the decorator _arguments and one check per kind of
+# argument, before anything reaches the compiled part (docs/python.md, "Arguments"): a bad argument raises a
+# ValueError with one sentence naming it; a plainly wrong Python type raises ArgumentTypeError, which is both a
+# TypeError and a ValueError. pybind11 never sees a wrong type, so its listing of signatures never shows.
 
+
+class ArgumentTypeError(TypeError, ValueError):
+    """An argument of a plainly wrong Python type (None for a scenario, a number for a method), named in one
+    sentence. A TypeError, as Python raises for a wrong type, and a ValueError, as every refusal of gyrocal is."""
+
+
+def _type_name(value):
+    return "None" if value is None else type(value).__name__
+
+
+def _no_nul(text, argument):
+    """`text`, refused if it holds a NUL character: no file name or option holds one, and a sentence holding it
+    would be cut short at it."""
+    if "\x00" in text:
+        shown = text if len(text) <= 80 else text[:77] + "..."
+        raise ValueError(f"{argument} {shown!r} holds a NUL character ('\\x00'), which no name or path holds.")
+    return text
+
+
+def _is_path(value):
+    return isinstance(value, (str, bytes, os.PathLike))
+
+
+def _path(value, argument):
+    """A file's path as str: str, bytes (decoded as os.fsdecode does) or os.PathLike, as Python's open() takes."""
+    if not _is_path(value):
+        raise ArgumentTypeError(f"{argument} must be a file's path (str, bytes or os.PathLike), "
+                                f"not {_type_name(value)}.")
+    path = os.fspath(value)
+    if not isinstance(path, (str, bytes)):
+        raise ArgumentTypeError(f"{argument} must be a file's path, but its __fspath__ gave {_type_name(path)}.")
+    path = _no_nul(os.fsdecode(path), argument)
+    try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ValueError(f"{argument} {path!r} is not UTF-8 text; gyrocal takes paths in UTF-8.") from None
+    return path
+
+
+def _record(value, argument):
+    """A record: its path (see _path), or a mapping of its columns (anything indexable by a column's name)."""
+    if _is_path(value):
+        return _path(value, argument)
+    if not hasattr(value, "__getitem__"):
+        raise ArgumentTypeError(f"{argument} must be a record's path or a mapping of its columns (a dict of "
+                                f"arrays, a pandas DataFrame), not {_type_name(value)}.")
+    return value
+
+
+def _scenario(value, argument):
+    if not isinstance(value, Scenario):
+        raise ArgumentTypeError(f"{argument} must be a gyrocal.Scenario (gyrocal.Scenario.load(path), "
+                                f"gyrocal.Scenario.parse(text) or gyrocal.Scenario()), not {_type_name(value)}.")
+    return value
+
+
+def _optional(check):
+    """The check `check`, with None let through (an optional argument left out)."""
+    return lambda value, argument: None if value is None else check(value, argument)
+
+
+def _text(value, argument):
+    if not isinstance(value, str):
+        raise ArgumentTypeError(f"{argument} must be a str, not {_type_name(value)}.")
+    return value
+
+
+def _name(value, argument):
+    return _no_nul(_text(value, argument), argument)
+
+
+def _choice(default):
+    """A choice given as text ("least-squares"); None is `default` (for the scenario's own choice, "")."""
+    def check(value, argument):
+        if value is None:
+            return default
+        if not isinstance(value, str):
+            raise ArgumentTypeError(f"{argument} must be a string or None, not {_type_name(value)}.")
+        return _no_nul(value, argument)
+    return check
+
+
+def _estimate(value, argument):
+    """None (the scenario's [calibration] estimate), one name, or an iterable of names: a list of str."""
+    if value is None:
+        return None
+    if isinstance(value, str):
+        return [_no_nul(value, argument)]
+    if isinstance(value, bytes) or not hasattr(value, "__iter__"):
+        raise ArgumentTypeError(f"{argument} must be a machine error's name or a list of names, "
+                                f"not {_type_name(value)}.")
+    names = list(value)
+    for name in names:
+        if not isinstance(name, str):
+            raise ArgumentTypeError(f"{argument} must be a list of names (str), but it holds {_type_name(name)} "
+                                    f"{name!r}.")
+        _no_nul(name, argument)
+    return names
+
+
+#: The largest seed: the simulation's seed is an unsigned 64-bit integer, as --seed.
+_MAX_SEED = 2**64 - 1
+
+
+def _seed(value, argument):
+    """None (the scenario's [test] seed) or an integer from 0 to 2**64 - 1, Python's or NumPy's."""
+    if value is None:
+        return None
+    try:
+        seed = operator.index(value)
+    except TypeError:
+        raise ArgumentTypeError(f"{argument} must be an integer from 0 to {_MAX_SEED}, not {value!r}.") from None
+    if not 0 <= seed <= _MAX_SEED:
+        raise ValueError(f"{argument} must be an integer from 0 to {_MAX_SEED}, not {seed}.")
+    return seed
+
+
+def _is_real(value):
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def _real(value, argument):
+    """A real number (Python's or NumPy's, or a 0-d array of one) as a float."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        return float(value)
+    if not _is_real(value):
+        raise ArgumentTypeError(f"{argument} must be a number, not {_type_name(value)}.")
+    return float(value)
+
+
+#: What an array of a kind that does not hold numbers holds, by NumPy's kind character.
+_KIND_NAMES = {"U": "str", "S": "bytes", "b": "bool", "c": "complex", "M": "datetime64", "m": "timedelta64"}
+
+
+def _numbers(value, what):
+    """`value` (a number, a sequence or an array of numbers) as a contiguous float64 array. A value that is not a
+    number (None, a str, a bool) is refused by name: NumPy would make None a NaN and "1.5" a number."""
+    if value is None:
+        raise ArgumentTypeError(f"{what} must be a number or an array of numbers, not None.")
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as e:
+        raise ArgumentTypeError(f"{what} is not an array of numbers ({e}).") from None
+    kind = array.dtype.kind
+    if kind == "O":
+        for item in array.flat:
+            if not _is_real(item):
+                raise ArgumentTypeError(f"{what} must hold numbers, not {_type_name(item)}.")
+    elif kind not in "iuf":
+        raise ArgumentTypeError(f"{what} must hold numbers, not {_KIND_NAMES.get(kind, array.dtype.name)}.")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
+def _arguments(**checks):
+    """Checks the named arguments of the decorated function, each with its check(value, name), which returns the
+    value to use or raises; a call that does not bind (an unknown or missing argument) raises
+    ArgumentTypeError in one sentence."""
+    def decorate(function):
+        signature = inspect.signature(function)
+
+        @functools.wraps(function)
+        def checked(*args, **kwargs):
+            try:
+                bound = signature.bind(*args, **kwargs)
+            except TypeError as e:
+                raise ArgumentTypeError(f"{function.__name__}(): {e}.") from None
+            bound.apply_defaults()
+            for name, check in checks.items():
+                bound.arguments[name] = check(bound.arguments[name], name)
+            return function(*bound.args, **bound.kwargs)
+        return checked
+    return decorate
+
+
+# --- records ----------------------------------------------------------------------------------------------------
 
 def _column(rec, name):
     try:
         values = rec[name]
-    except (KeyError, IndexError, TypeError):
+    except (KeyError, IndexError, TypeError, ValueError):
         raise ValueError(f"{_ARRAYS_NAME}: the record has no column {name}.") from None
-    return np.ascontiguousarray(values, dtype=np.float64)
+    return _numbers(values, f"{_ARRAYS_NAME}: column {name}")
 
 
 #: gyrocal's own output columns: a gyro's (deg/h) and an accelerometer's (g).
@@ -47,7 +229,7 @@ _ACCEL_COLUMN = "accel_g"
 def _has_column(rec, name):
     try:
         rec[name]
-    except (KeyError, IndexError, TypeError):
+    except (KeyError, IndexError, TypeError, ValueError):
         return False
     return True
 
@@ -62,37 +244,29 @@ def _output_column(rec, scenario):
     return column
 
 
+@_arguments(scenario=_scenario, beta_deg=_real)
 def exact_inputs(scenario, time_s, beta_deg):
     """Exact inputs to the gyro at the instants time_s (s) of a dwell at the scenario's rate and beta_deg,
     as `gyrocal inputs --time-s T --beta-deg B`: (omega, specific_force), each an (n, 3) float64 array of
     the I, O, S components, rad/s and g. time_s is a number or a one-dimensional array; an array of more
     dimensions, or a value that is not finite (as beta_deg), raises ValueError as the command line refuses
     it."""
-    t = np.ascontiguousarray(time_s, dtype=np.float64)
+    t = _numbers(time_s, "time_s")
     if t.ndim == 0:
         t = t.reshape(1)
-    return _gyrocal._exact_inputs(scenario, t, float(beta_deg))
+    return _gyrocal._exact_inputs(scenario, t, beta_deg)
 
 
-#: The largest seed: the simulation's seed is an unsigned 64-bit integer, as --seed.
-_MAX_SEED = 2**64 - 1
-
-
+@_arguments(scenario=_scenario, seed=_seed)
 def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
     record's columns (RECORD_COLUMNS; an accelerometer's output is keyed accel_g, in g, as its record's header). seed=None takes the scenario's [test] seed, as without --seed; any other
     seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
-    if seed is not None:
-        try:
-            value = operator.index(seed)
-        except TypeError:
-            raise ValueError(f"seed must be an integer from 0 to {_MAX_SEED}, not {seed!r}.") from None
-        if not 0 <= value <= _MAX_SEED:
-            raise ValueError(f"seed must be an integer from 0 to {_MAX_SEED}, not {value}.")
-        seed = value
     return _gyrocal._simulate(scenario, seed)
 
 
+@_arguments(rec=_record, scenario=_scenario, method=_choice("least-squares"), compensation=_choice("full"),
+            estimate=_estimate, reduction=_choice(""), gyro_model=_choice(""))
 def calibrate(rec, scenario, method="least-squares", compensation="full", estimate=None, reduction=None,
               gyro_model=None):
     """`gyrocal calibrate --json` as a dict. rec is a record's path (read through the scenario's [record]
@@ -107,21 +281,17 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     always. The options are built by the command line's own function, so the result is its result. The
     coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors); an
     accelerometer's scenario ([sensor] kind) gives its eleven in its table's order (K0 K1 K2 K3 Kip Kio Kpo
-    Kpp Koo delta_p delta_o), from a record whose output column is accel_g."""
-    if isinstance(estimate, str):
-        estimate = [estimate]
-    if estimate is not None:
-        estimate = [str(name) for name in estimate]
-    reduction = "" if reduction is None else str(reduction)
-    gyro_model = "" if gyro_model is None else str(gyro_model)
+    Kpp Koo delta_p delta_o), from a record whose output column is accel_g. method and compensation left None
+    take their defaults, as the command line without --method and --compensation."""
     options = (method, compensation, reduction, estimate, gyro_model)
-    if _is_path(rec):
-        return _gyrocal._calibrate_path(os.fspath(rec), scenario, *options)
+    if isinstance(rec, str):
+        return _gyrocal._calibrate_path(rec, scenario, *options)
     names = RECORD_COLUMNS[:4] + (_output_column(rec, scenario),)
     columns = [_column(rec, name) for name in names]
     return _gyrocal._calibrate_arrays(*columns, scenario, *options, _ARRAYS_NAME)
 
 
+@_arguments(rec=_record, scenario=_optional(_scenario))
 def noise(rec, scenario=None):
     """`gyrocal noise --json` as a dict: the overlapping Allan deviation of the record's output and the fitted
     IEEE 952 terms. rec is a record's path or a mapping of arrays holding time_s and the output: gyro_deg_h
@@ -129,11 +299,30 @@ def noise(rec, scenario=None):
     A record's path is read through the scenario's [record] layout when it has one (as `gyrocal noise
     --config`), and the scenario's [sensor] kind says whose output it must hold; without a scenario the
     record's output column says. The noise itself does not depend on the scenario."""
-    if _is_path(rec):
-        return _gyrocal._noise_path(os.fspath(rec), scenario)
+    if isinstance(rec, str):
+        return _gyrocal._noise_path(rec, scenario)
     if scenario is not None:
         column = _output_column(rec, scenario)
     else:
         column = _ACCEL_COLUMN if _has_column(rec, _ACCEL_COLUMN) and not _has_column(rec, _GYRO_COLUMN) \
             else _GYRO_COLUMN
     return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, column), column, _ARRAYS_NAME)
+
+
+# --- Scenario.load and Scenario.parse: the compiled class's, with their arguments checked as above -------------
+
+@_arguments(path=_path)
+def _load(path):
+    """Read the configuration file (TOML) at path (str, bytes or os.PathLike), as --config does."""
+    return Scenario._load(path)
+
+
+@_arguments(text=_text, name=_name)
+def _parse(text, name="<string>"):
+    """Parse a configuration given as TOML text; name stands for the file in messages. Text that is empty or
+    white space only, or larger than 16 MiB, is refused as a configuration file is."""
+    return Scenario._parse(text, name)
+
+
+Scenario.load = staticmethod(_load)
+Scenario.parse = staticmethod(_parse)

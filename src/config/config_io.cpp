@@ -1,9 +1,5 @@
 #include "gyrocal/config/config_io.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
 #include <charconv>
@@ -20,6 +16,7 @@
 
 #include <toml++/toml.h>
 
+#include "gyrocal/core/bounded_read.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
@@ -1241,52 +1238,35 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   return s;
 }
 
-Scenario load_scenario(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  const auto fail = [&name](const std::string& why) {
-    throw Error("Cannot read configuration file " + name + ": " + why + ".");
-  };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    const int error = errno;
-    if (error == ENOENT) fail("it does not exist");
-    fail(std::error_code(error, std::generic_category()).message());
-  }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat status {};
-  if (::fstat(fd, &status) == 0 && S_ISDIR(status.st_mode)) fail("it is a directory");
-  // Whatever the file is (a regular file, a FIFO, /dev/zero), at most kMaxConfigurationBytes + 1 bytes are
-  // read: a configuration is a few kB.
-  std::string text;
-  constexpr std::size_t kChunk = 64 << 10;
-  while (text.size() <= kMaxConfigurationBytes) {
-    const std::size_t old_size = text.size();
-    text.resize(old_size + kChunk);
-    const ssize_t count = ::read(fd, text.data() + old_size, kChunk);
-    if (count < 0 && errno == EINTR) {
-      text.resize(old_size);
-      continue;
-    }
-    if (count < 0) fail(std::error_code(errno, std::generic_category()).message());
-    text.resize(old_size + static_cast<std::size_t>(count));
-    if (count == 0) break;
-  }
+void check_configuration_text(std::string_view text, const std::string& described, std::string_view advice) {
   if (text.size() > kMaxConfigurationBytes) {
-    fail("it is larger than " + std::to_string(kMaxConfigurationBytes >> 20) +
-         " MiB, the limit for a configuration (a gyrocal configuration is a few kB): it is not a "
-         "configuration file");
+    throw Error(described + " is larger than " + std::to_string(kMaxConfigurationBytes >> 20) +
+                " MiB, the limit for a configuration (a gyrocal configuration is a few kB): it is not a "
+                "configuration.");
   }
   // An empty file is more likely a failed write than a choice of every default (docs/interface.md).
-  if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
-    throw Error("Configuration file " + name + " is empty" +
-                (text.empty() ? std::string() : std::string(" (white space only)")) +
-                "; to use the built-in scenario leave out --config, or write a configuration with "
-                "`gyrocal init FILE`.");
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
+    throw Error(described + " is empty" +
+                (text.empty() ? std::string() : std::string(" (white space only)")) + "; " +
+                std::string(advice) + ".");
   }
-  return parse_scenario(text, name);
+}
+
+Scenario load_scenario(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  // Whatever the file is (a regular file, a FIFO, /dev/zero), at most kMaxConfigurationBytes + 1 bytes are
+  // read: a configuration is a few kB.
+  const BoundedRead read = read_bounded(path, kMaxConfigurationBytes, "configuration file");
+  if (read.too_large) {
+    throw Error("Cannot read configuration file " + name + ": it is larger than " +
+                std::to_string(kMaxConfigurationBytes >> 20) +
+                " MiB, the limit for a configuration (a gyrocal configuration is a few kB): it is not a "
+                "configuration file.");
+  }
+  check_configuration_text(read.text, "Configuration file " + name,
+                           "to use the built-in scenario leave out --config, or write a configuration with "
+                           "`gyrocal init FILE`");
+  return parse_scenario(read.text, name);
 }
 
 std::string scenario_to_toml(const Scenario& s) {

@@ -35,6 +35,14 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
 /// The largest configuration file load_scenario reads: 16 MiB (core/limits.hpp).
 inline constexpr std::size_t kMaxConfigurationBytes = limits::kConfigurationBytes;
 
+/// Refuses configuration text that no configuration holds, by the rule load_scenario applies to a file
+/// (Python's Scenario.parse applies it to its text): larger than kMaxConfigurationBytes, or empty or white
+/// space only (more likely a failed write than a choice of every default; comments alone are a choice).
+/// Throws Error "<described> is empty; <advice>." or "<described> is larger than 16 MiB, ...", where
+/// `described` names the text ("Configuration file rig.toml") and `advice` says how to get the built-in
+/// scenario instead.
+void check_configuration_text(std::string_view text, const std::string& described, std::string_view advice);
+
 /// Read and parse the configuration file at path (any readable file: a regular file, a FIFO, /dev/stdin).
 /// Throws Error naming the file if it cannot be read, is a directory, is larger than
 /// kMaxConfigurationBytes (only that much plus one byte is read: /dev/zero ends quickly), or is empty or

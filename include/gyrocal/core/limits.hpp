@@ -121,8 +121,14 @@ inline constexpr double kCalibrationRateWindows = 300000;
 /// The largest result file `report` reads, bytes. A calibration result is ~100 kB; a Monte Carlo result
 /// with its trials' draws a few MB.
 inline constexpr std::size_t kResultBytes = std::size_t{64} << 20;
-/// The most coefficient or parameter names in one result (a sensor has 11; an IMU 6 x 13).
+/// The most distinct names in one result: the keys of its JSON objects, counted once each however often they
+/// occur (a sensor has 11 coefficients, an IMU 6 x 13; with the fields, the machine errors --estimate names
+/// and the Monte Carlo sources, a result has a few hundred). The report's tables are indexed by these names.
 inline constexpr std::size_t kResultNames = 4096;
+/// The deepest nesting of arrays and objects in a result (the root object counts as one level): a gyrocal
+/// result nests five or six. The report prints some values with the JSON library's dump, which recurses once
+/// per level, so deeper input is refused while it is parsed, before it can overflow the stack.
+inline constexpr int kResultDepth = 64;
 
 // ---- Runs ----
 

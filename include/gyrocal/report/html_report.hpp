@@ -2,6 +2,7 @@
 // The self-contained HTML report of a result (docs/report.md): tables and plots of every section of a
 // result file that is present, in one HTML file that opens with no network. The plots are drawn by
 // Chart.js (Debian's libjs-chart.js), whose bundle is compiled into gyrocal and inlined into the page.
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,9 +25,19 @@ struct HtmlReportOptions {
 };
 
 /// Parses the text of a result file as `gyrocal report` reads it: valid JSON that holds an object.
-/// Throws gyrocal::Error naming `source_name` (and the line and column of a syntax error) otherwise, for a
-/// number beyond the range of a double, and for arrays and objects nested more than 64 levels deep.
+/// Throws gyrocal::Error naming `source_name` otherwise: first, when the first character after white space
+/// (and a byte order mark) is not the '{' of an object (naming the character, its line and column); when
+/// the text is larger than limits::kResultBytes; on a syntax error (with its line and column); for a number
+/// beyond the range of a double; for arrays and objects nested more than limits::kResultDepth levels deep;
+/// and for more than limits::kResultNames distinct object keys (core/limits.hpp).
 nlohmann::json parse_result_json(std::string_view text, const std::string& source_name);
+
+/// Reads and parses the result file at `path` (any readable file: a regular file, a FIFO, /dev/stdin) as
+/// parse_result_json does, naming the file by `path`. At most limits::kResultBytes + 1 bytes are read, and
+/// reading stops at the first character if it cannot open a JSON object, so that a record, a huge file or
+/// /dev/zero is refused at once and in bounded memory. Throws gyrocal::Error as parse_result_json does, and
+/// "Cannot read result file PATH: ..." if the file does not exist, is a directory or cannot be read.
+nlohmann::json read_result_file(const std::filesystem::path& path);
 
 /// The key of gyrocal's own marker in every result JSON that gyrocal writes (docs/interface.md, "Files"):
 /// `"gyrocal": {"result": KIND, "version": "X.Y.Z"}`. It tells `report` which page to draw and lets `--json`
