@@ -236,21 +236,25 @@ TEST(Config, RandomValuesRoundTripBitForBit) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_int_distribution<int> exponent(-12, 6);
   const auto random_value = [&] { return unit(rng) * std::pow(10.0, exponent(rng)); };
+  // Below 10^top: a key with a physical range (core/limits.hpp: 1 m, 2e5 arcsec, 100 m/s^2).
+  const auto bounded_value = [&](int top) {
+    return unit(rng) * std::pow(10.0, std::min(exponent(rng), top));
+  };
   for (int trial = 0; trial < 300; ++trial) {
     Scenario s = default_scenario();
     s.site.latitude_rad = 90.0 * unit(rng) * kDegToRad;
-    s.site.gravity_m_s2 = std::abs(random_value()) + 1e-3;
+    s.site.gravity_m_s2 = std::abs(bounded_value(1)) + 1e-3;
     s.centrifuge.rate_rad_s = random_value();
     s.test.rates_rad_s = {s.centrifuge.rate_rad_s};  // one rate, one place (written once, in [test])
     s.test.static_hold_s = std::abs(random_value());
     s.centrifuge.heading_rad = random_value() * kDegToRad;
-    s.errors.counter_perpendicularity_x_rad = random_value() * kArcsecToRad;
-    s.errors.lever_arm_m = Eigen::Vector3d(random_value(), random_value(), random_value());
+    s.errors.counter_perpendicularity_x_rad = bounded_value(5) * kArcsecToRad;
+    s.errors.lever_arm_m = Eigen::Vector3d(bounded_value(0), bounded_value(0), bounded_value(0));
     s.errors.counter_wobble_x_rad.terms = {
-        {3, std::abs(random_value()) * kArcsecToRad, random_value() * kDegToRad}};
+        {3, std::abs(bounded_value(5)) * kArcsecToRad, random_value() * kDegToRad}};
     s.gyro.values[0] = random_value();
     s.test.gamma_rad = {random_value() * kDegToRad};
-    s.uncertainty.position_angle_error_rad = std::abs(random_value()) * kArcsecToRad;
+    s.uncertainty.position_angle_error_rad = std::abs(bounded_value(5)) * kArcsecToRad;
     expect_same(round_trip(s), s);
     if (HasFailure()) break;
   }
@@ -411,18 +415,20 @@ TEST(ConfigErrors, NonFiniteValues) {
 }
 
 TEST(ConfigErrors, OutOfRange) {
-  expect_refused("[centrifuge]\nradius_m = -1.0\n", 2, "centrifuge.radius_m", "must be > 0, not -1");
+  expect_refused("[centrifuge]\nradius_m = -1.0\n", 2, "centrifuge.radius_m", "must be > 0 and <= 1000");
   expect_refused("[centrifuge]\nradius_m = 0\n", 2, "centrifuge.radius_m", "must be > 0");
   expect_refused("[site]\nlatitude_deg = 91\n", 2, "site.latitude_deg", "between -90 and 90");
   expect_refused("[site]\ngravity_m_s2 = 0.0\n", 2, "site.gravity_m_s2", "> 0");
-  expect_refused("[site]\nearth_rate_rad_s = -1e-5\n", 2, "site.earth_rate_rad_s", ">= 0");
-  expect_refused("[gyro.noise]\nquantization_deg_h = -0.1\n", 2, "gyro.noise.quantization_deg_h", ">= 0");
+  expect_refused("[site]\nearth_rate_rad_s = -1e-5\n", 2, "site.earth_rate_rad_s", "between 0 and 1");
+  expect_refused("[gyro.noise]\nquantization_deg_h = -0.1\n", 2, "gyro.noise.quantization_deg_h",
+                 "between 0 and 1e+07");
   expect_refused("[test]\nsample_rate_hz = 0\n", 2, "test.sample_rate_hz", "> 0");
   expect_refused("[test]\nrevolutions = 0\n", 2, "test.revolutions", "integer >= 1");
   expect_refused("[test]\nsettle_s = -2.0\n", 2, "test.settle_s", ">= 0");
   expect_refused("[test]\nseed = -1\n", 2, "test.seed", "integer >= 0");
   expect_refused("[test]\ngamma_deg = []\n", 2, "test.gamma_deg", "must not be empty");
-  expect_refused("[uncertainty]\nbase_tilt_x_arcsec = -0.5\n", 2, "uncertainty.base_tilt_x_arcsec", ">= 0");
+  expect_refused("[uncertainty]\nbase_tilt_x_arcsec = -0.5\n", 2, "uncertainty.base_tilt_x_arcsec",
+                 "between 0 and 2e+05");
 }
 
 TEST(ConfigErrors, BadHarmonics) {
@@ -433,7 +439,7 @@ TEST(ConfigErrors, BadHarmonics) {
   expect_refused(head + "  { harmonic = 1.5 },\n]\n", 4, "centrifuge.errors.main_wobble_y[1].harmonic",
                  "must be an integer");
   expect_refused(head + "  { amplitude_arcsec = -1.0 },\n]\n", 4,
-                 "centrifuge.errors.main_wobble_y[1].amplitude_arcsec", ">= 0");
+                 "centrifuge.errors.main_wobble_y[1].amplitude_arcsec", "between 0 and 2e+05");
 }
 
 TEST(ConfigErrors, WrongArrayLength) {

@@ -333,7 +333,8 @@ TEST(ConfigurationBounds, PlanNamesTheCauseOfAnOutputThatOverflowsItsWeighting) 
 // ------------------------------------------------------------------
 
 TEST(TinyOutputs, AVaryingOutputIsNotCalledConstant) {
-  // A record's outputs scaled by 1e-300 vary, if tinily: not "the constant ... with no scatter at all".
+  // A record's outputs scaled by 1e-300 vary, if tinily: not "the constant ... with no scatter at all", nor a
+  // calibration of nonsense (exit 0) once they are no longer called constant.
   const Scenario s = small_test();
   std::vector<RecordSample> rows = record_of(s);
   for (RecordSample& x : rows) x.output *= 1e-300;
@@ -344,6 +345,9 @@ TEST(TinyOutputs, AVaryingOutputIsNotCalledConstant) {
   });
   EXPECT_FALSE(contains(m, "the constant")) << m;
   EXPECT_FALSE(contains(m, "no scatter at all")) << m;
+  // It is refused naming the cause: a scatter that underflows, and the scale.
+  EXPECT_TRUE(contains(m, "underflows")) << m;
+  EXPECT_TRUE(contains(m, "output_scale_per_deg_h")) << m;
 }
 
 }  // namespace

@@ -208,17 +208,34 @@ std::vector<MisfitCause> gyro_misfit_causes(const OutputConfiguration& output) {
 void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output) {
   if (reduction.positions.size() < 2) return;
   const double v0 = reduction.positions.front().mean_deg_h;
-  for (const ReducedPosition& p : reduction.positions)
+  bool constant = true;
+  double largest = 0.0;
+  for (const ReducedPosition& p : reduction.positions) {
+    if (!without_noise(p.std_err_deg_h)) return;
     // Constant relative to the values' own magnitude: outputs of 1e-299 deg/h that differ by a third between
     // positions vary (a scale wrong by 1e300), and were called constant against an absolute 1e-9.
-    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean_deg_h))) ||
-        !without_noise(p.std_err_deg_h))
-      return;
-  throw Error(fmt::format(
-      "the gyro output is the constant {} deg/h at every one of the {} positions, with no scatter at all: a "
-      "dead or disconnected sensor (or a [record] output_column that names a column that does not change; "
-      "{} = {}); nothing can be calibrated from it.",
-      number(v0), reduction.positions.size(), output.scale_key, number(output.scale)));
+    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean_deg_h))))
+      constant = false;
+    largest = std::max(largest, std::abs(p.mean_deg_h));
+  }
+  if (constant)
+    throw Error(fmt::format(
+        "the gyro output is the constant {} deg/h at every one of the {} positions, with no scatter at all: "
+        "a "
+        "dead or disconnected sensor (or a [record] output_column that names a column that does not change; "
+        "{} = {}); nothing can be calibrated from it.",
+        number(v0), reduction.positions.size(), output.scale_key, number(output.scale)));
+  // Outputs that vary, without scatter, all below 1e-150 deg/h: their squares (below 1e-300) leave a double's
+  // range at its small end, so the scatter between revolutions reads 0; no gyro's output is that small.
+  constexpr double kSquaresUnderflow = 1e-150;
+  if (largest < kSquaresUnderflow)
+    throw Error(
+        fmt::format("the gyro output varies between the {} positions but never exceeds {} deg/h in "
+                    "magnitude: its scatter "
+                    "between revolutions underflows a double (its squares fall below 1e-300), and no gyro's "
+                    "output is that "
+                    "small; is the output's scale right ({} = {})?",
+                    reduction.positions.size(), number(largest), output.scale_key, number(output.scale)));
 }
 
 void OutputRange::push(double value) {
