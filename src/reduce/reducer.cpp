@@ -182,8 +182,8 @@ class WarningLog {
       } else if (index == 0) {
         std::string places;
         for (std::size_t i = 1; i < k.places.size(); ++i) places += (i > 1 ? "; " : "") + k.places[i];
-        out.push_back(fmt::format("{} The same warning {} more times ({} in all): {}{}.", k.messages[0],
-                                  k.count - 1, k.count, places, k.count > k.places.size() ? "; …" : ""));
+        out.push_back(fmt::format("{} The same warning {} more times ({} in all): {}{}", k.messages[0],
+                                  k.count - 1, k.count, places, k.count > k.places.size() ? "; …" : "."));
       }
     }
     return out;
