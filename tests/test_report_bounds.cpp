@@ -1,7 +1,8 @@
-// `gyrocal report`'s input is bounded (issue 29, D2 and D18; docs/report.md, "The result file"): at most
+// `gyrocal report`'s input is bounded (issue 29, D2 and D18; docs/report.md): at most
 // limits::kResultBytes + 1 bytes are read from any file (a regular file, a pipe, /dev/zero), reading stops at
 // the first character when it cannot open a JSON object (a record, binary bytes), and a result holds at most
-// limits::kResultNames distinct names, which the report handles in time linear in their number (n log n).
+// limits::kResultNames distinct names; reading is linear in the file's size (it was quadratic in the members
+// of an object).
 // Every refusal names the file and the limit, exits 1 and leaves no report behind.
 #include <gtest/gtest.h>
 

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <system_error>
 
@@ -33,6 +34,10 @@ BoundedRead read_bounded(const std::filesystem::path& path, std::size_t max_byte
   constexpr std::size_t kChunk = 64 << 10;
   while (out.text.size() <= max_bytes) {
     const std::size_t old_size = out.text.size();
+    // Grown by doubling, but never beyond the limit and one read: a file at the limit is held once, not in a
+    // buffer of twice its size.
+    if (out.text.capacity() < old_size + kChunk)
+      out.text.reserve(std::min(std::max(2 * out.text.capacity(), old_size + kChunk), max_bytes + kChunk));
     out.text.resize(old_size + kChunk);
     const ssize_t count = ::read(fd, out.text.data() + old_size, kChunk);
     if (count < 0) {
