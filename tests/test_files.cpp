@@ -400,10 +400,14 @@ TEST_F(Files, AnInterruptedDemoLeavesNoFolderAndAnExistingOneAsItWas) {
   EXPECT_EQ(o.signal, SIGTERM) << o.err;
   EXPECT_TRUE(others({}).empty()) << others({}).front();
 
-  // An existing folder with an earlier demo and a file of the user: all exactly as before.
+  // An existing folder with an earlier demo (files gyrocal wrote, which demo replaces without --force) and a
+  // file of the user: all exactly as before.
   fs::create_directories(path("old"));
-  write("old/record.csv", "earlier record\n");
-  write("old/result.json", "{}\n");
+  const std::string earlier_record =
+      "# gyrocal-record 1\n# generator = gyrocal simulate\ntime_s,gyro_deg_h\n";
+  const std::string earlier_result = "{\"gyrocal\": {\"result\": \"calibration\", \"version\": \"0.1.0\"}}\n";
+  write("old/record.csv", earlier_record);
+  write("old/result.json", earlier_result);
   write("old/notes.txt", "mine\n");
   const pid_t again = spawn({"demo", "--out", "old"});
   ASSERT_TRUE(wait_until(again, [&] { return has_entry(path("old"), ".gyrocal.tmp"); }));
@@ -411,8 +415,8 @@ TEST_F(Files, AnInterruptedDemoLeavesNoFolderAndAnExistingOneAsItWas) {
   const Outcome o2 = finish(again);
   EXPECT_EQ(o2.signal, SIGINT) << o2.err;
   EXPECT_TRUE(others({"record.csv", "result.json", "notes.txt"}, path("old")).empty());
-  EXPECT_EQ(slurp(path("old/record.csv")), "earlier record\n");
-  EXPECT_EQ(slurp(path("old/result.json")), "{}\n");
+  EXPECT_EQ(slurp(path("old/record.csv")), earlier_record);
+  EXPECT_EQ(slurp(path("old/result.json")), earlier_result);
   EXPECT_EQ(slurp(path("old/notes.txt")), "mine\n");
   EXPECT_TRUE(others({"old"}).empty());
 }

@@ -69,9 +69,9 @@ const CLI::Validator kSeed(
     },
     "INTEGER 0..2^64-1", "SEED");
 
-CLI::Validator integer_between(long long least, long long most) {
+CLI::Validator integer_between(long long least, long long most, bool check_range) {
   return CLI::Validator(
-      [least, most](std::string& text) -> std::string {
+      [least, most, check_range](std::string& text) -> std::string {
         const std::string refusal =
             fmt::format("must be an integer from {} to {}, not {}", least, most, as_given(text));
         long long value = 0;
@@ -89,7 +89,7 @@ CLI::Validator integer_between(long long least, long long most) {
             return refusal;
           value = static_cast<long long>(number);
         }
-        if (value < least || value > most) return refusal;
+        if (check_range && (value < least || value > most)) return refusal;
         text = std::to_string(value);
         return {};
       },

@@ -128,7 +128,9 @@ extern const CLI::Validator kSeed;
 /// anything else, an empty value included, is refused as given with the range ("--trials: must be an
 /// integer from 2 to 1000000000, not ''"), never read as 0 or as a saturated value. Add it with transform()
 /// (it rewrites the value in plain decimal).
-CLI::Validator integer_between(long long least, long long most);
+/// With `check_range` false, only what is not an integer (or lies beyond a long long) is refused here, with
+/// the same message; the command refuses the rest of the range itself, with its reason (montecarlo --trials).
+CLI::Validator integer_between(long long least, long long most, bool check_range = true);
 
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);

@@ -80,7 +80,8 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--trials", opt->trials,
                   "Number of trials: 2 to 1000000000 (1e9), or to 100000 (1e5) with --samples")
       ->required()
-      ->transform(integer_between(2, kMaxFastTrials));
+      ->transform(
+          integer_between(2, kMaxFastTrials, /*check_range=*/false));  // the range below, with reasons
   CLI::Option* seed = sub->add_option("--seed", opt->seed,
                                       "Random seed of the trials' draws, 0 to 2^64-1; default: [test] seed "
                                       "(not --compensation seed, the seed paper's correction)")
