@@ -21,7 +21,7 @@
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/model/machine_errors.hpp"
-#include "key_parts.hpp"
+#include "toml_prescan.hpp"
 
 namespace gyrocal {
 namespace {
@@ -1059,76 +1059,6 @@ void write_accelerometer(TomlWriter& w, const Scenario& s) {
     w.key(k.key, toml_number(s.accelerometer.noise.*k.member), k.meaning);
 }
 
-/// Refuses a character beyond ASCII anywhere but in a comment (and a UTF-8 byte order mark at the start).
-/// The keys and values of a configuration are ASCII, so this refuses nothing that could be read, and it keeps
-/// such characters away from toml++ 3.3.0 (Debian 12), whose whitespace test reaches __builtin_unreachable
-/// for many of them (U+00A1 to U+049A among others; upstream marzer/tomlplusplus issue 295, found by
-/// fuzzing, docs/fuzzing.md). Strings are followed as TOML writes them (basic, literal, multi-line), so that
-/// a '#' inside a string never counts as a comment; a string holding such a character is refused too (the
-/// only strings, [record]'s, are ASCII: docs/records.md). Where this scan and TOML could disagree (a closing
-/// delimiter with extra quotes), the scan sees a string where TOML sees none, which refuses more, never less.
-void refuse_non_ascii(std::string_view text, const std::string& file) {
-  constexpr std::string_view kBom = "\xEF\xBB\xBF", kTripleQuote = R"(""")", kTripleApostrophe = "'''";
-  if (text.starts_with(kBom)) text.remove_prefix(kBom.size());
-  const auto beyond_ascii = [](char c) { return static_cast<unsigned char>(c) >= 0x80; };
-  enum class State { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
-  State state = State::kCode;
-  std::size_t line = 1, line_start = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    const std::string_view rest = text.substr(i);
-    if (beyond_ascii(c) && state != State::kComment) {
-      throw Error(file + ", line " + std::to_string(line) + ", column " + std::to_string(i - line_start + 1) +
-                  ": a character beyond ASCII outside a comment; the keys and values of a configuration are "
-                  "ASCII.");
-    }
-    if (c == '\n') {
-      ++line;
-      line_start = i + 1;
-      if (state != State::kMultiBasic && state != State::kMultiLiteral) state = State::kCode;
-      continue;
-    }
-    switch (state) {
-      case State::kCode:
-        if (c == '#') {
-          state = State::kComment;
-        } else if (rest.starts_with(kTripleQuote) || rest.starts_with(kTripleApostrophe)) {
-          state = c == '"' ? State::kMultiBasic : State::kMultiLiteral;
-          i += 2;
-        } else if (c == '"') {
-          state = State::kBasic;
-        } else if (c == '\'') {
-          state = State::kLiteral;
-        }
-        break;
-      case State::kBasic:
-      case State::kMultiBasic:
-        if (c == '\\') {
-          // Skip the escaped character, unless it is a line end (counted above) or beyond ASCII (refused
-          // next).
-          if (i + 1 < text.size() && text[i + 1] != '\n' && !beyond_ascii(text[i + 1])) ++i;
-        } else if (state == State::kBasic && c == '"') {
-          state = State::kCode;
-        } else if (state == State::kMultiBasic && rest.starts_with(kTripleQuote)) {
-          state = State::kCode;
-          i += 2;
-        }
-        break;
-      case State::kLiteral:
-        if (c == '\'') state = State::kCode;
-        break;
-      case State::kMultiLiteral:
-        if (rest.starts_with(kTripleApostrophe)) {
-          state = State::kCode;
-          i += 2;
-        }
-        break;
-      case State::kComment:
-        break;
-    }
-  }
-}
-
 }  // namespace
 
 std::string toml_float(double v) {
@@ -1137,8 +1067,7 @@ std::string toml_float(double v) {
 
 Scenario parse_scenario(std::string_view toml_text, const std::string& source_name) {
   const Reader reader(source_name);
-  refuse_non_ascii(toml_text, source_name);
-  refuse_long_dotted_keys(toml_text, source_name);  // before toml++, which nests a table per part
+  prescan_configuration(toml_text, source_name);  // before toml++ (see toml_prescan.hpp)
   toml::table root;
   try {
     root = toml::parse(toml_text, source_name);

@@ -1,4 +1,4 @@
-#include "key_parts.hpp"
+#include "toml_prescan.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -16,11 +16,13 @@ bool is_bare(char c) {
 
 }  // namespace
 
-void refuse_long_dotted_keys(std::string_view text, const std::string& file) {
-  constexpr std::string_view kTripleQuote = R"(""")", kTripleApostrophe = "'''";
+void prescan_configuration(std::string_view text, const std::string& file) {
+  constexpr std::string_view kBom = "\xEF\xBB\xBF", kTripleQuote = R"(""")", kTripleApostrophe = "'''";
+  if (text.starts_with(kBom)) text.remove_prefix(kBom.size());
+  const auto beyond_ascii = [](char c) { return static_cast<unsigned char>(c) >= 0x80; };
   enum class State { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
   State state = State::kCode;
-  std::size_t line = 1;
+  std::size_t line = 1, line_start = 0;
   // The run of key parts being read (a key, a header's name, or a value such as 1.5): its dots, the line it
   // began on (a key does not span lines).
   bool in_run = false;
@@ -68,8 +70,14 @@ void refuse_long_dotted_keys(std::string_view text, const std::string& file) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     const std::string_view rest = text.substr(i);
+    if (beyond_ascii(c) && state != State::kComment) {
+      throw Error(file + ", line " + std::to_string(line) + ", column " + std::to_string(i - line_start + 1) +
+                  ": a character beyond ASCII outside a comment; the keys and values of a configuration are "
+                  "ASCII.");
+    }
     if (c == '\n') {
       ++line;
+      line_start = i + 1;
       if (state != State::kMultiBasic && state != State::kMultiLiteral) {
         state = State::kCode;
         end_run();
@@ -130,7 +138,9 @@ void refuse_long_dotted_keys(std::string_view text, const std::string& file) {
       case State::kBasic:
       case State::kMultiBasic:
         if (c == '\\') {
-          if (i + 1 < text.size() && text[i + 1] != '\n') ++i;  // the escaped character (a line end counts)
+          // Skip the escaped character, unless it is a line end (counted above) or beyond ASCII (refused
+          // next).
+          if (i + 1 < text.size() && text[i + 1] != '\n' && !beyond_ascii(text[i + 1])) ++i;
         } else if (state == State::kBasic && c == '"') {
           state = State::kCode;
         } else if (state == State::kMultiBasic && rest.starts_with(kTripleQuote)) {
