@@ -4,6 +4,9 @@
 // limits::kResultNames distinct names; reading is linear in the file's size (it was quadratic in the members
 // of an object).
 // Every refusal names the file and the limit, exits 1 and leaves no report behind.
+// The tables the report draws are bounded too (limits::kReportTableCells): a table whose rows x columns (an
+// array's length x the union of its entries' keys) exceed the limit is refused as a problem of its section,
+// before any of its cells is built; the rest of the page is drawn.
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
@@ -15,6 +18,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -280,6 +284,165 @@ TEST(ReportBounds, AResultAtTheNamesLimitIsDrawnWhole) {
   // One table row per coefficient (and the header's).
   EXPECT_EQ(count(page, "<td>deg/h</td>"), n);
   fs::remove_all(dir);
+}
+
+// The parsed result is held whole: its values are bounded (limits::kResultValues), so that 64 MiB of tiny
+// values
+// (`{},` 22 million times: 2.3 GB before the fix) are refused while they are read. At the limit exactly, the
+// result is read.
+TEST(ReportBounds, MoreValuesThanTheLimitAreRefused) {
+  // The root object, the array and its numbers.
+  const auto with_numbers = [](std::size_t n) {
+    std::string text = "{\"x\": [";
+    text.reserve(2 * n + 16);
+    for (std::size_t i = 0; i < n; ++i) text += i == 0 ? "0" : ",0";
+    return text + "]}";
+  };
+  EXPECT_NO_THROW((void)parse_result_json(with_numbers(limits::kResultValues - 2), "at.json"));
+  try {
+    (void)parse_result_json(with_numbers(limits::kResultValues - 1), "over.json");
+    ADD_FAILURE() << "more values than the limit were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("over.json holds more than 4194304 JSON values"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("the limit for a result"), std::string::npos) << e.what();
+  }
+}
+
+// ---- The cells of a table ---------------------------------------------------------------------------------
+
+/// The number of table cells on a page.
+std::size_t cells_on(const std::string& page) {
+  return count(page, "<td");
+}
+
+/// `n` entries of an array, entry i holding {"<prefix><i % keys>": i} and `common` (so a table of them has
+/// `keys` columns of their own).
+json cycling_entries(std::size_t n, std::size_t keys, const std::string& prefix, const json& common = {}) {
+  json entries = json::array();
+  for (std::size_t i = 0; i < n; ++i) {
+    json e = common.is_object() ? common : json::object();
+    e[prefix + std::to_string(i % keys)] = i;
+    entries.push_back(std::move(e));
+  }
+  return entries;
+}
+
+// Issue 29: `data_quality.rejected` of 2,000 entries cycling through 1,000 keys is a table of 2,000 x 1,003
+// cells (start_s, end_s, reason and the keys): beyond the limit, it is refused naming the file, the section,
+// its rows x columns and the limit, and the page is written with the other sections (before the fix the
+// table was drawn whole: 2 million cells; 50,000 entries of 4,000 keys ran out of 2 GB).
+TEST(ReportBounds, AnExplodingTableIsRefusedAsAProblemOfItsSection) {
+  const fs::path dir = fresh_test_folder("report-bounds");
+  json result = result_with_coefficients(3);
+  result["data_quality"] = {{"rows_read", 10}, {"rows_used", 5}, {"outliers", 0}, {"gaps", 0}};
+  result["data_quality"]["rejected"] =
+      cycling_entries(2000, 1000, "k", {{"start_s", 1.0}, {"end_s", 2.0}, {"reason", "not planned"}});
+  ASSERT_GT(2000u * 1003u, limits::kReportTableCells);
+  ASSERT_LE(distinct_names(result), limits::kResultNames);
+  const fs::path input = dir / "rejected.json", html = dir / "rejected.html";
+  write_file(input, result.dump());
+  const CliOutcome o = run_cli("report " + input.string() + " --html " + html.string(), dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  for (const std::string_view w :
+       {std::string_view("warning"), std::string_view(input.string()), std::string_view("data_quality"),
+        std::string_view("data_quality.rejected"), std::string_view("2000 rows"),
+        std::string_view("1003 columns"), std::string_view("1000000, the limit of a table")})
+    EXPECT_NE(o.err.find(w), std::string::npos) << w << " in: " << o.err;
+  const std::string page = test::slurp(html);
+  EXPECT_NE(page.find("1003 columns"), std::string::npos);
+  // The other sections are drawn: the coefficients' table.
+  EXPECT_NE(page.find("<td>k2</td>"), std::string::npos);
+  EXPECT_LT(cells_on(page), 1000u);
+  fs::remove_all(dir);
+}
+
+/// Renders `result` and expects one problem naming `where` and the limit, and a page without the table.
+void expect_table_refused(const json& result, std::string_view where) {
+  std::vector<std::string> problems;
+  HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string page = render_html_report(result, options);
+  ASSERT_EQ(problems.size(), 1u) << where;
+  EXPECT_NE(problems[0].find(where), std::string::npos) << problems[0];
+  EXPECT_NE(problems[0].find("1000000, the limit of a table"), std::string::npos) << problems[0];
+  EXPECT_LE(cells_on(page), limits::kReportTableCells / 100) << where;
+}
+
+// Every table drawn from an array or object of the result is bounded before its cells are built: the union
+// of keys (coefficients' and machine errors' fields, dwells' fields, comparison's labels, the budget's
+// sources, the sensitivity heat maps' estimates) or the rows alone (positions) or the bins (histograms).
+TEST(ReportBounds, EveryTableOfTheReportIsBounded) {
+  {
+    json r = {{"data_quality", {{"dwells", cycling_entries(1000, 1000, "d")}}}};
+    expect_table_refused(r, "data_quality.dwells would be a table of 1000 rows \xC3\x97 1001 columns");
+  }
+  {
+    json r = result_with_coefficients(1000);
+    std::size_t i = 0;
+    for (auto& [name, e] : r["coefficients"].items()) e["f" + std::to_string(i++)] = 1;
+    expect_table_refused(r, "coefficients would be a table of 1000 rows \xC3\x97 1008 columns");
+  }
+  {
+    json r = {{"machine_errors", cycling_entries(1000, 1000, "f", {{"error", "x"}, {"value", 1}})}};
+    expect_table_refused(r, "machine_errors would be a table of 1000 rows \xC3\x97 1007 columns");
+  }
+  {
+    json r = {{"comparison", json::array()}};
+    for (int k = 0; k < 1000; ++k)
+      r["comparison"].push_back(
+          {{"label", std::to_string(k)}, {"coefficients", {{"c" + std::to_string(k), 1}}}});
+    expect_table_refused(r, "comparison would be a table of 1000 rows \xC3\x97 1002 columns");
+  }
+  {
+    json r = {{"positions", json::array()}};
+    for (std::size_t k = 0; k <= limits::kReportTableCells / 8; ++k) r["positions"].push_back(json::object());
+    expect_table_refused(r, "positions would be a table of 125001 rows \xC3\x97 8 columns");
+  }
+  {
+    json budget = json::object();
+    for (int k = 0; k < 1000; ++k) budget["c" + std::to_string(k)] = {{"s" + std::to_string(k), 0.5}};
+    json r = {{"montecarlo", {{"budget", budget}}}};
+    expect_table_refused(r, "montecarlo.budget would be a table of 1000 rows \xC3\x97 1002 columns");
+  }
+  {
+    json counts = json::array(), edges = json::array({0});
+    for (std::size_t k = 0; k <= limits::kReportTableCells; ++k) {
+      counts.push_back(0);
+      edges.push_back(k + 1);
+    }
+    json r = {
+        {"montecarlo",
+         {{"coefficients",
+           {{"dF", {{"mean", 0}, {"std", 1}, {"histogram", {{"edges", edges}, {"counts", counts}}}}}}}}}};
+    expect_table_refused(r,
+                         "montecarlo.coefficients' histograms would be a table of 1 rows \xC3\x97 1000001");
+  }
+  {
+    json rows = json::array();
+    for (int k = 0; k < 2001; ++k)
+      rows.push_back(
+          {{"error", "e"}, {"value", 1}, {"shift", {{"none", {{"n" + std::to_string(k % 500), 1.0}}}}}});
+    json r = {{"sensitivity", {{"rows", rows}}}};
+    expect_table_refused(
+        r, "sensitivity.rows (the heat maps) would be a table of 2001 rows \xC3\x97 500 columns");
+  }
+}
+
+// The limit leaves a real result's tables whole: the sample (every section) draws with no problem, and a
+// table of exactly the limit's cells is drawn.
+TEST(ReportBounds, ATableAtTheLimitIsDrawn) {
+  json r = {
+      {"data_quality",
+       {{"rejected", cycling_entries(1000, 997, "k", {{"start_s", 1.0}, {"end_s", 2.0}, {"reason", "x"}})}}}};
+  ASSERT_EQ(1000u * 1000u, limits::kReportTableCells);
+  std::vector<std::string> problems;
+  HtmlReportOptions options;
+  options.problems = &problems;
+  const std::string page = render_html_report(r, options);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  // The rejected table's cells, and the eight of the counts' table (four rows of label and count).
+  EXPECT_EQ(cells_on(page), limits::kReportTableCells + 8);
 }
 
 }  // namespace

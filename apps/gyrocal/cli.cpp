@@ -222,22 +222,11 @@ bool is_simulated_record(const std::string& path) {
 bool is_earlier_result(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return false;
-  // A result is a few MB at most; a bigger file is something else (a record), and is not read.
-  constexpr std::uintmax_t kLargestResult = 256u << 20;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec || size > kLargestResult) return false;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  // The first character that is not white space must open an object: a record or a configuration is
-  // told apart without reading it.
-  char c = 0;
-  while (in.get(c) && std::isspace(static_cast<unsigned char>(c))) {
-  }
-  if (!in || c != '{') return false;
-  std::string text(1, c);
-  text.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  // Read as `report` reads a result (read_result_file): bounded by limits::kResultBytes through
+  // read_bounded, stopping at the first character when it cannot open a JSON object (a record or a
+  // configuration is told apart without reading it), and held to a result's names and depth.
   try {
-    return has_result_marker(parse_result_json(text, path));
+    return has_result_marker(read_result_file(path));
   } catch (const Error&) {
     return false;
   }

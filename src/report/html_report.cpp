@@ -87,15 +87,15 @@ class ResultParser {
  public:
   ResultParser(json& result, const std::string& source_name) : dom_(result), source_name_(source_name) {}
 
-  bool null() { return dom_.null(); }
-  bool boolean(bool value) { return dom_.boolean(value); }
-  bool number_integer(json::number_integer_t value) { return dom_.number_integer(value); }
-  bool number_unsigned(json::number_unsigned_t value) { return dom_.number_unsigned(value); }
-  bool number_float(json::number_float_t value, const json::string_t& text) {
-    return dom_.number_float(value, text);
+  bool null() { return value() && dom_.null(); }
+  bool boolean(bool v) { return value() && dom_.boolean(v); }
+  bool number_integer(json::number_integer_t v) { return value() && dom_.number_integer(v); }
+  bool number_unsigned(json::number_unsigned_t v) { return value() && dom_.number_unsigned(v); }
+  bool number_float(json::number_float_t v, const json::string_t& text) {
+    return value() && dom_.number_float(v, text);
   }
-  bool string(json::string_t& value) { return dom_.string(value); }
-  bool binary(json::binary_t& value) { return dom_.binary(value); }
+  bool string(json::string_t& v) { return value() && dom_.string(v); }
+  bool binary(json::binary_t& v) { return value() && dom_.binary(v); }
   bool start_object(std::size_t size) {
     enter();
     return dom_.start_object(size);
@@ -127,8 +127,19 @@ class ResultParser {
   }
 
  private:
+  /// One more value: refused beyond limits::kResultValues, before it is built (the parsed result is held
+  /// whole, ~100 B a value at worst). Returns true.
+  bool value() {
+    if (++values_ > limits::kResultValues)
+      throw Error(fmt::format(
+          "{} holds more than {} JSON values (numbers, strings, arrays, objects), the limit for a result (a "
+          "gyrocal result holds a few ten thousand): it is not a result.",
+          source_name_, limits::kResultValues));
+    return true;
+  }
   /// An array or object opens: refused beyond limits::kResultDepth levels (the root object is the first).
   void enter() {
+    value();
     if (depth_ >= limits::kResultDepth)
       throw Error(
           fmt::format("{} nests arrays and objects more than {} levels deep; a gyrocal result nests "
@@ -140,6 +151,7 @@ class ResultParser {
   nlohmann::detail::json_sax_dom_parser<json> dom_;
   const std::string& source_name_;
   int depth_ = 0;
+  std::size_t values_ = 0;
   std::unordered_set<std::string> names_;
 };
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 
 namespace gyrocal::report {
 
@@ -108,6 +109,14 @@ std::string string_or(const json& object, std::string_view key, std::string_view
   if (j == nullptr || j->is_null()) return std::string(fallback);
   if (j->is_string()) return j->get<std::string>();
   return j->dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string short_text(std::string_view text, std::size_t max_bytes) {
+  if (text.size() <= max_bytes) return std::string(text);
+  std::size_t end = max_bytes;
+  // Back to the first byte of a UTF-8 character (continuation bytes are 10xxxxxx).
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  return std::string(text.substr(0, end)) + "\xE2\x80\xA6";
 }
 
 std::string scalar_text(const json& j) {
@@ -230,8 +239,21 @@ Cell num_cell(std::string text, std::string cls, std::string title) {
   return {esc(text), true, std::move(cls), std::move(title)};
 }
 
+void check_table_cells(std::size_t rows, std::size_t columns, std::string_view where) {
+  // Neither factor exceeds a result's bytes (64 MiB), so the product fits a 64-bit size.
+  const std::size_t cells = rows * columns;
+  if (cells <= limits::kReportTableCells) return;
+  throw Error(fmt::format(
+      "{} would be a table of {} rows \xC3\x97 {} columns, {} cells, more than {}, the limit of a table in "
+      "the report (a gyrocal result's largest tables have a few ten thousand cells); it is not drawn",
+      where, rows, columns, cells, limits::kReportTableCells));
+}
+
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<Cell>>& rows,
                   std::string_view cls) {
+  std::size_t columns = header.size();
+  for (const auto& row : rows) columns = std::max(columns, row.size());
+  check_table_cells(rows.size(), columns, "a table");
   std::string s = fmt::format("<div class=\"table-wrap\"><table class=\"{}\">\n", cls);
   // A table of label and value (every heading empty) has no heading row.
   const bool headed =
@@ -273,7 +295,9 @@ std::string generic_table(const json& entries, const std::vector<std::string>& f
       if (std::find(first.begin(), first.end(), key) == first.end()) others.insert(key);
   }
   columns.insert(columns.end(), others.begin(), others.end());
+  check_table_cells(entries.size(), columns.size(), where);
   std::vector<std::vector<Cell>> rows;
+  rows.reserve(entries.size());
   for (const auto& e : entries) {
     std::vector<Cell> row;
     for (const auto& column : columns) {

@@ -40,6 +40,11 @@ std::optional<double> number(const json& object, std::string_view key, std::stri
 std::optional<double> number(const json& j, std::string_view where);
 /// A string member as it is, any other value as compact JSON, `fallback` when missing or null.
 std::string string_or(const json& object, std::string_view key, std::string_view fallback = "");
+/// `text` as it is when it has at most `max_bytes` bytes, else its first bytes (whole UTF-8 characters) and
+/// an ellipsis: for a text from the result that a table or plot repeats in many cells (a row's label in each
+/// of its cells), so that the page grows with the cells, not with the cells times the text. A gyrocal name
+/// or unit has a few dozen bytes.
+std::string short_text(std::string_view text, std::size_t max_bytes = 120);
 /// Any JSON value as text: strings unquoted, anything else as compact JSON.
 std::string scalar_text(const json& j);
 /// Any JSON value for a reader: strings unquoted, numbers with 6 significant digits, booleans yes/no, null a
@@ -88,13 +93,23 @@ Cell num_cell(std::string text, std::string cls = "", std::string title = "");
 /// A cell for a field of unknown type: a dash when absent (nullptr), a number cell for a number, text else.
 Cell value_cell(const json* v);
 
-/// An HTML table (header cells are escaped here; long names may break after an underscore).
+/// The bound on every table (and heat map) the report draws (limits::kReportTableCells; issue 29): throws
+/// gyrocal::Error naming `where` (the part of the result drawn), its `rows` x `columns` and the limit when
+/// they make more cells than the limit. Called before any row is built, with rows and columns counted from
+/// the array's length and the union of its entries' keys, so that a table's memory stays bounded whatever
+/// the result; the section then shows the sentence in its place (Page::section) and the page is still drawn.
+void check_table_cells(std::size_t rows, std::size_t columns, std::string_view where);
+
+/// An HTML table (header cells are escaped here; long names may break after an underscore). Throws as
+/// check_table_cells when it has more cells than limits::kReportTableCells (a table built without that check
+/// first).
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<Cell>>& rows,
                   std::string_view cls = "");
 
 /// A table of an array of objects whose fields are not all known: the `first` fields in that order, then
 /// every other field that any entry has, alphabetically; numbers right-aligned, anything else as scalar_text.
-/// Throws naming `where` when `entries` is not an array of objects.
+/// Throws naming `where` when `entries` is not an array of objects, or when its entries x columns are more
+/// cells than limits::kReportTableCells (checked before any cell is built).
 std::string generic_table(const json& entries, const std::vector<std::string>& first, std::string_view where);
 
 }  // namespace gyrocal::report

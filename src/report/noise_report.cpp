@@ -63,6 +63,7 @@ struct AllanPoint {
 std::vector<AllanPoint> allan_points(const json& noise) {
   const json& a = member(noise, "allan", "the result");
   expect(a, json::value_t::array, "allan");
+  check_table_cells(a.size(), 7, "allan");
   std::vector<AllanPoint> points;
   for (std::size_t k = 0; k < a.size(); ++k) {
     const std::string where = fmt::format("allan[{}]", k);

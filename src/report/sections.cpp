@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 #include <set>
+#include <unordered_map>
 #include <utility>
 
 #include <fmt/format.h>
@@ -106,8 +107,13 @@ void test_plan(const json& result, Page& page, std::string& out) {
   const json* positions_j = find(p, "positions");
   if (positions_j == nullptr) return;
   expect(*positions_j, json::value_t::array, "plan.positions");
+  check_table_cells(positions_j->size(), 4, "plan.positions");
   std::vector<std::vector<Cell>> prow;
+  // The distinct rates in the order they first occur, each with its positions (one pass: a search of the
+  // positions per rate was positions x rates).
   std::vector<double> rates;
+  std::vector<std::vector<std::size_t>> at_rate;
+  std::unordered_map<double, std::size_t> rate_index;
   for (std::size_t k = 0; k < positions_j->size(); ++k) {
     const json& q = (*positions_j)[k];
     const std::string where = fmt::format("plan.positions[{}]", k);
@@ -116,15 +122,19 @@ void test_plan(const json& result, Page& page, std::string& out) {
                     num_cell(num(number(q, "gamma_deg", where))),
                     num_cell(num(number(q, "rate_rad_s", where)))});
     const double rate = number(q, "rate_rad_s", where).value_or(0.0);
-    if (std::find(rates.begin(), rates.end(), rate) == rates.end()) rates.push_back(rate);
+    const auto [it, added] = rate_index.try_emplace(rate, rates.size());
+    if (added) {
+      rates.push_back(rate);
+      at_rate.emplace_back();
+    }
+    at_rate[it->second].push_back(k);
   }
   json series = json::array();
   for (std::size_t i = 0; i < rates.size(); ++i) {
     json points = json::array(), tips = json::array();
-    for (std::size_t k = 0; k < positions_j->size(); ++k) {
+    for (const std::size_t k : at_rate[i]) {
       const json& q = (*positions_j)[k];
       const std::string where = fmt::format("plan.positions[{}]", k);
-      if (number(q, "rate_rad_s", where).value_or(0.0) != rates[i]) continue;
       const auto beta = number(q, "beta_deg", where), gamma = number(q, "gamma_deg", where);
       if (!beta || !gamma) continue;
       points.push_back({{"x", *gamma}, {"y", *beta}});
@@ -171,6 +181,8 @@ void coefficients(const json& result, Page& page, std::string& out) {
       if (field != "value" && field != "std" && field != "unit" && field != "identifiable")
         extra_fields.insert(field);
   }
+  // name, unit, truth, estimate, sigma, error, error/sigma, identifiable, then the fields.
+  check_table_cells(c.size(), 8 + extra_fields.size(), "coefficients");
   for (const auto& name : ordered_keys(c)) {
     const json& e = c[name];
     const std::string where = "coefficients." + name;
@@ -257,6 +269,7 @@ void coefficients(const json& result, Page& page, std::string& out) {
 void combinations(const json& result, Page&, std::string& out) {
   const json& c = member(result, "combinations", "the result");
   expect(c, json::value_t::array, "combinations");
+  check_table_cells(c.size(), 3, "combinations");
   std::vector<std::vector<Cell>> rows;
   for (std::size_t k = 0; k < c.size(); ++k) {
     const std::string where = fmt::format("combinations[{}]", k);
@@ -274,6 +287,7 @@ void combinations(const json& result, Page&, std::string& out) {
 void alternatives(const json& result, Page&, std::string& out) {
   const json& a = member(result, "alternatives", "the result");
   expect(a, json::value_t::array, "alternatives");
+  check_table_cells(a.size(), 3, "alternatives");
   std::vector<std::vector<Cell>> rows;
   for (std::size_t k = 0; k < a.size(); ++k) {
     const std::string where = fmt::format("alternatives[{}]", k);
@@ -307,6 +321,7 @@ void comparison(const json& result, Page&, std::string& out) {
   }
   std::vector<std::string> header = {"coefficient", "truth"};
   header.insert(header.end(), labels.begin(), labels.end());
+  check_table_cells(names.size(), header.size(), "comparison");
   std::vector<std::vector<Cell>> rows;
   for (const auto& name : ordered_names(names)) {
     const auto truth = truth_of(result, name);
@@ -344,6 +359,7 @@ void comparison(const json& result, Page&, std::string& out) {
 void positions(const json& result, Page& page, std::string& out) {
   const json& p = member(result, "positions", "the result");
   expect(p, json::value_t::array, "positions");
+  check_table_cells(p.size(), 8, "positions");
   std::vector<std::vector<Cell>> rows;
   json labels = json::array(), center = json::array(), low = json::array(), high = json::array(),
        tips = json::array();
@@ -432,23 +448,23 @@ void sensitivity_rate_errors(const json& result, const json& s, const std::vecto
   const json& rows_j = s["rows"];
   const json* sigma_j = find(s, "least_squares_noise_std");
   if (sigma_j) expect(*sigma_j, json::value_t::object, "sensitivity.least_squares_noise_std");
-  std::vector<std::string> names, compensations;
+  std::vector<std::string> names;
+  std::set<std::string> compensations;
   for (const char* name : kRateErrorNames)
     for (const auto& row : rows_j)
       if (const json* ls = find(row, "least_squares"); ls && ls->is_object()) {
         for (const auto& [comp, m] : ls->items())
           if (m.is_object() && m.contains(name)) {
             if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
-            if (std::find(compensations.begin(), compensations.end(), comp) == compensations.end())
-              compensations.push_back(comp);
+            compensations.insert(comp);
           }
       }
   const json* not_identifiable = find(s, "not_identifiable");
   if (names.empty() && (not_identifiable == nullptr || not_identifiable->empty())) return;
   std::vector<std::string> ordered_comp;
   for (const char* c : {"none", "seed", "full", "self"})
-    if (std::find(compensations.begin(), compensations.end(), c) != compensations.end())
-      ordered_comp.push_back(c);
+    if (compensations.count(c)) ordered_comp.push_back(c);
+  check_table_cells(rows_j.size(), 2 + names.size() * ordered_comp.size(), "sensitivity.rows' least_squares");
   out +=
       "<h3>Rate errors (least squares, gyro model drift+rate)</h3>\n<p class=\"note\">Each machine error "
       "alone shifts the scale-factor error and the input axis' misalignments by the amounts below, in their "
@@ -495,15 +511,14 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
 
   // Compensations and estimate names that occur in any row, in a fixed order.
   std::vector<std::string> compensations;
-  std::set<std::string> names_set;
+  std::set<std::string> compensation_set, names_set;
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const std::string where = fmt::format("sensitivity.rows[{}]", k);
     const json& shift = member(rows_j[k], "shift", where);
     expect(shift, json::value_t::object, where + ".shift");
     for (const auto& [comp, m] : shift.items()) {
       expect(m, json::value_t::object, where + ".shift." + comp);
-      if (std::find(compensations.begin(), compensations.end(), comp) == compensations.end())
-        compensations.push_back(comp);
+      if (compensation_set.insert(comp).second) compensations.push_back(comp);
       for (const auto& [name, v] : m.items()) names_set.insert(name);
     }
   }
@@ -515,10 +530,20 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
     if (std::find(ordered_comp.begin(), ordered_comp.end(), c) == ordered_comp.end())
       ordered_comp.push_back(c);
   const std::vector<std::string> names = ordered_names(names_set);
+  // The heat maps, one per compensation, are counted together (each cell holds a colour and a tooltip), and
+  // the table of shifts beside them.
+  check_table_cells(rows_j.size(), names.size() * ordered_comp.size(), "sensitivity.rows (the heat maps)");
+  check_table_cells(rows_j.size(), 2 + ordered_comp.size(), "sensitivity.rows (the table of shifts)");
 
   std::vector<std::string> row_labels;
   for (std::size_t k = 0; k < rows_j.size(); ++k)
     row_labels.push_back(sensitivity_row_label(rows_j[k], fmt::format("sensitivity.rows[{}]", k)));
+  // Each estimate's unit and name as the cells repeat them, once.
+  std::vector<std::string> units, short_names;
+  for (const auto& name : names) {
+    units.push_back(short_text(estimate_unit(s, result, name)));
+    short_names.push_back(short_text(name));
+  }
 
   // The scale: shift/sigma when noise_std gives the sigma of every estimate, else the shift itself.
   // Shared by all compensations so that their maps compare at a glance; logarithmic because shifts
@@ -583,12 +608,16 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
       const json* m = find(row["shift"], comp);
       json crow = json::array(), trow = json::array();
       std::vector<std::pair<double, std::string>> notable;
-      for (const auto& name : names) {
+      // Repeated in every cell of the row: the texts from the result are shortened (short_text), so that a
+      // long label cannot be copied rows x estimates times.
+      const std::string magnitude =
+          fmt::format("{} = {} {}", short_text(row_labels[k]), num(number(row, "value", where)),
+                      short_text(string_or(row, "unit")));
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        const std::string& name = names[i];
         const json* v = m ? find(*m, name) : nullptr;
         const std::optional<double> given = v ? number(*v, where + "." + name) : std::nullopt;
-        const std::string unit = estimate_unit(s, result, name);
-        const std::string magnitude = fmt::format("{} = {} {}", row_labels[k],
-                                                  num(number(row, "value", where)), string_or(row, "unit"));
+        const std::string& unit = units[i];
         if (!given) {
           crow.push_back("#d9d9d9");
           trow.push_back(json::array({magnitude, "not given"}));
@@ -604,9 +633,10 @@ void sensitivity_study(const json& s, const json& result, Page& page, std::strin
         trow.push_back(std::move(lines));
         const bool matters = normalised ? (z && std::fabs(*z) >= 1.0) : (std::fabs(shift) >= 1e-3 * z_max);
         if (matters)
-          notable.emplace_back(std::fabs(z.value_or(shift)),
-                               normalised ? fmt::format("{} {} ({}\xCF\x83)", name, num(shift, 3), num(*z, 3))
-                                          : fmt::format("{} {}", name, num(shift, 3)));
+          notable.emplace_back(
+              std::fabs(z.value_or(shift)),
+              normalised ? fmt::format("{} {} ({}\xCF\x83)", short_names[i], num(shift, 3), num(*z, 3))
+                         : fmt::format("{} {}", short_names[i], num(shift, 3)));
       }
       colours.push_back(std::move(crow));
       tips.push_back(std::move(trow));
@@ -648,6 +678,17 @@ void montecarlo_run(const json& m, const json& result, Page& page, std::string& 
     out += fmt::format("<p>{} trials.</p>\n", esc(num(trials, 12)));
   if (const json* c = find(m, "coefficients")) {
     expect(*c, json::value_t::object, "montecarlo.coefficients");
+    check_table_cells(c->size(), 6, "montecarlo.coefficients");
+    // The histograms' bins, each a bar with its label and tooltip: as many cells as a table of a row per
+    // histogram and a column per bin of the largest.
+    std::size_t histograms = 0, most_bins = 0;
+    for (const auto& [name, e] : c->items())
+      if (const json* h = find(e, "histogram"))
+        if (const json* counts = find(*h, "counts"); counts && counts->is_array()) {
+          ++histograms;
+          most_bins = std::max(most_bins, counts->size());
+        }
+    check_table_cells(histograms, most_bins, "montecarlo.coefficients' histograms");
     std::vector<std::vector<Cell>> rows;
     std::string grid;
     for (const auto& name : ordered_keys(*c)) {
@@ -699,11 +740,14 @@ void montecarlo_run(const json& m, const json& result, Page& page, std::string& 
     expect(*b, json::value_t::object, "montecarlo.budget");
     const std::vector<std::string> coefs = ordered_keys(*b);
     std::vector<std::string> sources;
+    std::set<std::string> source_set;
     for (const auto& name : coefs) {
       expect((*b)[name], json::value_t::object, "montecarlo.budget." + name);
       for (const auto& [source, v] : (*b)[name].items())
-        if (std::find(sources.begin(), sources.end(), source) == sources.end()) sources.push_back(source);
+        if (source_set.insert(source).second) sources.push_back(source);
     }
+    // A row per estimate: its name, a share per source and the total (the stacked bars hold as many).
+    check_table_cells(coefs.size(), sources.size() + 2, "montecarlo.budget");
     // Noise first, then the machine errors as the result names them.
     std::stable_partition(sources.begin(), sources.end(), [](const std::string& s) { return s == "noise"; });
     json series = json::array();
@@ -777,25 +821,25 @@ void dwell_table(const json& dwells, std::string& out) {
                                         {"before_leaving", "before leaving"},
                                         {"outliers", "outliers"}};
   static constexpr Column kAfter[] = {{"gaps", "gaps"}, {"ended", "steady run ended"}, {"reason", "reason"}};
-  // The columns any dwell has: the known ones in the order above, then the others alphabetically.
-  const auto any_has = [&](std::string_view key) {
-    return std::any_of(dwells.begin(), dwells.end(),
-                       [&](const json& d) { return d.is_object() && find(d, key) != nullptr; });
-  };
-  std::set<std::string> known, dropped_keys;
+  // The columns any dwell has: the known ones in the order above, then the others alphabetically. The keys
+  // present are collected in one pass over the dwells (asking each dwell per column and row was rows^2).
+  std::set<std::string> known, dropped_keys, present;
   for (const auto& c : kBefore) known.emplace(c.key);
   for (const auto& c : kAfter) known.emplace(c.key);
   known.emplace("dropped");
   std::set<std::string> others;
   for (std::size_t k = 0; k < dwells.size(); ++k) {
     expect(dwells[k], json::value_t::object, fmt::format("data_quality.dwells[{}]", k));
-    for (const auto& [key, v] : dwells[k].items())
+    for (const auto& [key, v] : dwells[k].items()) {
       if (!known.count(key)) others.insert(key);
+      present.insert(key);
+    }
     if (const json* d = find(dwells[k], "dropped")) {
       expect(*d, json::value_t::object, fmt::format("data_quality.dwells[{}].dropped", k));
       for (const auto& [key, v] : d->items()) dropped_keys.insert(key);
     }
   }
+  const auto any_has = [&](std::string_view key) { return present.count(std::string(key)) > 0; };
   std::vector<std::string> header;
   const bool numbered = !any_has("index");
   if (numbered) header.emplace_back("dwell");
@@ -814,8 +858,10 @@ void dwell_table(const json& dwells, std::string& out) {
   for (const auto& c : kAfter)
     if (any_has(c.key)) header.emplace_back(c.header);
   header.insert(header.end(), others.begin(), others.end());
+  check_table_cells(dwells.size(), header.size(), "data_quality.dwells");
 
   std::vector<std::vector<Cell>> rows;
+  rows.reserve(dwells.size());
   for (std::size_t k = 0; k < dwells.size(); ++k) {
     const json& d = dwells[k];
     std::vector<Cell> row;
@@ -904,6 +950,8 @@ void machine_errors(const json& result, Page&, std::string& out) {
           field != "unit" && field != "configured" && field != "correlations")
         extra_fields.insert(field);
   }
+  // label, unit, configured, estimate, sigma, change, change/sigma, then the fields.
+  check_table_cells(m.size(), 7 + extra_fields.size(), "machine_errors");
   std::vector<std::vector<Cell>> rows;
   std::vector<std::vector<Cell>> correlation_rows;
   for (std::size_t k = 0; k < m.size(); ++k) {
@@ -1075,16 +1123,14 @@ void sensitivity_settings(const json& s, Page&, std::string& out) {
 void sensitivity_least_squares(const json& s, Page&, std::string& out) {
   const json& rows_j = member(s, "rows", "the study");
   expect(rows_j, json::value_t::array, "rows");
-  std::vector<std::string> compensations;
+  std::set<std::string> compensations;
   for (const auto& row : rows_j)
     if (const json* m = find(row, "least_squares_matters"); m && m->is_object())
-      for (const auto& [comp, v] : m->items())
-        if (std::find(compensations.begin(), compensations.end(), comp) == compensations.end())
-          compensations.push_back(comp);
+      for (const auto& [comp, v] : m->items()) compensations.insert(comp);
   std::vector<std::string> ordered_comp;
   for (const char* c : {"none", "seed", "full", "self"})
-    if (std::find(compensations.begin(), compensations.end(), c) != compensations.end())
-      ordered_comp.push_back(c);
+    if (compensations.count(c)) ordered_comp.push_back(c);
+  check_table_cells(rows_j.size(), 2 + ordered_comp.size(), "rows' least_squares_matters");
   std::vector<std::vector<Cell>> rows;
   for (std::size_t k = 0; k < rows_j.size(); ++k) {
     const json& row = rows_j[k];

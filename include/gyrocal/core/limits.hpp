@@ -129,6 +129,21 @@ inline constexpr std::size_t kResultNames = 4096;
 /// result nests five or six. The report prints some values with the JSON library's dump, which recurses once
 /// per level, so deeper input is refused while it is parsed, before it can overflow the stack.
 inline constexpr int kResultDepth = 64;
+/// The most JSON values in one result (each number, string, boolean, null, array and object counts one): 4
+/// Mi. The parsed result is held whole, ~100 B a value at worst (an empty object: 64 MiB of `{},` were 22
+/// million values and 2.3 GB; of `0,` 1.1 GB), so this keeps it under ~450 MB whatever the result (issue 29).
+/// A gyrocal result holds a few ten thousand values (a sensitivity study of 1,024 rows ~60,000); 64 MiB of
+/// numbers written with 17 digits are 3.5 million.
+inline constexpr std::size_t kResultValues = std::size_t{1} << 22;
+/// The most cells of one table (or heat map) the report draws: rows x columns, counted from an array's length
+/// and the union of its entries' keys before any cell is built, so that a result within the limits above
+/// cannot make a table of rows x names cells (50,000 rejected steady runs cycling through 4,000 keys were
+/// 200 million cells; `report` ran out of 2 GB; issue 29). 1,000,000 cells are a page a browser still
+/// renders (~50 MB of HTML); a real result's largest tables stay far inside: the dwell table of a
+/// 512-position test ~10,000 cells, the heat maps of 8 harmonic series x 64 terms x 2 phases x 13 estimates
+/// x 3 compensations ~40,000. A table beyond it is refused as a problem of its section, naming its rows x
+/// columns and this limit; the other sections are drawn (docs/report.md).
+inline constexpr std::size_t kReportTableCells = 1000000;
 
 // ---- Runs ----
 
