@@ -27,6 +27,7 @@
 #include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/centrifuge.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/result/noise_json.hpp"
@@ -114,9 +115,11 @@ py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double
   if (time_s.ndim() != 1)
     throw Error(
         fmt::format("time_s has {} dimensions; give a number or a one-dimensional array.", time_s.ndim()));
-  for (py::ssize_t i = 0; i < time_s.size(); ++i)
+  for (py::ssize_t i = 0; i < time_s.size(); ++i) {
     if (!std::isfinite(time_s.data()[i]))
       throw Error(fmt::format("time_s[{}] must be a finite number, not {}.", i, time_s.data()[i]));
+    check_time_within_test(time_s.data()[i], scenario.test, fmt::format("time_s[{}]", i));
+  }
   const CentrifugeModel model = scenario.model();
   // As `gyrocal inputs --time-s`: a spinning dwell at the configured rate, beta in radians from degrees.
   const double rate = scenario.centrifuge.rate_rad_s, beta = beta_deg * kDegToRad;

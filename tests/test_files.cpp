@@ -424,16 +424,16 @@ TEST_F(Files, AnInterruptedDemoLeavesNoFolderAndAnExistingOneAsItWas) {
 // ---- Item 9: work that cannot be done ---------------------------------------------------------------------
 
 TEST_F(Files, AConfigurationLargerThanTheLimitIsRefusedWithTheLimit) {
-  // 17 MiB of comments: valid TOML, but no configuration is that large.
+  // 2 MiB of comments: valid TOML, but no configuration is that large (limits::kConfigurationBytes, 1 MiB).
   {
     std::ofstream out(path("huge.toml"), std::ios::binary);
     const std::string line = "# " + std::string(1021, 'x') + "\n";
-    for (int i = 0; i < 17 * 1024; ++i) out << line;
+    for (int i = 0; i < 2 * 1024; ++i) out << line;
   }
   const Outcome o = run({"inputs", "--config", "huge.toml", "--beta-deg", "0", "--time-s", "0"});
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.err.find("huge.toml"), std::string::npos) << o.err;
-  EXPECT_NE(o.err.find("larger than 16 MiB"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("larger than 1 MiB"), std::string::npos) << o.err;
 
   // /dev/zero never ends: it is read only up to the limit. (A bound on memory shows it, where the
   // sanitizers' own reservations allow one.)
@@ -445,7 +445,7 @@ TEST_F(Files, AConfigurationLargerThanTheLimitIsRefusedWithTheLimit) {
   });
   EXPECT_EQ(z.status, 1);
   EXPECT_NE(z.err.find("/dev/zero"), std::string::npos) << z.err;
-  EXPECT_NE(z.err.find("larger than 16 MiB"), std::string::npos) << z.err;
+  EXPECT_NE(z.err.find("larger than 1 MiB"), std::string::npos) << z.err;
 }
 
 TEST_F(Files, MonteCarloStatesItsMostTrialsAndRefusesMore) {

@@ -118,6 +118,16 @@ TEST_F(Outputs, AFailedAppendToStandardOutputLeavesTheFileAsItWas) {
 
 // ---- D6: demo --out -----------------------------------------------------------------------------------
 
+// A demo whose standard output is closed early (`gyrocal demo | head -c1`) is ended by SIGPIPE while its
+// files are staged: like SIGINT, SIGTERM and SIGHUP, the signal removes the staging folder (it was left, 7
+// MB).
+TEST_F(Outputs, ADemoEndedByABrokenPipeLeavesNoStagingFolder) {
+  run_to("demo --out " + p("dp"), "| head -c1 >/dev/null");
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".dp.tmp"), std::string::npos)
+        << "left behind: " << e.path().filename();
+}
+
 TEST_F(Outputs, DemoReplacesOnlyAnEarlierDemosFilesWithoutForce) {
   fs::create_directory(path("rig"));
   write("rig/record.csv", "rig data\n");

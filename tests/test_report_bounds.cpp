@@ -147,7 +147,7 @@ TEST(ReportBounds, AFileLargerThanTheLimitIsRefusedNamingTheLimit) {
   const fs::path big = dir / "big.json";
   write_sparse(big, "{\"coefficients\": {}, \"pad\": \"", limits::kResultBytes + 1);
   const CliOutcome o = run_cli("report " + big.string() + " --html " + (dir / "big.html").string(), dir);
-  expect_refused(o, dir, {big.string(), "larger than 64 MiB", "the limit for a result file"});
+  expect_refused(o, dir, {big.string(), "larger than 16 MiB", "the limit for a result file"});
   fs::remove_all(dir);
 }
 
@@ -163,7 +163,7 @@ TEST(ReportBounds, AnEndlessPipeIsReadOnlyUpToTheLimit) {
   o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   o.err = test::slurp(dir / "err.txt");
   fs::remove(dir / "err.txt");
-  expect_refused(o, dir, {"/dev/stdin", "larger than 64 MiB"});
+  expect_refused(o, dir, {"/dev/stdin", "larger than 16 MiB"});
   fs::remove_all(dir);
 }
 

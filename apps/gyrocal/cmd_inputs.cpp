@@ -8,6 +8,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/model/instant.hpp"
+#include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/result/inputs_json.hpp"
 
 namespace gyrocal::cli {
@@ -93,25 +94,18 @@ void register_inputs(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
-    // An instant lies within a test: at most limits::kTestSamples samples at [test] sample_rate_hz (a
-    // larger time would also overflow theta = omega t into inf and every input into NaN).
-    const double longest_s = limits::kTestSamples / s.test.sample_rate_hz;
-    const std::string longest =
-        fmt::format("{:g} s, the longest test gyrocal runs ({:g} samples at [test] sample_rate_hz = {:g} Hz)",
-                    longest_s, limits::kTestSamples, s.test.sample_rate_hz);
-    if (time->count() && !(std::fabs(opt->time_s) <= longest_s))
-      throw Error(
-          fmt::format("--time-s must be between -{:g} s and {}, not {:g}.", longest_s, longest, opt->time_s));
+    // An instant lies within a test (a larger time would also overflow theta = omega t into inf and every
+    // input into NaN).
+    if (time->count()) check_time_within_test(opt->time_s, s.test, "--time-s");
     const CentrifugeModel model = s.model();
     const double rate = s.centrifuge.rate_rad_s, beta = opt->beta_deg * kDegToRad;
     const InstantInputs in =
         time->count() ? inputs_at_time(model, rate, beta, opt->time_s)
                       : inputs_at_gamma(model, rate, beta, opt->gamma_deg * kDegToRad, opt->revolution);
-    if (!time->count() && !(std::fabs(in.time_s) <= longest_s))
-      throw Error(fmt::format(
-          "--gamma-deg {:g} in --revolution {} is {:g} s into the dwell, beyond {}: give a smaller angle or "
-          "revolution.",
-          opt->gamma_deg, opt->revolution, in.time_s, longest));
+    if (!time->count())
+      check_time_within_test(
+          in.time_s, s.test,
+          fmt::format("The instant of --gamma-deg {:g} in --revolution {}", opt->gamma_deg, opt->revolution));
     if (!all_finite(in))
       throw Error(
           fmt::format("the inputs at --beta-deg {:g} and {} are not finite numbers (they overflow with the "

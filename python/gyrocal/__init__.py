@@ -320,7 +320,7 @@ def _load(path):
 @_arguments(text=_text, name=_name)
 def _parse(text, name="<string>"):
     """Parse a configuration given as TOML text; name stands for the file in messages. Text that is empty or
-    white space only, or larger than 16 MiB, is refused as a configuration file is."""
+    white space only, or larger than 1 MiB, is refused as a configuration file is."""
     return Scenario._parse(text, name)
 
 

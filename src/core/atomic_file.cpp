@@ -87,7 +87,7 @@ struct Slot {
 
 Slot g_slots[kSlots];
 
-constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};  // SIGPIPE: `gyrocal demo | head -c1`
 
 extern "C" void remove_registered_paths(int signal_number) {
   for (Slot& slot : g_slots)
@@ -143,7 +143,7 @@ void unregister(int& slot) {
   slot = -1;
 }
 
-/// Blocks SIGINT, SIGTERM and SIGHUP on the calling thread for its lifetime; a signal that arrives
+/// Blocks SIGINT, SIGTERM, SIGHUP and SIGPIPE on the calling thread for its lifetime; a signal that arrives
 /// meanwhile is delivered afterwards.
 class SignalsBlocked {
  public:

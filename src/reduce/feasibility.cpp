@@ -179,4 +179,17 @@ void check_calibration_memory(const TestSpec& test, const ReduceOptions& options
         seconds, test.revolutions, windows, options.window_s, limits::kCalibrationRateWindows));
 }
 
+double longest_test_s(const TestSpec& test) {
+  return kMaxTestSamples / test.sample_rate_hz;
+}
+
+void check_time_within_test(double time_s, const TestSpec& test, const std::string& what) {
+  const double longest_s = longest_test_s(test);
+  if (std::fabs(time_s) <= longest_s) return;
+  throw Error(fmt::format(
+      "{} must be between -{:g} s and {:g} s, the longest test gyrocal runs ({:g} samples at [test] "
+      "sample_rate_hz = {:g} Hz), not {}.",
+      what, longest_s, longest_s, kMaxTestSamples, test.sample_rate_hz, time_s));
+}
+
 }  // namespace gyrocal

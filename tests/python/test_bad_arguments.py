@@ -164,8 +164,8 @@ def test_parse_refuses_an_empty_configuration_as_load_does(tmp_path):
 
 
 def test_parse_refuses_text_beyond_the_configurations_limit():
-    limit = 16 << 20
-    refused(lambda: gyrocal.Scenario.parse("#" * limit + "\n"), "<string>", "larger than 16 MiB")
+    limit = 1 << 20
+    refused(lambda: gyrocal.Scenario.parse("#" * limit + "\n"), "<string>", "larger than 1 MiB")
 
 
 def test_parse_and_load_refuse_arguments_of_the_wrong_type(tmp_path):
@@ -176,3 +176,14 @@ def test_parse_and_load_refuse_arguments_of_the_wrong_type(tmp_path):
     config = tmp_path / "c.toml"
     config.write_text(SMALL_TEST)
     assert gyrocal.Scenario.load(os.fsencode(config)).to_toml() == gyrocal.Scenario.load(config).to_toml()
+
+
+def test_exact_inputs_refuses_an_instant_beyond_the_longest_test():
+    # As `gyrocal inputs --time-s`: 1e10 samples at the scenario's 200 Hz are 5e7 s; beyond it theta = Omega t
+    # loses every digit and then overflows (1e308 gave NaN arrays).
+    sc = gyrocal.Scenario()
+    for t in (1e308, -1e308, 1e9):
+        refused(lambda: gyrocal.exact_inputs(sc, t, 0.0), "time_s[0] must be between", "5e+07 s")
+    refused(lambda: gyrocal.exact_inputs(sc, [0.0, 6e7], 0.0), "time_s[1]")
+    omega, force = gyrocal.exact_inputs(sc, 4e7, 0.0)
+    assert np.isfinite(omega).all() and np.isfinite(force).all()

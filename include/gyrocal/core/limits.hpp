@@ -9,8 +9,10 @@ namespace gyrocal::limits {
 
 // ---- Configuration (TOML) ----
 
-/// The largest configuration text, bytes: 16 MiB. A complete commented configuration is ~20 kB.
-inline constexpr std::size_t kConfigurationBytes = std::size_t{16} << 20;
+/// The largest configuration text, bytes: 1 MiB. A complete commented configuration is ~20 kB, and its lists
+/// hold at most kPlanValuesPerList values each. The TOML library holds ~40 bytes of tree a byte of text: 16
+/// MiB of empty inline tables took 680 MB and 3 s before the counts below could refuse them (issue 29).
+inline constexpr std::size_t kConfigurationBytes = std::size_t{1} << 20;
 /// The most dotted parts in one key or table header (`a.b.c` has 3). gyrocal's deepest key has 4
 /// (centrifuge.errors.counter_wobble_x[0].harmonic written as a dotted key); the TOML library parses a dotted
 /// key by recursion, so the text is checked against this before the library sees it.
@@ -29,9 +31,10 @@ inline constexpr std::size_t kPlanValuesPerList = 360;
 /// The most positions of a test (rates x beta x gamma, the static set included): plan's work grows with the
 /// positions (with their square for the gyro's fit), and docs/interface.md promises plan below a second for
 /// any accepted test. Lowered from 1024 (issue 29, D4): at 1008 positions an accelerometer's plan took 1.6 s
-/// of CPU, at 504 0.8 s; a gyro's window-mean plan of 512 positions 0.56 s. 512 positions of 200
-/// revolutions at 10 rad/s are an 18-hour test; the default tests have 16 (gyro) and 96 (accelerometer).
-inline constexpr std::size_t kPositions = 512;
+/// of CPU, at 504 0.8 s; and `montecarlo`'s set-up grows with the cube of the positions (35 s at 512, 0.5 s
+/// at 128). 256 positions of 200 revolutions at 10 rad/s are a 9-hour test; the default tests have 16 (gyro)
+/// and 96 (accelerometer).
+inline constexpr std::size_t kPositions = 256;
 /// The most revolutions of one dwell.
 inline constexpr std::int64_t kRevolutions = 100000000;
 /// The most samples a test may hold (its dwells, holds and settle intervals): 1e10 rows are ~0.4 TB.
@@ -43,10 +46,16 @@ inline constexpr double kTestSamples = 1e10;
 /// A geometric error of a bearing or a spindle lives in its first few harmonics; beyond the 64th it is
 /// vibration, which a dwell's fit averages away. The channels' Fourier route resolves up to this harmonic.
 inline constexpr int kHarmonic = 64;
-/// The most terms in one harmonic series of the configuration.
-inline constexpr std::size_t kHarmonicTerms = 64;
-/// The most machine errors named by --estimate (each a column of the design).
-inline constexpr std::size_t kEstimatedErrors = 64;
+/// The most terms in one harmonic series of the configuration: a runout or a wobble is stated in its first
+/// few harmonics. The model's work grows with the terms: eight series of 64 terms made `plan` take 4 s of CPU
+/// and `sensitivity` and `montecarlo` 6-7 s (issue 29); of 8 terms each, `plan` stays below a second.
+inline constexpr std::size_t kHarmonicTerms = 8;
+/// The most machine errors named by --estimate (each a column of the design). Self-calibration's work grows
+/// faster than their square (each Gauss-Newton iteration evaluates the model twice per error, and more errors
+/// need more iterations): `plan` took 0.9 s of CPU with 8, 6.6 s with 16 and over a minute with 64 (issue
+/// 29). The errors a test can separate from a sensor's coefficients are few: the radius and its stretch,
+/// the counter platform's perpendicularities and rate mismatch (docs/self_calibration.md).
+inline constexpr std::size_t kEstimatedErrors = 8;
 
 // ---- Records ----
 
@@ -118,9 +127,10 @@ inline constexpr double kCalibrationRateWindows = 300000;
 
 // ---- Results given to `report` ----
 
-/// The largest result file `report` reads, bytes. A calibration result is ~100 kB; a Monte Carlo result
-/// with its trials' draws a few MB.
-inline constexpr std::size_t kResultBytes = std::size_t{64} << 20;
+/// The largest result file `report` reads, bytes: 16 MiB. A calibration result is ~100 kB, a sensitivity
+/// study of 1,024 rows ~2 MB; Monte Carlo results do not grow with their trials. A result of 64 MiB (500,000
+/// positions) took `report` 0.9 GB and 11 s to draw as 100 MB of HTML (issue 29).
+inline constexpr std::size_t kResultBytes = std::size_t{16} << 20;
 /// The most distinct names in one result: the keys of its JSON objects, counted once each however often they
 /// occur (a sensor has 11 coefficients, an IMU 6 x 13; with the fields, the machine errors --estimate names
 /// and the Monte Carlo sources, a result has a few hundred). The report's tables are indexed by these names.
@@ -132,8 +142,7 @@ inline constexpr int kResultDepth = 64;
 /// The most JSON values in one result (each number, string, boolean, null, array and object counts one): 4
 /// Mi. The parsed result is held whole, ~100 B a value at worst (an empty object: 64 MiB of `{},` were 22
 /// million values and 2.3 GB; of `0,` 1.1 GB), so this keeps it under ~450 MB whatever the result (issue 29).
-/// A gyrocal result holds a few ten thousand values (a sensitivity study of 1,024 rows ~60,000); 64 MiB of
-/// numbers written with 17 digits are 3.5 million.
+/// A gyrocal result holds a few ten thousand values (a sensitivity study of 1,024 rows ~60,000).
 inline constexpr std::size_t kResultValues = std::size_t{1} << 22;
 /// The most cells of one table (or heat map) the report draws: rows x columns, counted from an array's length
 /// and the union of its entries' keys before any cell is built, so that a result within the limits above

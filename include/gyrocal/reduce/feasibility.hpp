@@ -25,6 +25,15 @@ int min_samples_per_revolution(const ReduceOptions& options);
 /// test has neither [test] static_hold_s nor a non-zero rate.
 double planned_test_samples(const TestSpec& test, double centrifuge_rate_rad_s);
 
+/// The longest time into a test, s: limits::kTestSamples samples at [test] sample_rate_hz (5e7 s at 200 Hz).
+/// Beyond it the main angle theta = Omega t of an instant loses every digit and then overflows.
+double longest_test_s(const TestSpec& test);
+
+/// Throws Error "<what> must be between -L s and L s, the longest test gyrocal runs (...), not <time_s>."
+/// when |time_s| exceeds longest_test_s(test) or is not finite: the one bound on an instant that `gyrocal
+/// inputs` and the Python module's exact_inputs share.
+void check_time_within_test(double time_s, const TestSpec& test, const std::string& what);
+
 /// The number of positions of the test, as test_positions (plan/positions.hpp) counts them: at each rate and
 /// counter rate offset, beta x gamma (a spinning set's gamma: spinning_gammas).
 double planned_positions(const TestSpec& test);
