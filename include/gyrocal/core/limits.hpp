@@ -147,12 +147,13 @@ inline constexpr std::size_t kResultValues = std::size_t{1} << 22;
 /// The most cells of one table (or heat map) the report draws: rows x columns, counted from an array's length
 /// and the union of its entries' keys before any cell is built, so that a result within the limits above
 /// cannot make a table of rows x names cells (50,000 rejected steady runs cycling through 4,000 keys were
-/// 200 million cells; `report` ran out of 2 GB; issue 29). 1,000,000 cells are a page a browser still
-/// renders (~50 MB of HTML); a real result's largest tables stay far inside: the dwell table of a
-/// 512-position test ~10,000 cells, the heat maps of 8 harmonic series x 64 terms x 2 phases x 13 estimates
-/// x 3 compensations ~40,000. A table beyond it is refused as a problem of its section, naming its rows x
-/// columns and this limit; the other sections are drawn (docs/report.md).
-inline constexpr std::size_t kReportTableCells = 1000000;
+/// 200 million cells; `report` ran out of 2 GB; issue 29). 250,000 cells: a result with every table and heat
+/// map at 1,000,000 cells peaked at 2.2 GB (a heat map's cell, with its tooltip, ~1 kB), so each is held to a
+/// quarter of that. A real result's largest tables stay far inside: the dwell table of a 512-position test
+/// ~10,000 cells, the heat maps of 8 harmonic series x 64 terms x 2 phases x 13 estimates x 3 compensations
+/// ~40,000. A table beyond it is refused as a problem of its section, naming its rows x columns and this
+/// limit; the other sections are drawn (docs/report.md).
+inline constexpr std::size_t kReportTableCells = 250000;
 
 // ---- Runs ----
 
