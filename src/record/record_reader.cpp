@@ -286,7 +286,7 @@ struct RecordReader::State {
     if (metadata.size() >= limits::kRecordMetadataLines) {
       fail(fmt::format(
           "the record holds more than {} metadata lines ('key = value') before its header, the limit "
-          "(gyrocal writes about 40); is the header line missing?",
+          "(gyrocal writes about 40): is the header line missing",
           limits::kRecordMetadataLines));
     }
     metadata_bytes += key.size() + value.size();
