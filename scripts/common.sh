@@ -29,10 +29,11 @@ ensure_packages() {
 
 # libjs-chart.js is inlined into the HTML report; chromium runs the report's browser test (docs/report.md).
 # What the build needs (libjs-chart.js: the plotting library the HTML report inlines; pybind11-dev, python3-dev and
-# python3-numpy: the Python module, built for Debian's /usr/bin/python3, docs/python.md).
+# python3-numpy: the Python module, built for Debian's /usr/bin/python3, docs/python.md; libsqlite3-dev: the
+# calibration history's database, embedded; libssl-dev: OpenSSL's libcrypto for the records' SHA-256, docs/history.md).
 GYROCAL_BUILD_PACKAGES=(g++ cmake make libeigen3-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
                         libfmt-dev libfast-float-dev libgtest-dev libbenchmark-dev libjs-chart.js
-                        pybind11-dev python3-dev python3-numpy)
+                        pybind11-dev python3-dev python3-numpy libsqlite3-dev libssl-dev)
 # What the tests need beyond the build: a headless browser that opens the report; pytest for the Python module.
 GYROCAL_TEST_PACKAGES=(chromium python3-pytest)
 
