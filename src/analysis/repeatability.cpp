@@ -103,7 +103,8 @@ Repeatability repeatability(std::span<const RunValue> values, const Repeatabilit
   r.run_to_run_std_high = bounds.high;
   r.std_ratio = s / r.mean_stated_std;
   // F(n-1, infinity): (n-1) X = chi2 ~ chi2(n-1) when the stated sigma explain the scatter.
-  r.f_test_p = regularized_gamma_q(0.5 * dof, 0.5 * chi2);
+  // (A chi2 that overflowed is beyond any doubt.)
+  r.f_test_p = std::isinf(chi2) ? 0.0 : regularized_gamma_q(0.5 * dof, 0.5 * chi2);
 
   // The trend: ordinary least squares of value against day, with n >= 3 and two different dates.
   const auto [first, last] = std::minmax_element(
