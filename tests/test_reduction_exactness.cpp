@@ -15,7 +15,8 @@
 // ~100 deg/h into the output at harmonics 5 and 7 of gamma, outside the dwell fit's harmonics 0 to 3: a
 // sample taken by one reduction and not the other moves its values far above rounding. The expected values
 // are the gyro's output equation (model/gyro.hpp) applied to the model's reduced channels with the scenario's
-// coefficients; the data's are the reducer's.
+// coefficients, or an accelerometer's design row (sensor/accelerometer.hpp) with its truth's products; the
+// data's are the reducer's.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -63,8 +65,11 @@ std::vector<testing::RigRow> rig(const Scenario& s, const testing::RigImperfecti
   return rows;
 }
 
+/// The rows reduced as calibrate reduces them for the scenario's sensor (reduction_plan: an accelerometer's
+/// spinning dwells at seven gamma, their whole harmonic content).
 Reduction reduce_rows(const Scenario& s, const std::vector<testing::RigRow>& rows) {
-  Reducer reducer(s.test, ReduceOptions{}, "rig.csv", s.centrifuge.rate_rad_s);
+  Reducer reducer(reduction_plan(s.test, s.sensor_kind, ReduceOptions{}), ReduceOptions{}, "rig.csv",
+                  s.centrifuge.rate_rad_s);
   for (const RecordSample& x : testing::as_samples(rows)) reducer.push(x);
   return reducer.finish();
 }
@@ -189,6 +194,71 @@ TEST(ReductionExactness, WhereTheChannelsFollowTheMeasuredMotionTheDataAndTheMod
   rows[a_measured_row(r, rows)].output += 1.0;
   const Mismatch moved = mismatch(s, reduce_rows(s, rows), ChannelRoute::kExact);
   EXPECT_GT(moved.worst, 1e-5);
+}
+
+TEST(ReductionExactness, AnAccelerometersDesignRowsAreReducedByTheOutputsOperator) {
+  // The same for an accelerometer (identify/sensor_channels.hpp): the default accelerometer's truth,
+  // noise-free, at 6 and 12 rad/s, its spinning dwells reduced to seven gamma; a ripple, spikes and a gap;
+  // each measured sample's output rewritten as the accelerometer's output at the joints the channels take.
+  // The model: the design row's known part plus its regressors times the truth's products
+  // (sensor/accelerometer.hpp).
+  Scenario s = exactness_scenario();
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  s.accelerometer.noise = AccelerometerNoise{};
+  s.test.rates_rad_s = {6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;
+  const CentrifugeModel model = s.model();
+  std::vector<testing::RigRow> rows = rig(s, imperfections(2e-4));
+  const Reduction first = reduce_rows(s, rows);
+  ASSERT_EQ(first.positions.size(), 56u);  // 2 rates x 4 beta x 7 gamma
+  const double k1 = s.accelerometer.coefficients[AccelCoefficient::K1];
+  std::size_t replaced = 0;
+  for (const Dwell& d : first.dwells) {
+    ASSERT_TRUE(d.measured.resolved && d.measured.quanta_resolved);
+    std::size_t row = 0;
+    for (std::size_t si = 0; si < d.stretches.size(); ++si) {
+      const TimeStretch& st = d.stretches[si];
+      if (si == 0) {
+        const auto it = std::lower_bound(rows.begin(), rows.end(), st.first_time_s - 1e-6,
+                                         [](const testing::RigRow& a, double v) { return a.time_s < v; });
+        ASSERT_NEAR(it->time_s, st.first_time_s, 1e-6);
+        row = static_cast<std::size_t>(it - rows.begin());
+      }
+      const double record_first_s = rows[row].time_s;
+      for (std::size_t i = 0; i < st.count; ++i, ++row) {
+        testing::RigRow& x = rows[row];
+        ASSERT_NEAR(x.time_s, record_first_s + static_cast<double>(i) * st.interval_s, 1e-6);
+        const double spike = x.output - s.accelerometer.output(exact_inputs(model, x.truth));
+        x.output = s.accelerometer.output(exact_inputs(model, measured_joints(d, si, i))) +
+                   (std::abs(spike) > 0.1 * k1 ? spike : 0.0);
+        ++replaced;
+      }
+    }
+  }
+  EXPECT_GT(replaced, 5000u);
+  const Reduction r = reduce_rows(s, rows);
+  ASSERT_EQ(r.positions.size(), first.positions.size());
+  EXPECT_EQ(r.outliers, first.outliers);
+  EXPECT_GE(r.outliers, 3u);
+  EXPECT_GE(r.gaps, 1u);
+  const Eigen::VectorXd u = s.accelerometer.products();
+  const auto worst = [&](const Reduction& x) {
+    const std::vector<PositionChannels> ch =
+        reduce_sensor_channels(x, model, ReduceOptions{}, Sensor{Accelerometer{}});
+    double w = 0.0;
+    for (std::size_t i = 0; i < x.positions.size(); ++i) {
+      const DesignRow& row = ch[i].sensor_exact;
+      double y = row.known;
+      for (std::size_t j = 0; j < row.size; ++j) y += u[static_cast<Eigen::Index>(j)] * row.regressors[j];
+      w = std::max(w, std::abs(x.positions[i].mean_deg_h - y));
+    }
+    return w;
+  };
+  EXPECT_LT(worst(r), 1e-12 * 12.0 * k1);
+
+  rows[a_measured_row(r, rows)].output += 1e-3 * k1;
+  EXPECT_GT(worst(reduce_rows(s, rows)), 1e-9 * k1);
 }
 
 }  // namespace
