@@ -39,53 +39,6 @@ void Reducer::State::reject(const Run& r, std::string reason) {
   }
 }
 
-void Reducer::State::end_run(std::string reason, Ending how) {
-  if (!run) return;
-  if (how == Ending::kRecordEnds) {
-    // The record ends while the run waits for two windows to agree: it is matched on its last window, so
-    // that a dwell cut short is measured (or refused) as one.
-    if (!run->decided && !run->guard.empty()) decide(*run, run->t_prev);
-    while (run && run->matched && !run->guard.empty()) {
-      const Run::Waiting w = run->guard.front();
-      run->guard.pop_front();
-      measure(w.u, w.gap, w.dropped, w.t_record);
-    }
-    if (!run) return;
-  }
-  // The machine left: the rows waiting in the guard are measured up to the first that lies further from
-  // the steady state than twice the measured rows did (the move's onset, found as the run's start is);
-  // from there on they are dropped.
-  bool onset = how != Ending::kLeft || !run->measuring;
-  while (run && !run->guard.empty()) {
-    const Run::Waiting w = run->guard.front();
-    onset = onset || !w.dev.within(run->steady_dev);
-    if (onset) break;
-    run->guard.pop_front();
-    measure(w.u, w.gap, w.dropped, w.t_record);
-  }
-  if (!run) return;
-  run->guard.for_each([&](const Run::Waiting& w) {
-    // Beyond the planned duration they would not have been measured anyway; before the match they are
-    // settle rows.
-    const bool beyond = run->measuring && w.u.t >= run->t_first + run->planned_duration - 1e-9;
-    ++(!run->decided ? run->quality.settle_rows
-       : beyond      ? run->quality.beyond_planned_rows
-                     : run->quality.before_leaving_rows);
-  });
-  run->guard.clear();
-  // The run's accumulator is moved and read below: the samples handed to the feed go in first.
-  feed->sync();
-  Run r = std::move(*run);
-  run.reset();
-  r.quality.ended = std::move(reason);
-  r.quality.run_start_s = r.start_s;
-  r.quality.run_end_s = r.end_s;
-  finish_run(r);
-  window.clear();
-  window_tested_at = -std::numeric_limits<double>::infinity();
-  for (const Row& q : r.held) take(q);
-}
-
 void Reducer::State::finish_run(Run& r) {
   if (!r.decided) {
     if (r.end_s - r.start_s < plan.settle_s)

@@ -54,15 +54,6 @@ void Reducer::push(const RecordSample& s) {
   state_->summary.add(s);
 }
 
-void Reducer::push_unsummarised(const RecordSample& s) {
-  State& st = *state_;
-  if (st.rows > 0 && !(s.time_s > st.t_last))
-    throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
-  ++st.rows;
-  st.t_last = s.time_s;
-  st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output});
-}
-
 std::size_t Reducer::dwells_held() const {
   return state_->dwells.size();
 }

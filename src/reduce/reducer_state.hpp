@@ -308,6 +308,9 @@ inline double heading_sweep_rad_s(double rate_rad_s, double offset_rad_s) {
 
 using namespace reduce_detail;  // the reducer's own types, in the files that include this internal header
 
+// The members of the per-row path are declared inline and defined in steady_runs.cpp, the one file that calls
+// them (Reducer::push_unsummarised is its entry): GCC then inlines them into one another as it did when they
+// were defined in the class, which the reducer's time per row depends on.
 struct Reducer::State {
   TestSpec plan;
   ReduceOptions options;
@@ -350,7 +353,7 @@ struct Reducer::State {
 
   // ---- Looking for a steady state -------------------------------------------------------------------
   /// Takes a row (raw encoder readings) while no run is in progress.
-  void look(const Row& raw);
+  inline void look(const Row& raw);
 
   /// docs/rate_platform.md: in a plan with counter rate offsets, a window whose main axis is at a planned
   /// rate (or stopped) while the platform's heading (theta + psi_r) turns at no planned offset is an offset
@@ -359,29 +362,29 @@ struct Reducer::State {
   /// matched on its last window, which still holds the ramp, and would be refused). A plain plan (the single
   /// offset 0) is not affected: there such a window starts a run, refused with its reason. The heading is
   /// held to rate_steadiness here, the tolerance the run's later windows must keep.
-  bool offset_ramp(double main_rate_rad_s, double counter_rate_rad_s) const;
+  inline bool offset_ramp(double main_rate_rad_s, double counter_rate_rad_s) const;
 
-  void take(const Row& raw);
+  inline void take(const Row& raw);
 
-  void take_one(const Row& raw);
+  inline void take_one(const Row& raw);
 
-  void start_run(const Row& first, const Line& th, const Line& ps, double beta);
+  inline void start_run(const Row& first, const Line& th, const Line& ps, double beta);
 
   /// Matches the run to the plan, on the rates of its last window (check_rate), at time t (run's clock).
-  void decide(Run& r, double t);
+  inline void decide(Run& r, double t);
 
   // ---- Following a steady run -----------------------------------------------------------------------
   /// Takes a row into the run; ends the run (and hands the rows it held back to look()) when the machine
   /// has left its steady state.
-  void follow(const Row& raw);
+  inline void follow(const Row& raw);
 
   /// The rate, window by window, against the run's (and the lines the next rows are predicted from). False
   /// when the run ended here.
-  bool check_rate(Run& r, const Row& u, double t, double t_record);
+  inline bool check_rate(Run& r, const Row& u, double t, double t_record);
 
   /// Takes a row of the measured part (on the run's clock) into the dwell; gap and dropped: the row follows
   /// a gap, or rows dropped as glitches.
-  void measure(const Row& u, bool gap, bool dropped, double t_record);
+  inline void measure(const Row& u, bool gap, bool dropped, double t_record);
 
   void reject(const Run& r, std::string reason);
 
