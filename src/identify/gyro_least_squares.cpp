@@ -1,0 +1,217 @@
+#include "least_squares_identify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Eigen/Cholesky>
+
+#include "gyrocal/core/limits.hpp"
+#include "gyrocal/identify/identifiability.hpp"
+#include "gyrocal/identify/unknowns.hpp"
+
+#include "fit_refusals.hpp"
+#include "position_covariance.hpp"
+
+namespace gyrocal::identify_detail {
+namespace {
+
+/// docs/physics.md section 15: the misalignments' unknowns carry (1 + e) dO and (1 + e) dS; the factor is
+/// divided out here. Then what the plan makes of the rate errors is said, not assumed: dO is excited only by
+/// the Earth rate's horizontal part, e without counter rate offsets only by the Earth rate.
+void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
+  CoefficientEstimate& e = r.rate_terms[0];
+  CoefficientEstimate& d_o = r.rate_terms[1];
+  CoefficientEstimate& d_s = r.rate_terms[2];
+  const double e_ppm = e.identifiable ? e.value : 0.0;
+  rate_terms_from_solution(e_ppm, d_o.value, d_s.value, d_o.std, d_s.std);
+  bool offsets = false, positive = false, negative = false;
+  for (const ReducedPosition& p : reduction.positions) {
+    offsets |= p.counter_rate_offset_rad_s != 0.0;
+    positive |= p.counter_rate_offset_rad_s > 0.0;
+    negative |= p.counter_rate_offset_rad_s < 0.0;
+  }
+  if (!offsets)
+    r.warnings.push_back(fmt::format(
+        "scale_factor_error_ppm: without counter rate offsets only the Earth rate (at most 15 deg/h) reaches "
+        "the input axis, so the scale-factor error is barely identifiable{}; add offsets of both signs "
+        "([test] "
+        "counter_rate_offsets_rad_s, docs/physics.md section 15).",
+        e.identifiable ? fmt::format(" (standard uncertainty {:.3g} ppm)", e.std) : std::string(" here")));
+  else if (!(positive && negative))
+    r.warnings.push_back(
+        "the counter rate offsets are all of one sign: the scale-factor error and the misalignment toward S "
+        "then separate from the counter rate mismatch and the drift less well than with offsets of both "
+        "signs "
+        "(docs/physics.md section 15).");
+  if (d_o.identifiable) {
+    r.warnings.push_back(fmt::format(
+        "input_axis_misalignment_O_arcsec is weakly identifiable (standard uncertainty {:.3g} arcsec): a "
+        "rotation about Up never turns the gyro about O, which stays horizontal, so only the Earth rate's "
+        "horizontal part (about 11 deg/h at 39 deg latitude) reaches it (docs/physics.md section 15).",
+        d_o.std));
+  } else {
+    d_o.reason =
+        "only the Earth rate's horizontal part reaches O (a rotation about Up never does), and this plan "
+        "cannot separate it (docs/physics.md section 15).";
+    r.warnings.push_back("input_axis_misalignment_O_arcsec is not identifiable from this plan: " +
+                         d_o.reason);
+  }
+  // Each rate error the plan leaves unidentifiable gets its reason, so that a study of the result (the
+  // sensitivity, the Monte Carlo) can say why it shows no number.
+  const char* const advice =
+      "; counter rate offsets of both signs ([test] counter_rate_offsets_rad_s) turn the gyro about I and S "
+      "(docs/physics.md section 15).";
+  for (CoefficientEstimate* c : {&e, &d_s})
+    if (!c->identifiable)
+      c->reason = offsets ? std::string(
+                                "this plan cannot separate it from the drift coefficients and the "
+                                "other rate errors (see the unidentifiable directions)") +
+                                advice
+                          : std::string(
+                                "without counter rate offsets only the Earth rate (at most 15 "
+                                "deg/h) turns the gyro about I and S") +
+                                advice;
+}
+
+}  // namespace
+
+void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+                            const CentrifugeModel& model, const CalibrationOptions& options,
+                            CalibrationResult& r, const ErrorColumns& extra,
+                            ErrorColumnsSolution* extra_solution) {
+  if (options.sensor != SensorKind::kGyro) {
+    sensor_least_squares(reduction, channels, options, r, extra, extra_solution);
+    return;
+  }
+  const auto m = static_cast<Eigen::Index>(reduction.positions.size());
+  const Unknowns unknowns = least_squares_unknowns(options.gyro_model);
+  // The unknowns, in this one place: the ten coefficients, the rate terms of the gyro model
+  // (identify/unknowns.hpp), then the estimated machine errors of a self-calibration.
+  const auto nc = static_cast<Eigen::Index>(unknowns.size());
+  const auto n = nc + extra.columns.cols();
+  std::vector<std::string> names = unknowns.names;
+  names.insert(names.end(), extra.names.begin(), extra.names.end());
+  // Generalised least squares: the positions of one dwell are correlated, so rows and observations are
+  // whitened by the Cholesky factor of their covariance and solved with unit (known) weights.
+  Eigen::MatrixXd design(m, n);
+  Eigen::VectorXd observations(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
+    const PositionChannels& ch = channels[static_cast<std::size_t>(i)];
+    const std::vector<double> x = design_row(ch, options.compensation, unknowns);
+    for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
+    for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
+    observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
+  }
+  check_finite(reduction, design, observations, channels, options.compensation);
+  refuse_repeated_positions(reduction);
+  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
+  // The weights come from the covariance with one level for the whole record (the levels pooled over the
+  // dwells by their degrees of freedom); the uncertainties from each dwell's own level (a sandwich). A few
+  // revolutions measure a dwell's level poorly, and weights that follow those errors favour the dwells whose
+  // noise was underestimated: z-scores of 1.2..1.4 at 3..6 revolutions (docs/calibration.md, "Degrees of
+  // freedom").
+  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
+  if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
+  IdentifiabilityOptions io;
+  io.least_squares = options.least_squares;
+  io.least_squares.rank_tolerance =
+      std::max(io.least_squares.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  io.least_squares.estimable_tolerance =
+      std::max(io.least_squares.estimable_tolerance, options.estimable_tolerance);
+  io.min_regressor_level = options.min_regressor_level;
+  io.named_tolerance = options.estimable_tolerance;
+  const Eigen::MatrixXd whitened_design = llt.matrixL().solve(design);
+  const Eigen::VectorXd whitened_observations = llt.matrixL().solve(observations);
+  refuse_overflowing_weighting(
+      reduction, observations, whitened_observations, "deg/h",
+      fmt::format("an output is at most {:g} deg/h, limits::kOutputMagnitude; [gyro] dF ... dOS at most {:g} "
+                  "deg/h per g^n, limits::kGyroCoefficient",
+                  limits::kOutputMagnitude, limits::kGyroCoefficient));
+  const CoefficientFit fit = fit_coefficients(design.leftCols(nc), whitened_design, whitened_observations,
+                                              r.g_level, reduction.positions, model, io, names);
+  const LeastSquaresSolution& sol = fit.solution;
+  r.rank = sol.rank;
+  r.unknowns = static_cast<int>(n);
+  r.condition_number = sol.effective_condition_number;
+  r.chi2 = sol.chi2;
+  r.dof = sol.dof;
+  // The estimate is G y with G = cov X~' L^-1 (X~ = L^-1 X, whitened): a combination c'x is the linear
+  // function (G'c)'y of the positions, whose standard uncertainty is widened for the degrees of freedom of
+  // their measured covariance.
+  const Eigen::MatrixXd gain =
+      sol.covariance * whitened_design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
+  const auto sandwich_std = [&](const Eigen::VectorXd& c, const std::string& name) {
+    const Eigen::VectorXd g = gain.transpose() * c;
+    double nu = 0.0;
+    const double factor = student_factor(reduction, covariance, g, &nu);
+    warn_few_dof(nu, name, r);
+    return std::sqrt(g.dot(covariance * g)) * factor;
+  };
+  for (std::size_t c = 0; c < unknowns.size(); ++c) {
+    const auto ci = static_cast<Eigen::Index>(c);
+    if (!sol.identifiable[c]) continue;
+    const CoefficientEstimate estimate = {
+        sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true, {}};
+    if (c < kNumCoefficients)
+      r.coefficients[c] = estimate;
+    else
+      r.rate_terms[c - kNumCoefficients] = estimate;
+  }
+  if (extra_solution != nullptr) {
+    ErrorColumnsSolution& e = *extra_solution;
+    const auto k = extra.columns.cols();
+    e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
+    e.std = e.value;
+    e.identifiable.assign(static_cast<std::size_t>(k), false);
+    e.covariance = gain * covariance * gain.transpose();
+    e.null_space = sol.null_space;
+    e.names = sol.names;
+    for (Eigen::Index j = 0; j < k; ++j) {
+      if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
+      e.identifiable[static_cast<std::size_t>(j)] = true;
+      e.value[j] = sol.estimate[nc + j];
+      e.std[j] = sandwich_std(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
+    }
+  }
+  if (options.gyro_model == GyroModel::kDriftRate) state_rate_terms(reduction, r);
+  // Residuals in deg/h, not in whitened units.
+  const Eigen::VectorXd residuals = observations - design * sol.estimate;
+  r.residuals_deg_h.clear();
+  for (Eigen::Index i = 0; i < m; ++i) r.residuals_deg_h.push_back(residuals[i]);
+  for (const std::string& w : sol.warnings) {
+    // Identifiability is said once, below, in the coefficients' terms.
+    if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
+      continue;
+    r.warnings.push_back("least squares: " + w);
+  }
+  if (fit.directions.empty()) return;
+  r.unidentifiable = fit.direction_texts;
+  r.combinations = fit.combinations;
+  // Each combination's uncertainty, like the coefficients', from each dwell's own level (the sandwich).
+  for (NamedEstimate& c : r.combinations)
+    c.std = sandwich_std(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), c.name);
+  std::string listed;
+  for (std::size_t k = 0; k < fit.direction_texts.size(); ++k)
+    listed += fmt::format("{}({}) {}", k ? "; " : "", k + 1, fit.direction_texts[k]);
+  std::string generic;
+  for (const NamedEstimate& c : fit.combinations)
+    if (c.name.rfind("combination ", 0) == 0)
+      generic += fmt::format(
+          " {} = {} is estimable instead (not one of docs/physics.md section 8's).", c.name,
+          describe_combination(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), sol.names));
+  const std::size_t k = fit.directions.size();
+  r.warnings.push_back(
+      fmt::format("{} direction{} of the coefficients cannot be identified from this plan: {}. {}{}", k,
+                  k > 1 ? "s" : "", listed, fit.advice, generic));
+  // The combinations are of the coefficients (the estimated errors are identifiable, so their part is
+  // rounding).
+  for (NamedEstimate& c : r.combinations) c.coefficients.resize(kNumCoefficients);
+}
+
+}  // namespace gyrocal::identify_detail

@@ -1,0 +1,18 @@
+#pragma once
+// Self-calibration (docs/physics.md section 12; docs/self_calibration.md): the machine errors named by
+// --estimate estimated with the sensor's coefficients by Gauss-Newton on the exact model. Internal to
+// src/identify.
+#include <vector>
+
+#include "gyrocal/identify/calibration.hpp"
+
+namespace gyrocal::identify_detail {
+
+/// `base` (a result holding the record's data quality and g-level) with the coefficients and the estimated
+/// machine errors of options.estimate; the errors the plan does not identify are reported with their reason
+/// and kept at their configured value.
+CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+                                 const CentrifugeModel& model, const CalibrationOptions& options,
+                                 const CalibrationResult& base);
+
+}  // namespace gyrocal::identify_detail
