@@ -240,6 +240,21 @@ TEST_F(HistoryCli, TheDefaultDatabaseAndTheConfigurationsOwn) {
   EXPECT_NE(o.err.find("history.database"), std::string::npos) << o.err;
 }
 
+TEST(HistoryConfiguration, TheDatabaseKeyRoundTrips) {
+  Scenario s = default_scenario();
+  EXPECT_TRUE(s.history_database.empty());
+  // The default configuration names the key, commented out, and reads back without it.
+  const std::string text = scenario_to_toml(s);
+  EXPECT_NE(text.find("# [history]"), std::string::npos);
+  EXPECT_NE(text.find("# database = \"gyrocal-history.sqlite\""), std::string::npos);
+  EXPECT_TRUE(parse_scenario(text, "c.toml").history_database.empty());
+  s.history_database = "lab/rig \"A\".sqlite";
+  EXPECT_EQ(parse_scenario(scenario_to_toml(s), "c.toml").history_database, s.history_database);
+  EXPECT_NE(test::config_error("[history]\ndatabase = \"\"\n").find("history.database"), std::string::npos);
+  EXPECT_NE(test::config_error("[history]\nfile = \"x\"\n").find("unknown key history.file"),
+            std::string::npos);
+}
+
 TEST_F(HistoryCli, CalibrateStoresTheRunInTheSameStep) {
   const std::string calibrate =
       "calibrate " + path("r.csv").string() + " --config " + path("c.toml").string();

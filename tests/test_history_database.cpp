@@ -230,6 +230,14 @@ TEST(HistoryRun, AnAccelerometerAndAnImu) {
   EXPECT_TRUE(ri.quality.misfit_tested);
   EXPECT_EQ(ri.quality.misfit_p_value, 0.01);  // the most significant channel's
   EXPECT_EQ(ri.quality.std_scale, 2.0);
+  // The same misfit kept in each channel's entry instead.
+  imu["channels"]["gx"]["misfit"] = imu["misfit"]["gx"];
+  imu["channels"]["ax"]["misfit"] = imu["misfit"]["ax"];
+  imu.erase("misfit");
+  const history::Run rc = run_from_result(imu, "imu.json");
+  EXPECT_TRUE(rc.quality.misfit_tested);
+  EXPECT_EQ(rc.quality.misfit_p_value, 0.01);
+  EXPECT_EQ(rc.quality.std_scale, 2.0);
 }
 
 TEST(HistoryRun, WhatIsNotACalibrationResultIsRefusedNamingFileAndKey) {
