@@ -160,7 +160,7 @@ TEST(HistorySummary, RefusesNoRunsAndADamagedDate) {
       history::summarize("SN1", {make_run(5, date, {coefficient("dF", 1.0, 0.1)})});
       ADD_FAILURE() << "accepted " << date;
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(fmt::format("run 5 of unit 'SN1' has the date '{}'", date)),
+      EXPECT_NE(std::string(e.what()).find(fmt::format("run 5 of unit 'SN1': '{}' is not a date", date)),
                 std::string::npos)
           << e.what();
     }

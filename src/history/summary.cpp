@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
-#include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
@@ -16,47 +14,10 @@
 namespace gyrocal::history {
 namespace {
 
-/// Days from 1970-01-01 to the civil date y-m-d (proleptic Gregorian; H. Hinnant, "chrono-Compatible
-/// Low-Level Date Algorithms", days_from_civil).
-long long days_from_civil(long long y, unsigned m, unsigned d) {
-  y -= m <= 2 ? 1 : 0;
-  const long long era = (y >= 0 ? y : y - 399) / 400;
-  const auto yoe = static_cast<unsigned>(y - era * 400);
-  const unsigned doy = (153 * (m > 2 ? m - 3 : m + 9) + 2) / 5 + d - 1;
-  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-  return era * 146097 + static_cast<long long>(doe) - 719468;
-}
-
-/// The digits text[at, at + count) as a number, or nothing.
-std::optional<unsigned> digits(std::string_view text, std::size_t at, std::size_t count) {
-  if (at + count > text.size()) return std::nullopt;
-  unsigned v = 0;
-  for (std::size_t i = at; i < at + count; ++i) {
-    if (text[i] < '0' || text[i] > '9') return std::nullopt;
-    v = v * 10 + static_cast<unsigned>(text[i] - '0');
-  }
-  return v;
-}
-
-/// A run's date (run.hpp: "YYYY-MM-DD" or "YYYY-MM-DDTHH:MM:SS", a trailing "Z" taken) as days since
-/// 1970-01-01 UTC, the trend's time axis. The history stores only dates it checked, so anything else is a
-/// database's damage: an Error naming the run.
+/// A run's date as days since 1970-01-01 UTC, the trend's time axis (run.hpp's days_since_epoch). The history
+/// stores only dates it checked, so a refusal here is a database's damage: the message names the run.
 double run_day(const Run& run) {
-  std::string_view t = run.date;
-  if (!t.empty() && t.back() == 'Z') t.remove_suffix(1);
-  const auto y = digits(t, 0, 4), m = digits(t, 5, 2), d = digits(t, 8, 2);
-  const bool date_ok = (t.size() == 10 || t.size() == 19) && t[4] == '-' && t[7] == '-' && y && m && d &&
-                       *m >= 1 && *m <= 12 && *d >= 1 && *d <= 31;
-  std::optional<unsigned> hh = 0, mm = 0, ss = 0;
-  if (date_ok && t.size() == 19) {
-    hh = digits(t, 11, 2), mm = digits(t, 14, 2), ss = digits(t, 17, 2);
-    if (t[10] != 'T' || t[13] != ':' || t[16] != ':' || !hh || !mm || !ss || *hh > 23 || *mm > 59 || *ss > 60)
-      hh.reset();
-  }
-  if (!date_ok || !hh)
-    throw Error(fmt::format("history: run {} of unit '{}' has the date '{}', not YYYY-MM-DD[THH:MM:SS].",
-                            run.id, run.unit, run.date));
-  return static_cast<double>(days_from_civil(*y, *m, *d)) + (*hh * 3600.0 + *mm * 60.0 + *ss) / 86400.0;
+  return days_since_epoch(run.date, fmt::format("run {} of unit '{}'", run.id, run.unit));
 }
 
 bool states(const std::optional<double>& value, const std::optional<double>& std) {
