@@ -1,6 +1,7 @@
 #include "gyrocal/core/special_functions.hpp"
 
 #include <cmath>
+#include <limits>
 
 // The regularised incomplete gamma and beta functions by their series and continued fractions (the modified
 // Lentz method; Numerical Recipes, sections 6.2 and 6.4). Q is taken from its continued fraction directly
@@ -100,6 +101,12 @@ double regularized_gamma_q(double a, double x) {
   if (x <= 0.0) return 1.0;
   if (x < a + 1.0) return 1.0 - gamma_front(a, x) * gamma_series(a, x);
   return gamma_front(a, x) * gamma_continued_fraction(a, x);
+}
+
+double student_t_two_sided_p(double t, double dof) {
+  if (std::isnan(t) || !(dof > 0.0) || !std::isfinite(dof)) return std::numeric_limits<double>::quiet_NaN();
+  if (std::isinf(t)) return 0.0;
+  return regularized_beta(0.5 * dof, 0.5, dof / (dof + t * t));
 }
 
 }  // namespace gyrocal
