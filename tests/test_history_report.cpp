@@ -278,6 +278,40 @@ TEST(HistoryReport, ChartsBeyondTheReportsCellsAreRefusedAsTheSectionsProblem) {
   EXPECT_EQ(count(section(html, "runs"), "<tr>"), 13u);
 }
 
+// From summarize() itself: ten runs whose dF scatters by its stated sigma but for run 6, 20 sigma off; the
+// individuals chart flags run 6 and the page marks it in the chart, the table and the runs.
+TEST(HistoryReport, ARunFarOutsideIsMarkedOnThePageOfSummarize) {
+  std::vector<gyrocal::history::Run> runs;
+  for (int i = 0; i < 10; ++i) {
+    gyrocal::history::Run r;
+    r.id = i + 1;
+    r.unit = "SN-1";
+    r.date = date_of(2 * i);
+    r.sensor = "gyro";
+    r.channels = {"gyro"};
+    r.record_sha256 = std::string(64, 'a');
+    gyrocal::history::CoefficientValue c;
+    c.channel = "gyro";
+    c.name = "dF";
+    c.unit = "deg/h";
+    c.identifiable = true;
+    c.value = 1.0 + 0.01 * ((i % 3) - 1) + (i == 5 ? 0.2 : 0.0);
+    c.std = 0.01;
+    r.coefficients.push_back(c);
+    runs.push_back(r);
+  }
+  const HistorySummary s = gyrocal::history::summarize("SN-1", runs);
+  ASSERT_EQ(s.coefficients.size(), 1u);
+  ASSERT_TRUE(s.coefficients[0].stats);
+  ASSERT_EQ(s.coefficients[0].stats->flagged, (std::vector<std::int64_t>{6}));
+  const std::string html = gyrocal::history_report_html(s);
+  const json plots = plot_descriptions(html);
+  ASSERT_EQ(plots.size(), 1u);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(plots[0]["flagged"][i].get<bool>(), i == 5) << i;
+  EXPECT_NE(section(html, "repeatability").find("<td class=\"far\""), std::string::npos);
+  EXPECT_NE(section(html, "runs").find(">dF</td>"), std::string::npos);
+}
+
 // In a real browser at a laptop's width (1366 px): no script error, every chart drawn with marks, no table
 // wider than its box, nothing wider than the window. The pages stay in the build tree
 // (tests/history_report_browser/) to be looked at.
