@@ -230,6 +230,14 @@ TEST(HistoryRun, AnAccelerometerAndAnImu) {
   EXPECT_TRUE(ri.quality.misfit_tested);
   EXPECT_EQ(ri.quality.misfit_p_value, 0.01);  // the most significant channel's
   EXPECT_EQ(ri.quality.std_scale, 2.0);
+  // The same misfit kept in each channel's entry instead.
+  imu["channels"]["gx"]["misfit"] = imu["misfit"]["gx"];
+  imu["channels"]["ax"]["misfit"] = imu["misfit"]["ax"];
+  imu.erase("misfit");
+  const history::Run rc = run_from_result(imu, "imu.json");
+  EXPECT_TRUE(rc.quality.misfit_tested);
+  EXPECT_EQ(rc.quality.misfit_p_value, 0.01);
+  EXPECT_EQ(rc.quality.std_scale, 2.0);
 }
 
 TEST(HistoryRun, WhatIsNotACalibrationResultIsRefusedNamingFileAndKey) {
@@ -480,6 +488,37 @@ TEST(HistoryDatabase, BadRunsAreRefusedBeforeAnythingIsWritten) {
   r.record_sha256 = "abc";
   EXPECT_NE(error_of([&] { db.add(r); }).find("record_sha256"), std::string::npos);
   EXPECT_TRUE(db.units().empty());
+  fs::remove_all(dir);
+}
+
+TEST(HistoryDatabase, AUnitHoldsAtMostTheLimitsRuns) {
+  const fs::path dir = fresh_test_folder("gyrocal-history");
+  const fs::path path = dir / "h.sqlite";
+  { Database created(path, Database::Mode::kCreateWrite); }
+  // limits::kHistoryRunsPerUnit runs of SN-1, written by another client in one transaction (fast), then one
+  // more.
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &h, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  ASSERT_EQ(
+      sqlite3_exec(h,
+                   ("WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < " +
+                    std::to_string(limits::kHistoryRunsPerUnit) +
+                    ") INSERT INTO runs (unit, date, date_days, date_source, sensor, record_path, "
+                    "record_sha256, config_sha256, gyrocal_version, method, compensation, note, rows_read, "
+                    "rows_used, outliers, gaps, misfit_tested, misfit_p_value, std_scale, added, "
+                    "result_json) SELECT 'SN-1', '2026-01-01', 20454, 'option', 'gyro', '', printf('%064d', "
+                    "i), '', '', '', '', '', 0, 0, 0, 0, 0, NULL, 1, '', '' FROM n; INSERT INTO channels "
+                    "SELECT id, 0, 'gyro' FROM runs")
+                       .c_str(),
+                   nullptr, nullptr, nullptr),
+      SQLITE_OK)
+      << sqlite3_errmsg(h);
+  sqlite3_close(h);
+  Database db(path, Database::Mode::kReadWrite);
+  const std::string e = error_of([&] { db.add(make_run("SN-1", "one more", "2026-01-02")); });
+  EXPECT_NE(e.find("kHistoryRunsPerUnit"), std::string::npos) << e;
+  EXPECT_NE(e.find(std::to_string(limits::kHistoryRunsPerUnit) + " runs"), std::string::npos) << e;
+  EXPECT_NO_THROW(db.add(make_run("SN-2", "one more", "2026-01-02")));
   fs::remove_all(dir);
 }
 

@@ -180,7 +180,19 @@ void read_quality(const nlohmann::json& result, std::string_view result_name, Ru
     run.quality.gaps = optional_count(*dq, "gaps", result_name, "data_quality");
   }
   const auto m = result.find("misfit");
-  if (m == result.end() || m->is_null()) return;
+  if (m == result.end() || m->is_null()) {
+    // An IMU whose misfit is kept in each channel's entry.
+    const auto channels = result.find("channels");
+    if (channels == result.end() || !channels->is_object()) return;
+    bool first = true;
+    for (const auto& [name, ch] : channels->items()) {
+      const auto cm = ch.is_object() ? ch.find("misfit") : ch.end();
+      if (!ch.is_object() || cm == ch.end() || cm->is_null()) continue;
+      fold_misfit(*cm, result_name, "channels." + name + ".misfit", run.quality, first);
+      first = false;
+    }
+    return;
+  }
   if (!m->is_object()) wrong_type(result_name, "misfit", *m, "an object");
   // A lone sensor's {tested, p_value, std_scale}, or an IMU's one such object per channel.
   if (m->contains("tested") || m->contains("p_value") || m->contains("std_scale")) {
