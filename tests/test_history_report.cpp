@@ -197,6 +197,8 @@ TEST(HistoryReport, ShowsTheUnitTheTableAChartPerCoefficientAndTheRuns) {
   // The table: a row per coefficient; the F-test's p below 0.01 and the flagged run shaded, the others not.
   const std::string table = section(html, "repeatability");
   EXPECT_EQ(count(table, "<tr>"), 4u);  // the header and three coefficients
+  EXPECT_EQ(count(table, "<th>"), 11u);
+  EXPECT_EQ(count(table, "<td"), 3u * 11u) << "a row with more or fewer cells than the header";
   EXPECT_NE(table.find("class=\"num far\" title=\"the stated \xCF\x83 do not explain"), std::string::npos);
   EXPECT_EQ(count(table, "class=\"num far\""), 1u) << "only dF's F-test p is below 0.01";
   EXPECT_NE(table.find("<td class=\"far\""), std::string::npos);

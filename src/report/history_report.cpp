@@ -80,7 +80,7 @@ std::vector<Cell> repeatability_row(const QuantityHistory& q) {
   row.push_back(num_cell(runs_text, "", unidentified));
   if (!q.stats) {
     row.push_back(text_cell("not identified by any run"));
-    for (int k = 0; k < 8; ++k) row.push_back(text_cell(kDash));
+    for (int k = 0; k < 7; ++k) row.push_back(text_cell(kDash));  // to the table's 11 columns
     return row;
   }
   const Repeatability& r = *q.stats;
