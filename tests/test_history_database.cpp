@@ -574,6 +574,10 @@ TEST(HistoryDatabase, FilesThatAreNotAGyrocalHistoryAreRefusedAndLeftUntouched) 
       error_of([&] { Database db(dir / "none.sqlite", Database::Mode::kReadWrite); }).find("does not exist"),
       std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "none.sqlite"));
+  EXPECT_NE(error_of([&] {
+              Database db(dir / "no" / "h.sqlite", Database::Mode::kCreateWrite);
+            }).find("its folder " + (dir / "no").string() + " does not exist"),
+            std::string::npos);
   // A folder.
   EXPECT_NE(error_of([&] { Database db(dir, Database::Mode::kCreateWrite); }).find("not a regular file"),
             std::string::npos);

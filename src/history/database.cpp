@@ -363,6 +363,10 @@ void create_if_missing(const fs::path& path) {
   if (errno != ENOENT)
     throw Error(fmt::format("Cannot open the history database {}: {}.", path.string(), std::strerror(errno)));
   const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec))
+    throw Error(fmt::format("Cannot create the history database {}: its folder {} does not exist.",
+                            path.string(), folder.string()));
   std::random_device rd;
   const fs::path temp =
       folder / fmt::format(".{}.{}-{:08x}.creating", path.filename().string(), ::getpid(), rd());
