@@ -21,6 +21,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/history/read.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/channels.hpp"
 #include "gyrocal/identify/record_check.hpp"
@@ -30,6 +31,7 @@
 #include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/history_json.hpp"
 #include "gyrocal/result/noise_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -258,6 +260,44 @@ void check_output_column_py(const std::string& column, const Scenario& scenario,
   require_output_column_for_sensor(column, scenario.sensor_kind, name, kScenarioName);
 }
 
+/// `gyrocal history show --unit UNIT --db DB --json` as a dict (without the file's marker), read by the same
+/// library function (history::read_unit_history, refusing as the command line does), with each quantity's
+/// runs also as arrays beside its "runs": "values" and "stds" (float64, the quantity's unit), "days"
+/// (float64, days since 1970-01-01 UTC) and "run_ids" (int64), in date order.
+py::object history_py(const std::string& db, const std::string& unit) {
+  history::HistorySummary summary;
+  nlohmann::ordered_json j;
+  {
+    py::gil_scoped_release release;
+    summary = history::read_unit_history(db, unit);
+    j = history_to_json(summary);
+  }
+  py::dict out = json_to_python(j);
+  const auto add_arrays = [](py::dict entry, const history::QuantityHistory& q) {
+    const auto n = static_cast<py::ssize_t>(q.values.size());
+    py::array_t<double> values(n), stds(n), days(n);
+    py::array_t<std::int64_t> ids(n);
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const RunValue& v = q.values[static_cast<std::size_t>(i)];
+      values.mutable_at(i) = v.value;
+      stds.mutable_at(i) = v.std;
+      days.mutable_at(i) = v.day;
+      ids.mutable_at(i) = v.run_id;
+    }
+    entry["values"] = values;
+    entry["stds"] = stds;
+    entry["days"] = days;
+    entry["run_ids"] = ids;
+  };
+  py::dict channels = out["channels"];
+  for (const history::QuantityHistory& q : summary.coefficients)
+    add_arrays(channels[py::str(q.channel)].cast<py::dict>()[py::str(q.name)].cast<py::dict>(), q);
+  py::dict machine = out["machine_errors"];
+  for (const history::QuantityHistory& q : summary.machine_errors)
+    add_arrays(machine[py::str(q.name)].cast<py::dict>(), q);
+  return out;
+}
+
 }  // namespace
 }  // namespace gyrocal
 
@@ -313,4 +353,5 @@ PYBIND11_MODULE(_gyrocal, m) {
   m.def("_noise_path", &noise_path_py);
   m.def("_noise_arrays", &noise_arrays_py);
   m.def("_check_output_column", &check_output_column_py);
+  m.def("_history", &history_py, py::arg("db"), py::arg("unit"));
 }

@@ -18,6 +18,7 @@
 #include "gyrocal/history/sha256.hpp"
 #include "gyrocal/record/record.hpp"
 #include "gyrocal/report/html_report.hpp"
+#include "history_show.hpp"
 
 namespace gyrocal::cli {
 
@@ -225,6 +226,7 @@ void register_history(CLI::App& app) {
                                           : "record file's time",
               db_path.string());
   });
+  register_history_show(*history);  // history show (cmd_history_show.cpp)
 }
 
 }  // namespace gyrocal::cli

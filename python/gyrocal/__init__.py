@@ -6,6 +6,7 @@
     rec = gyrocal.simulate(sc, seed=1)                 # dict of numpy arrays named as the record's columns
     res = gyrocal.calibrate(rec, sc, method="least-squares", compensation="full")
     nz = gyrocal.noise("static.csv", sc)               # noise's JSON as a dict
+    h = gyrocal.history("gyrocal-history.sqlite", "SN123")  # `history show --json` as a dict, with arrays
 
 Every error of gyrocal raises ValueError with the command line's sentence; an argument of a plainly wrong Python
 type raises ArgumentTypeError, a TypeError that is also a ValueError, naming the argument in one sentence.
@@ -22,7 +23,8 @@ import numpy as np
 from ._gyrocal import Scenario
 from . import _gyrocal
 
-__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "RECORD_COLUMNS", "ArgumentTypeError"]
+__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "history", "RECORD_COLUMNS",
+           "ArgumentTypeError"]
 
 #: The record's required columns, in order (docs/contract.md, "Record (CSV)").
 RECORD_COLUMNS = ("time_s", "main_angle_deg", "counter_angle_deg", "position_angle_deg", "gyro_deg_h")
@@ -307,6 +309,20 @@ def noise(rec, scenario=None):
         column = _ACCEL_COLUMN if _has_column(rec, _ACCEL_COLUMN) and not _has_column(rec, _GYRO_COLUMN) \
             else _GYRO_COLUMN
     return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, column), column, _ARRAYS_NAME)
+
+
+@_arguments(db=_path, unit=_name)
+def history(db, unit):
+    """`gyrocal history show --unit UNIT --db DB --json` as a dict: the unit, its sensor, its runs
+    ([{id, date, record_sha256, note, date_source, gyrocal_version, flags}]), and per channel's coefficient
+    (d["channels"][CHANNEL][COEFFICIENT]) and per machine error of the rig (d["machine_errors"][ERROR]) an
+    entry with the runs' values and their repeatability (mean, run_to_run_std, f_test_p, trend_per_day, limits,
+    flagged, ...; docs/history.md). Each entry also holds its runs as arrays, in date order: "values" and "stds"
+    (float64, in the entry's "unit"), "days" (float64, days since 1970-01-01 UTC:
+    pandas.to_datetime(e["days"], unit="D")) and "run_ids" (int64). The database (a path) is opened read-only
+    and never created; a missing database, one that is not a gyrocal history, or a unit it does not hold
+    (the sentence lists the units it has) raises ValueError with the command line's sentence."""
+    return _gyrocal._history(db, unit)
 
 
 # --- Scenario.load and Scenario.parse: the compiled class's, with their arguments checked as above -------------

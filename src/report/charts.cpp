@@ -52,4 +52,23 @@ json LogLogChart::to_json() const {
           {"ylabel", ylabel}};
 }
 
+json ControlChart::to_json() const {
+  return {{"kind", "control"},
+          {"points", points},
+          {"low", low},
+          {"high", high},
+          {"tips", tips},
+          {"flagged", flagged},
+          {"mean", mean},
+          {"limits", limits},
+          {"ewma", ewma},
+          {"ewma_low", ewma_low},
+          {"ewma_high", ewma_high},
+          {"ewma_tips", ewma_tips},
+          {"ewma_flagged", ewma_flagged},
+          {"title", title},
+          {"ylabel", ylabel},
+          {"mean_label", mean_label}};
+}
+
 }  // namespace gyrocal::report

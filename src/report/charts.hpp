@@ -58,4 +58,21 @@ struct LogLogChart {
   nlohmann::json to_json() const;
 };
 
+/// A control chart (kind "control"): each run's value (points [{x, y}], x its date in days since 1970-01-01
+/// UTC, which the page writes as a date) with its error bar [low, high] and its tip, marked where `flagged`
+/// (one boolean per point); the mean as a line (null = none); the Shewhart limits [low, high] as two lines
+/// (null = none); the EWMA per run (ewma [{x, y}], empty = none) with its limits per run (ewma_low,
+/// ewma_high), its tips, and marked where `ewma_flagged`.
+struct ControlChart {
+  nlohmann::json points = nlohmann::json::array(), low = nlohmann::json::array(),
+                 high = nlohmann::json::array(), tips = nlohmann::json::array(),
+                 flagged = nlohmann::json::array();
+  nlohmann::json mean, limits;
+  nlohmann::json ewma = nlohmann::json::array(), ewma_low = nlohmann::json::array(),
+                 ewma_high = nlohmann::json::array(), ewma_tips = nlohmann::json::array(),
+                 ewma_flagged = nlohmann::json::array();
+  std::string title, ylabel, mean_label;
+  nlohmann::json to_json() const;
+};
+
 }  // namespace gyrocal::report

@@ -248,6 +248,7 @@ std::string result_kind(const nlohmann::json& result) {
   if (result.contains("rows") && !result.contains("coefficients")) return "sensitivity";
   if (result.contains("budget") || result.contains("trials")) return "montecarlo";
   if (result.contains("specific_force_g") && result.contains("nominal")) return "inputs";
+  if (result.contains("unit") && result.contains("channels") && result.contains("runs")) return "history";
   return "calibration";
 }
 

@@ -151,6 +151,75 @@
         }
       };
     },
+    // A control chart against the date (x in days since 1970-01-01 UTC, written as dates): each run's value
+    // (flagged runs as red triangles) with its error bar (a broken line, as loglog's), the mean, the Shewhart
+    // limits, and the EWMA with its limits per run (EWMA points that left them larger).
+    control: function (s) {
+      var x0 = Infinity, x1 = -Infinity;
+      s.points.forEach(function (p) { x0 = Math.min(x0, p.x); x1 = Math.max(x1, p.x); });
+      var pad = x1 > x0 ? (x1 - x0) * 0.04 : 1;
+      x0 -= pad; x1 += pad;
+      var span = x1 - x0;
+      function date(v) {
+        var t = new Date(v * 86400000);
+        if (isNaN(t.getTime())) return String(v);
+        var iso = t.toISOString();
+        return span < 4 ? iso.slice(0, 10) + ' ' + iso.slice(11, 16) : iso.slice(0, 10);
+      }
+      var bars = [];
+      s.points.forEach(function (p, i) {
+        if (s.low[i] === null || s.high[i] === null) return;
+        bars.push({ x: p.x, y: s.low[i] }, { x: p.x, y: s.high[i] }, { x: p.x, y: null });
+      });
+      var red = '#d62728', blue = '#2166ac', orange = '#e08214';
+      var datasets = [
+        { label: 'runs (value \u00b1 \u03c3)', data: s.points, tips: s.tips, showLine: false, order: 0,
+          pointStyle: s.flagged.map(function (f) { return f ? 'triangle' : 'circle'; }),
+          pointRadius: s.flagged.map(function (f) { return f ? 7 : 4; }), pointHoverRadius: 8,
+          borderColor: s.flagged.map(function (f) { return f ? red : blue; }),
+          backgroundColor: s.flagged.map(function (f) { return f ? red : blue; }) },
+        { label: '\u03c3 of each run', data: bars, showLine: true, spanGaps: false, pointRadius: 0, pointHitRadius: 0,
+          borderColor: 'rgba(33,102,172,0.5)', borderWidth: 2, order: 1 }
+      ];
+      if (s.mean !== null)
+        datasets.push({ label: s.mean_label, data: [{ x: x0, y: s.mean }, { x: x1, y: s.mean }], showLine: true,
+                        pointRadius: 0, pointHitRadius: 0, borderColor: '#1f2328', borderWidth: 1.5, order: 2 });
+      if (s.limits !== null)
+        datasets.push({ label: 'Shewhart limits', showLine: true, spanGaps: false, pointRadius: 0, pointHitRadius: 0,
+                        data: [{ x: x0, y: s.limits[1] }, { x: x1, y: s.limits[1] }, { x: x1, y: null },
+                               { x: x0, y: s.limits[0] }, { x: x1, y: s.limits[0] }],
+                        borderColor: red, borderWidth: 1.5, borderDash: [6, 4], order: 3 });
+      if (s.ewma.length > 0) {
+        datasets.push({ label: 'EWMA', data: s.ewma, tips: s.ewma_tips, showLine: true, order: 4,
+                        pointRadius: s.ewma_flagged.map(function (f) { return f ? 6 : 2; }),
+                        pointStyle: s.ewma_flagged.map(function (f) { return f ? 'rectRot' : 'circle'; }),
+                        borderColor: orange, backgroundColor: orange, borderWidth: 1.5 });
+        var lim = [];
+        s.ewma.forEach(function (p, i) { lim.push({ x: p.x, y: s.ewma_high[i] }); });
+        lim.push({ x: s.ewma[s.ewma.length - 1].x, y: null });
+        s.ewma.forEach(function (p, i) { lim.push({ x: p.x, y: s.ewma_low[i] }); });
+        datasets.push({ label: 'EWMA limits', data: lim, showLine: true, spanGaps: false, pointRadius: 0,
+                        pointHitRadius: 0, borderColor: orange, borderWidth: 1, borderDash: [2, 3], order: 5 });
+      }
+      return {
+        type: 'scatter',
+        data: { datasets: datasets },
+        options: {
+          plugins: {
+            title: title(s.title),
+            legend: { position: 'bottom', labels: { boxWidth: 14, font: { size: 11 } } },
+            tooltip: { filter: function (c) { return !!c.dataset.tips; },
+                       callbacks: { title: function () { return ''; },
+                                    label: function (c) { return c.dataset.tips[c.dataIndex]; } } }
+          },
+          scales: {
+            x: { type: 'linear', min: x0, max: x1,
+                 ticks: { maxTicksLimit: 6, maxRotation: 0, callback: function (v) { return date(v); } } },
+            y: { title: title(s.ylabel) }
+          }
+        }
+      };
+    },
     scatter: function (s) {
       return {
         type: 'scatter',
@@ -202,6 +271,13 @@
     }
   });
   body.setAttribute('data-plots-rendered', String(rendered));
+  // Tables wider than their box (which then scrolls sideways): how many, for the checks on the page's width.
+  var wide = 0;
+  Array.prototype.forEach.call(document.querySelectorAll('.table-wrap'), function (w) {
+    if (w.scrollWidth > w.clientWidth + 1) wide += 1;
+  });
+  body.setAttribute('data-wide-tables', String(wide));
+  body.setAttribute('data-page-overflow', String(document.documentElement.scrollWidth > window.innerWidth));
   // Charts size themselves to their boxes; the printed page has other boxes.
   window.addEventListener('beforeprint', function () { charts.forEach(function (c) { c.resize(); }); });
   window.addEventListener('afterprint', function () { charts.forEach(function (c) { c.resize(); }); });

@@ -44,9 +44,10 @@ nlohmann::json read_result_file(const std::filesystem::path& path);
 /// replace an earlier result of gyrocal without --force.
 inline constexpr std::string_view kResultMarkerKey = "gyrocal";
 
-/// The kinds of result gyrocal writes, as the marker names them.
-inline constexpr std::string_view kResultKinds[] = {"calibration", "plan",  "sensitivity",
-                                                    "montecarlo",  "noise", "inputs"};
+/// The kinds of result gyrocal writes, as the marker names them ("history": `history show --json`, a unit's
+/// calibration history, which has no page of its own here: report --history draws it from the database).
+inline constexpr std::string_view kResultKinds[] = {"calibration", "plan",   "sensitivity", "montecarlo",
+                                                    "noise",       "inputs", "history"};
 
 /// Adds gyrocal's marker to `result` (a JSON object): `"gyrocal": {"result": kind, "version": this
 /// gyrocal's}`.
@@ -59,8 +60,8 @@ bool has_result_marker(const nlohmann::json& result);
 
 /// The kind of a result: its marker's, else (a result written before the marker, or by Python) from its
 /// shape: `allan` = noise, `rows` without `coefficients` = sensitivity, `budget` or `trials` = montecarlo,
-/// `specific_force_g` = inputs, anything else a calibration (a calibration, a plan or the demo's
-/// result.json).
+/// `specific_force_g` = inputs, `unit` with `channels` and `runs` = history, anything else a calibration (a
+/// calibration, a plan or the demo's result.json).
 std::string result_kind(const nlohmann::json& result);
 
 /// Renders the HTML report of `result`, the page of its kind (result_kind): a calibration or plan result (a
