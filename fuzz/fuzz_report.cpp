@@ -6,7 +6,8 @@
 // section it cannot read into a problem sentence. A clean refusal (gyrocal::Error) is fine; anything else
 // escaping, a crash, a leak or undefined behaviour is a finding. So is a problem sentence that carries a
 // library's internal message (nlohmann::json's "[json.exception...]") instead of one of ours, and a file
-// read that answers otherwise than the same bytes parsed in memory.
+// read that answers otherwise than the same bytes parsed in memory. The same JSON is also read as `history
+// add` reads it (history::run_from_result): a run with a channel and a coefficient, or a refusal of ours.
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/history/run.hpp"
 #include "gyrocal/report/html_report.hpp"
 
 namespace {
@@ -68,6 +70,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (in_memory.refusal) return 0;  // a clean refusal
   const nlohmann::json& result = in_memory.result;
+
+  // `history add` reads the same file into a run (src/history/run.cpp): a run, or a refusal of ours.
+  try {
+    const gyrocal::history::Run run = gyrocal::history::run_from_result(result, "fuzz.json");
+    if (run.channels.empty() || run.coefficients.empty()) std::abort();
+  } catch (const gyrocal::Error& e) {
+    if (std::string_view(e.what()).find("[json.exception.") != std::string_view::npos) {
+      std::fprintf(stderr, "internal message in a history refusal: %s\n", e.what());
+      std::abort();
+    }
+  }
 
   if (gyrocal::report_sections_present(result).empty()) return 0;  // `report` refuses it by name
   std::vector<std::string> problems;

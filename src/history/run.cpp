@@ -2,14 +2,18 @@
 // (history/run.hpp, docs/history.md).
 #include "gyrocal/history/run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/sensor/accelerometer.hpp"
+#include "gyrocal/sensor/gyro_sensor.hpp"
 
 namespace gyrocal::history {
 namespace {
@@ -99,6 +103,25 @@ std::string sensor_of(const nlohmann::json& object, std::string_view result_name
   if (s == "accelerometer") return "accelerometer";
   throw Error(fmt::format("{}: {} is '{}', not \"gyro\" or \"accelerometer\".", result_name,
                           key.empty() ? std::string("sensor") : key + ".sensor", s));
+}
+
+/// Puts out[first, end) in the order of `sensor`'s parameter table (dF dI dO dS dII ... for a gyro, K0 K1 K2
+/// ... for an accelerometer), as a result writes and a lab reads them: a parsed result's object comes sorted
+/// by name. A name the table does not hold keeps its place after the table's.
+void in_table_order(std::vector<CoefficientValue>& out, std::size_t first, std::string_view sensor) {
+  Gyro gyro;
+  gyro.model = GyroModel::kDriftRate;  // the table with the rate terms, a superset of the drift model's
+  const std::span<const SensorParameter> table =
+      sensor == "accelerometer" ? std::span<const SensorParameter>(kAccelerometerParameters)
+                                : gyro.parameters();
+  const auto rank = [&table](const CoefficientValue& v) {
+    std::size_t i = 0;
+    while (i < table.size() && table[i].name != v.name) ++i;
+    return i;
+  };
+  std::stable_sort(
+      out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
+      [&rank](const CoefficientValue& a, const CoefficientValue& b) { return rank(a) < rank(b); });
 }
 
 /// The coefficients object `c` (key: its path in the result, for messages) of `channel`, appended to `out`.
@@ -261,11 +284,13 @@ Run run_from_result(const nlohmann::json& result, std::string_view result_name) 
     for (const auto& [name, ch] : channels->items()) {
       const std::string k = "channels." + name;
       if (!ch.is_object()) wrong_type(result_name, k, ch, "an object {sensor, coefficients, ...}");
-      sensor_of(ch, result_name, k);
+      const std::string sensor = sensor_of(ch, result_name, k);
       const auto c = ch.find("coefficients");
       if (c == ch.end()) throw Error(fmt::format("{}: {} has no key coefficients.", result_name, k));
       run.channels.push_back(name);
+      const std::size_t first = run.coefficients.size();
       read_coefficients(*c, name, result_name, k + ".coefficients", run.coefficients);
+      in_table_order(run.coefficients, first, sensor);
     }
   } else {
     run.sensor = sensor_of(result, result_name, "");
@@ -274,6 +299,7 @@ Run run_from_result(const nlohmann::json& result, std::string_view result_name) 
     if (c == result.end())
       throw Error(fmt::format("{}: a calibration result without the key coefficients.", result_name));
     read_coefficients(*c, run.sensor, result_name, "coefficients", run.coefficients);
+    in_table_order(run.coefficients, 0, run.sensor);
   }
   read_machine_errors(result, result_name, run);
   read_quality(result, result_name, run);
