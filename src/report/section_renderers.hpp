@@ -2,7 +2,7 @@
 // The render functions of a result's sections and what they share, private to src/report (docs/report.md):
 // one file per kind of section; sections.cpp, sensitivity_sections.cpp and montecarlo_sections.cpp hold the
 // tables of the three pages (sections.hpp). Each render function draws its section of `result` into `out`
-// (its plots through `page`) and throws ReportError on a malformed section.
+// (its plots through `page`) and throws gyrocal::Error on a malformed section (its page shows the sentence).
 #include <optional>
 #include <string>
 #include <string_view>
