@@ -1,6 +1,7 @@
 #pragma once
 // Shared pieces of the command line: reading the configuration, writing outputs. No physics here.
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -12,6 +13,7 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/atomic_file.hpp"
 #include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/record/record.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
@@ -132,6 +134,31 @@ extern const CLI::Validator kSeed;
 /// the same message; the command refuses the rest of the range itself, with its reason (montecarlo --trials).
 CLI::Validator integer_between(long long least, long long most, bool check_range = true);
 
+// ---- The calibration history (docs/history.md) ----
+
+/// The history database a command uses: `option` (--db, --history) when given; else [history] database of
+/// `scenario` (a relative path taken from the folder of the configuration file `config_path`); else
+/// history::kDefaultDatabase in the current folder.
+std::filesystem::path history_database_path(const std::string& option, const Scenario* scenario,
+                                            const std::string& config_path);
+
+/// A run's date (ISO 8601, UTC) and where it came from ("option", "metadata", "file time").
+struct RunDate {
+  std::string date, source;
+};
+
+/// The date of a run (docs/history.md, "The run's date"): `date_option` (--date) when given; else the
+/// record's `date` metadata (`metadata`, when the record's head could be read; `record_name` names it); else
+/// the modification time, in UTC, of the record file at `record_file` (empty: none). Throws gyrocal::Error
+/// naming
+/// --date for a bad --date, the record for a bad metadata date, and asking for --date when there is no date.
+RunDate run_date(const std::string& date_option, const RecordMetadata* metadata,
+                 const std::string& record_name, const std::string& record_file);
+
+/// The checks of --unit, --note and --date before any work (the database checks them again when it adds):
+/// the serial's and the note's lengths (limits::kHistoryUnitBytes, kHistoryNoteBytes), a date that exists.
+void check_run_options(const std::string& unit, const std::string& note, const std::string& date);
+
 /// Each subcommand registers itself on the application.
 void register_init(CLI::App& app);
 void register_inputs(CLI::App& app);
@@ -143,5 +170,6 @@ void register_sensitivity(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 void register_report(CLI::App& app);
 void register_noise(CLI::App& app);
+void register_history(CLI::App& app);
 
 }  // namespace gyrocal::cli

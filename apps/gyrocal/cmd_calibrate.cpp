@@ -1,11 +1,19 @@
-// gyrocal calibrate RECORD: reduce a record and identify the drift coefficients.
+// gyrocal calibrate RECORD: reduce a record and identify the drift coefficients; with --history, store the
+// run in the calibration history (docs/history.md).
+#include <sys/stat.h>
+
 #include <fmt/format.h>
 
 #include "cli.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/history/database.hpp"
+#include "gyrocal/history/run.hpp"
+#include "gyrocal/history/sha256.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "tables.hpp"
 
@@ -14,8 +22,9 @@ namespace gyrocal::cli {
 void register_calibrate(CLI::App& app) {
   struct Options {
     std::string record, config, json, method = "least-squares", compensation = "full", estimate;
-    std::string gyro_model;  // empty: [calibration] gyro_model
-    std::string reduction;   // empty: [calibration] reduction
+    std::string gyro_model;                 // empty: [calibration] gyro_model
+    std::string reduction;                  // empty: [calibration] reduction
+    std::string history, unit, date, note;  // --history FILE --unit SERIAL [--date D] [--note T]
     bool force = false;
   };
   auto opt = std::make_shared<Options>();
@@ -40,10 +49,50 @@ void register_calibrate(CLI::App& app) {
   add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   add_force_flag(sub, opt->force);
+  sub->add_option(
+      "--history", opt->history,
+      "Store the run in this history database (SQLite; created if missing; docs/history.md), with "
+      "--unit");
+  sub->add_option("--unit", opt->unit, "With --history: the calibrated unit's serial");
+  sub->add_option("--date", opt->date,
+                  "With --history: the run's date, YYYY-MM-DD[THH:MM:SS] in UTC; default: the record's "
+                  "'# date = ...' metadata, else the record file's time");
+  sub->add_option("--note", opt->note, "With --history: a note kept with the run");
   sub->callback([opt] {
+    // --history and --unit go together; --date and --note only with them (docs/history.md).
+    const bool storing = !opt->history.empty();
+    if (storing && opt->unit.empty())
+      throw Error(
+          "--history needs --unit SERIAL: the serial of the unit calibrated, which the run is stored under.");
+    if (!storing && !opt->unit.empty())
+      throw Error("--unit is the serial a run is stored under in the history: give --history FILE with it.");
+    if (!storing && (!opt->date.empty() || !opt->note.empty()))
+      throw Error(
+          fmt::format("{} is kept with a run in the history: give --history FILE --unit SERIAL with it.",
+                      !opt->date.empty() ? "--date" : "--note"));
     refuse_to_overwrite_input(opt->json, opt->record);
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
+    std::string record_sha256, config_sha256;
+    std::optional<history::Database> db;
+    if (storing) {
+      check_run_options(opt->unit, opt->note, opt->date);
+      refuse_to_overwrite_input(opt->history, opt->record);
+      refuse_to_overwrite_input(opt->history, opt->config);
+      if (opt->history == opt->json)
+        throw Error(fmt::format("--history and --json name the same file {}.", opt->history));
+      // The record's SHA-256 identifies the run: the record must be a file that can be read again.
+      struct stat st {};
+      if (::stat(opt->record.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+        throw Error(
+            fmt::format("--history: the record {} is not a regular file (a pipe or a device): its SHA-256 "
+                        "identifies the run in the history, so give the record as a file.",
+                        opt->record));
+      // The database is opened (created if missing) and checked before the calibration's work.
+      db.emplace(history_database_path(opt->history, nullptr, ""), history::Database::Mode::kCreateWrite);
+      record_sha256 = history::sha256_file(opt->record, "record");
+      if (!opt->config.empty()) config_sha256 = history::sha256_file(opt->config, "configuration file");
+    }
     const Scenario s = load_configuration(opt->config);
     // The options as the library builds them for every caller (identify/scenario_options.hpp).
     CalibrationChoices choices;
@@ -64,18 +113,45 @@ void register_calibrate(CLI::App& app) {
     const std::vector<std::string> metadata_warnings =
         check_record_metadata(reader.metadata(), opt->record, s, config_name);
     for (const std::string& w : metadata_warnings) fmt::print(stderr, "gyrocal: warning: {}\n", w);
+    // The run's date, before the rows are read: --date, else the record's metadata, else its file's time.
+    std::optional<RunDate> date;
+    if (storing) date = run_date(opt->date, &reader.metadata(), opt->record, opt->record);
     CalibrationResult r = calibrate_record(reader, s.model(), s.test, options);
     r.warnings.insert(r.warnings.begin(), metadata_warnings.begin(), metadata_warnings.end());
-    if (!opt->json.empty()) {
-      nlohmann::ordered_json j = calibration_to_json(r);
+    nlohmann::ordered_json j;
+    if (!opt->json.empty() || storing) {
+      j = calibration_to_json(r);
       // Provenance (docs/interface.md): the record, the configuration (null: the built-in scenario), the
-      // plan.
+      // plan; with --history, the SHA-256 of the record and of the configuration (docs/history.md).
       j["record"] = opt->record;
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
       j["plan"] = plan_to_json(s.test);
-      write_result(opt->json, std::move(j), "calibration", opt->force);
+      if (storing) {
+        j["record_sha256"] = record_sha256;
+        j["config_sha256"] = config_sha256.empty() ? nlohmann::json(nullptr) : nlohmann::json(config_sha256);
+      }
     }
+    if (!opt->json.empty()) write_result(opt->json, j, "calibration", opt->force);
     if (opt->json != "-") print_out("{}", result_table(r));
+    if (storing) {
+      // The JSON above is written first: a refused add (the same record stored before) leaves it in place.
+      mark_result(j, "calibration");
+      const std::string text = j.dump(2) + "\n";
+      history::Run run = history::run_from_result(nlohmann::json::parse(text), opt->record);
+      run.unit = opt->unit;
+      run.note = opt->note;
+      run.date = date->date;
+      run.date_source = date->source;
+      run.record_sha256 = record_sha256;
+      run.config_sha256 = config_sha256;
+      const std::int64_t id = db->add(run, text);
+      const std::string line =
+          fmt::format("added run {} of unit {} ({}) to {}\n", id, run.unit, run.date, db->path().string());
+      if (opt->json == "-")
+        fmt::print(stderr, "{}", line);
+      else
+        print_out("{}", line);
+    }
   });
 }
 

@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   gyrocal::cli::register_montecarlo(app);
   gyrocal::cli::register_report(app);
   gyrocal::cli::register_noise(app);
+  gyrocal::cli::register_history(app);
   try {
     app.parse(argc, argv);
     if (app.get_subcommands().empty()) {

@@ -1152,6 +1152,16 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
         *text == "window" ? ReduceOptions::Method::kWindowMean : ReduceOptions::Method::kHarmonicFit;
   }
   calibration.reject_unknown();
+  // [history]: the calibration history's database (docs/history.md).
+  Section history(reader, top.table("history"), "history");
+  if (const toml::node* node = history.find("database")) {
+    s.history_database = reader.string(*node, "history.database");
+    if (s.history_database.empty())
+      reader.fail(node->source(), "history.database must name a database file, not be empty");
+    if (s.history_database.find('\0') != std::string::npos)
+      reader.fail(node->source(), "history.database must not hold a NUL character");
+  }
+  history.reject_unknown();
   const toml::table* reduce_table = top.table("reduce");
   Section reduce(reader, reduce_table, "reduce");
   read_reduce(reader, reduce, reduce_table, s.reduce);
@@ -1305,6 +1315,18 @@ std::string scenario_to_toml(const Scenario& s) {
         k.key, reduce_value(k, s.reduce),
         wrapped(std::string(k.unit) + "; default " + reduce_value(k, defaults) + ": " + std::string(k.reason),
                 kReduceCommentWidth));
+  }
+
+  constexpr std::string_view kHistoryNote =
+      "The calibration history (docs/history.md): the SQLite database that `history add` and `calibrate\n"
+      "--history` use when the command line names none (a relative path is taken from this file's folder).";
+  if (!s.history_database.empty()) {
+    w.section("history", kHistoryNote);
+    w.key("database", toml_string(s.history_database), "the history's database file");
+  } else {
+    TomlWriter keys;
+    keys.key("database", toml_string("gyrocal-history.sqlite"), "the history's database file");
+    w.section_commented("history", kHistoryNote, keys.text());
   }
 
   constexpr std::string_view kRecordNote =

@@ -43,6 +43,10 @@ struct Scenario {
   /// [accelerometer] and [accelerometer.noise]: the accelerometer's truth and noise, for simulation (used
   /// when sensor_kind is kAccelerometer). Defaults: docs/contract.md's.
   Accelerometer accelerometer;
+  /// [history] database: the calibration history's database file (docs/history.md) that `history add` and
+  /// `calibrate --history` use when the command line names none; empty = gyrocal-history.sqlite in the
+  /// current folder. A relative path is taken from the configuration file's folder.
+  std::string history_database;
 
   /// The sensor this scenario describes: the gyro of [gyro], [gyro.noise] and calibration.gyro_model, or the
   /// accelerometer.

@@ -165,4 +165,19 @@ inline constexpr long long kTrialsWithSamples = 100000;
 /// runs on; each thread reserves a stack, so a thread per trial (up to 1e9) would exhaust the process.
 inline constexpr int kThreads = 1024;
 
+// ---- The calibration history (docs/history.md) ----
+
+/// The longest unit serial (--unit), bytes: a serial is a few dozen characters ("SN-2026-000123"); it is
+/// printed in every line and message about the unit, and keys every run.
+inline constexpr std::size_t kHistoryUnitBytes = 128;
+/// The longest note of a run (--note), bytes: a sentence or a short paragraph ("after the shock test").
+inline constexpr std::size_t kHistoryNoteBytes = 4096;
+/// The most runs of one unit: `history show` reads them all and computes each coefficient's statistics and
+/// control chart over them; a unit calibrated every day for 25 years has 9,000. A further run is refused.
+inline constexpr std::size_t kHistoryRunsPerUnit = 10000;
+/// The largest history database gyrocal opens, bytes: 4 GiB. Each opening checks the whole file (PRAGMA
+/// quick_check), which reads every page; a run keeps its result's JSON (~100-250 kB), so 4 GiB hold ~20,000
+/// runs.
+inline constexpr std::uint64_t kHistoryDatabaseBytes = std::uint64_t{4} << 30;
+
 }  // namespace gyrocal::limits

@@ -1,10 +1,10 @@
 #pragma once
 // One calibration run of one unit as the calibration history keeps it (docs/history.md): who (the unit's
 // serial), when (the record's date), from what (the record's and the configuration's SHA-256, gyrocal's
-// version), and what came out (every coefficient with its standard uncertainty and identifiability, the machine
-// errors the run estimated, the misfit verdict and the data quality), read from a calibration result
-// (calibrate's JSON, docs/interface.md "Result (JSON)"). No file and no database here: run_from_result() reads an
-// already parsed result; history/database.hpp stores and loads runs.
+// version), and what came out (every coefficient with its standard uncertainty and identifiability, the
+// machine errors the run estimated, the misfit verdict and the data quality), read from a calibration result
+// (calibrate's JSON, docs/interface.md "Result (JSON)"). No file and no database here: run_from_result()
+// reads an already parsed result; history/database.hpp stores and loads runs.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -18,8 +18,9 @@ namespace gyrocal::history {
 /// One estimated quantity of one channel of a run: a coefficient (dF, K1, ...) in the result's own unit.
 /// `value` and `std` are absent where the run could not identify it (its result writes null).
 struct CoefficientValue {
-  std::string channel;  ///< the channel: a lone sensor's kind ("gyro", "accelerometer"), an IMU's channel name
-  std::string name;     ///< the coefficient's key in the result ("dF", "K1", "scale_factor_error_ppm", ...)
+  std::string
+      channel;       ///< the channel: a lone sensor's kind ("gyro", "accelerometer"), an IMU's channel name
+  std::string name;  ///< the coefficient's key in the result ("dF", "K1", "scale_factor_error_ppm", ...)
   std::optional<double> value;
   std::optional<double> std;  ///< standard uncertainty, same unit
   std::string unit;           ///< as the result writes it ("deg/h/g", "ug", ...)
@@ -70,14 +71,14 @@ struct Run {
 };
 
 /// Days since 1970-01-01T00:00:00 UTC of an ISO date "YYYY-MM-DD" or "YYYY-MM-DDTHH:MM:SS" (a trailing "Z" is
-/// taken), the time axis of trends. Throws gyrocal::Error naming `what` (e.g. "--date") for any other text or a
-/// date that does not exist (2026-02-30), or one outside the years 1900-9999.
+/// taken), the time axis of trends. Throws gyrocal::Error naming `what` (e.g. "--date") for any other text or
+/// a date that does not exist (2026-02-30), or one outside the years 1900-9999.
 double days_since_epoch(std::string_view iso_date, std::string_view what);
 
 /// The run stated by a calibration result (calibrate's JSON): sensor, channels, coefficients, machine errors,
-/// misfit and data quality, gyrocal's version, method and compensation, the record's path and (when the result
-/// holds them) `record_sha256` and `config_sha256`. unit, date, date_source and note are left for the caller,
-/// and so are record_sha256 / config_sha256 when the result lacks them. Throws gyrocal::Error naming
+/// misfit and data quality, gyrocal's version, method and compensation, the record's path and (when the
+/// result holds them) `record_sha256` and `config_sha256`. unit, date, date_source and note are left for the
+/// caller, and so are record_sha256 / config_sha256 when the result lacks them. Throws gyrocal::Error naming
 /// `result_name` and the key for a result that is not a calibration result (its `gyrocal.result` is not
 /// "calibration"), lacks coefficients, or holds a value of the wrong type.
 Run run_from_result(const nlohmann::json& result, std::string_view result_name);

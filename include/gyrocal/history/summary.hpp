@@ -27,14 +27,16 @@ struct QuantityHistory {
 /// A unit's runs and the history of every quantity they hold.
 struct HistorySummary {
   std::string unit;
-  std::string sensor;                 ///< the runs' sensor ("gyro", "accelerometer", ...)
-  std::vector<Run> runs;              ///< in date order, then id
-  std::vector<QuantityHistory> coefficients;    ///< by channel in the runs' order, then coefficient in the runs' order
+  std::string sensor;     ///< the runs' sensor ("gyro", "accelerometer", ...)
+  std::vector<Run> runs;  ///< in date order, then id
+  std::vector<QuantityHistory>
+      coefficients;  ///< by channel in the runs' order, then coefficient in the runs' order
   std::vector<QuantityHistory> machine_errors;  ///< by name, in order of first appearance
 };
 
 /// Summarises `runs` (one unit's, as Database::runs returns them: date order). Throws gyrocal::Error when
 /// `runs` is empty.
-HistorySummary summarize(const std::string& unit, std::vector<Run> runs, const RepeatabilityOptions& options = {});
+HistorySummary summarize(const std::string& unit, std::vector<Run> runs,
+                         const RepeatabilityOptions& options = {});
 
 }  // namespace gyrocal::history
