@@ -1,4 +1,5 @@
-// The keys of [centrifuge.errors] and [uncertainty], derived from the one table of machine errors.
+// The keys of [centrifuge.errors] and [uncertainty], derived from the one table of machine errors, and the
+// one-rate rule that the reader and the writer share (config_keys.hpp).
 #include "config_keys.hpp"
 
 namespace gyrocal::config_detail {
