@@ -1,5 +1,5 @@
-// libFuzzer target: the configuration reader (src/config/config_io.cpp): TOML text -> Scenario, with the
-// reader's validation (types, ranges, unknown keys). A clean refusal (gyrocal::Error) is fine; anything
+// libFuzzer target: the configuration reader (src/config/scenario_reader.cpp): TOML text -> Scenario, with
+// the reader's validation (types, ranges, unknown keys). A clean refusal (gyrocal::Error) is fine; anything
 // else escaping, a crash, a leak or undefined behaviour is a finding. A configuration that is accepted must
 // also survive the writer: scenario_to_toml's text parses back without error to the same text
 // (config_io.hpp promises a bit-exact round trip for any scenario that parse_scenario returned).

@@ -1,7 +1,7 @@
 #pragma once
 // The one table of the centrifuge's machine errors (docs/physics.md section 3): for each field of
 // CentrifugeErrors its name, unit, kind and the field it sets. The configuration's keys and units
-// (config/config_io.cpp), the sensitivity study's rows (analysis/sensitivity.cpp), the names of
+// (config/config_keys.cpp), the sensitivity study's rows (analysis/sensitivity.cpp), the names of
 // `--estimate` (identify/calibration.cpp) and `init`'s comments are all derived from it.
 #include <array>
 #include <cstddef>
