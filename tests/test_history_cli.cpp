@@ -325,3 +325,20 @@ TEST_F(HistoryCli, CalibrateRefusesHistoryOptionsThatDoNotGoTogether) {
 
 }  // namespace
 }  // namespace gyrocal
+
+namespace gyrocal {
+namespace {
+
+TEST_F(HistoryCli, AnEmptyDateIsRefusedNotTakenAsAbsent) {
+  for (const std::string& cmd :
+       {"history add " + path("res.json").string() + " --unit SN-1 --db " + path("h.sqlite").string(),
+        "calibrate " + path("r.csv").string() + " --history " + path("h.sqlite").string() + " --unit SN-1"}) {
+    const CliOutcome o = run(cmd + " --date ''");
+    EXPECT_EQ(o.status, 1) << cmd;
+    EXPECT_NE(o.err.find("--date is empty"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(path("h.sqlite"))) << cmd;
+  }
+}
+
+}  // namespace
+}  // namespace gyrocal

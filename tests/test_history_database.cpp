@@ -727,3 +727,58 @@ TEST(HistoryDatabase, AProcessKilledInTheMiddleOfAddsLeavesNoPartialRun) {
 
 }  // namespace
 }  // namespace gyrocal::history
+
+namespace gyrocal::history {
+namespace {
+
+// ---- What a first probe of the history found (docs/history.md, "Refusals") ----
+
+TEST(HistoryText, Utf8IsCheckedByItsDefinition) {
+  // RFC 3629: one to four bytes a character, no overlong form, no surrogate (U+D800..DFFF), nothing above
+  // U+10FFFF.
+  EXPECT_TRUE(valid_utf8(""));
+  EXPECT_TRUE(valid_utf8("SN-1 \xC3\xA9t\xC3\xA9"));           // "été": two-byte characters
+  EXPECT_TRUE(valid_utf8("\xE2\x82\xAC"));                     // U+20AC, three bytes
+  EXPECT_TRUE(valid_utf8("\xF0\x9F\x98\x80"));                 // U+1F600, four bytes
+  EXPECT_TRUE(valid_utf8("\xF4\x8F\xBF\xBF"));                 // U+10FFFF, the last
+  EXPECT_FALSE(valid_utf8("bad\xFF\xFEutf"));                  // never in UTF-8
+  EXPECT_FALSE(valid_utf8("\x80"));                            // a continuation byte alone
+  EXPECT_FALSE(valid_utf8("\xC0\xAF"));                        // "/" written in two bytes
+  EXPECT_FALSE(valid_utf8("\xE0\x80\xAF"));                    // ... and in three
+  EXPECT_FALSE(valid_utf8("\xED\xA0\x80"));                    // U+D800, a surrogate
+  EXPECT_FALSE(valid_utf8("\xF4\x90\x80\x80"));                // U+110000
+  EXPECT_FALSE(valid_utf8("\xE2\x82"));                        // cut short at the end
+  EXPECT_FALSE(valid_utf8(std::string("\xE2\x82", 2) + "A"));  // cut short inside
+}
+
+TEST(HistoryDatabase, ASerialOrNoteThatIsNotTextIsRefusedAndNothingStored) {
+  const fs::path dir = fresh_test_folder("gyrocal-history");
+  const fs::path path = dir / "h.sqlite";
+  Database db(path, Database::Mode::kCreateWrite);
+  std::string e = error_of([&] { db.add(make_run("bad\xFF\xFEutf", "record", "2026-03-02")); });
+  EXPECT_NE(e.find("--unit"), std::string::npos) << e;
+  EXPECT_NE(e.find("UTF-8"), std::string::npos) << e;
+  history::Run note = make_run("SN-1", "record", "2026-03-02");
+  note.note = "x\xFFy";
+  e = error_of([&] { db.add(note); });
+  EXPECT_NE(e.find("--note"), std::string::npos) << e;
+  EXPECT_NE(e.find("UTF-8"), std::string::npos) << e;
+  note.note = "line1\x1b[31mred";  // an escape sequence would reach the terminal of whoever reads the history
+  e = error_of([&] { db.add(note); });
+  EXPECT_NE(e.find("--note"), std::string::npos) << e;
+  EXPECT_NE(e.find("control character"), std::string::npos) << e;
+  EXPECT_TRUE(db.units().empty());
+  fs::remove_all(dir);
+}
+
+TEST(HistoryRun, ANegativeStandardUncertaintyIsRefusedNamingItsKey) {
+  nlohmann::json r = gyro_result();
+  r["coefficients"]["dI"]["std"] = -1.0;
+  const std::string e = error_of([&] { run_from_result(r, "r.json"); });
+  EXPECT_NE(e.find("r.json"), std::string::npos) << e;
+  EXPECT_NE(e.find("coefficients.dI.std"), std::string::npos) << e;
+  EXPECT_NE(e.find("negative"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace gyrocal::history

@@ -54,11 +54,14 @@ void register_calibrate(CLI::App& app) {
       "Store the run in this history database (SQLite; created if missing; docs/history.md), with "
       "--unit");
   sub->add_option("--unit", opt->unit, "With --history: the calibrated unit's serial");
-  sub->add_option("--date", opt->date,
-                  "With --history: the run's date, YYYY-MM-DD[THH:MM:SS] in UTC; default: the record's "
-                  "'# date = ...' metadata, else the record file's time");
+  const CLI::Option* date_option =
+      sub->add_option("--date", opt->date,
+                      "With --history: the run's date, YYYY-MM-DD[THH:MM:SS] in UTC; default: the record's "
+                      "'# date = ...' metadata, else the record file's time");
   sub->add_option("--note", opt->note, "With --history: a note kept with the run");
-  sub->callback([opt] {
+  sub->callback([opt, date_option] {
+    if (date_option->count() > 0 && opt->date.empty())
+      throw Error("--date is empty: give the run's date as YYYY-MM-DD[THH:MM:SS], or leave --date out.");
     // --history and --unit go together; --date and --note only with them (docs/history.md).
     const bool storing = !opt->history.empty();
     if (storing && opt->unit.empty())

@@ -148,7 +148,7 @@ void register_history(CLI::App& app) {
   add->add_option("--db", opt->db,
                   "History database (SQLite; created if missing); default: [history] database of the "
                   "configuration, else gyrocal-history.sqlite in the current folder");
-  add->add_option(
+  const CLI::Option* date_option = add->add_option(
       "--date", opt->date,
       "The run's date, YYYY-MM-DD[THH:MM:SS] in UTC; default: the record's '# date = ...' metadata, "
       "else the record file's time");
@@ -160,7 +160,9 @@ void register_history(CLI::App& app) {
   add->add_option("--config", opt->config,
                   "The configuration the result was calibrated with (for a rig's record layout and [history] "
                   "database); default: the result's config path, if readable");
-  add->callback([opt] {
+  add->callback([opt, date_option] {
+    if (date_option->count() > 0 && opt->date.empty())
+      throw Error("--date is empty: give the run's date as YYYY-MM-DD[THH:MM:SS], or leave --date out.");
     check_run_options(opt->unit, opt->note, opt->date);
     const nlohmann::json result = read_result_file(opt->result);
     history::Run run = history::run_from_result(result, opt->result);

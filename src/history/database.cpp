@@ -180,7 +180,10 @@ class Statement {
         fmt::format("Cannot write the history database {}: the disk is full ({}); nothing was stored.",
                     path.string(), detail));
   if (primary == SQLITE_READONLY || primary == SQLITE_PERM || primary == SQLITE_CANTOPEN)
-    throw Error(fmt::format("Cannot {} the history database {}: {}.", doing, path.string(), detail));
+    throw Error(fmt::format(
+        "Cannot write the history database {} while {}: {} (the file, its folder, and any -wal or -shm file "
+        "beside it must be writable by this user).",
+        path.string(), doing, detail));
   throw Error(fmt::format("The history database {} failed while {}: {} (SQLite error {}).", path.string(),
                           doing, detail, rc));
 }
@@ -429,6 +432,14 @@ void validate(const Run& run, const fs::path& path) {
   if (run.note.size() > limits::kHistoryNoteBytes)
     throw Error(fmt::format("--note: the note is {} bytes long, longer than {} (limits::kHistoryNoteBytes).",
                             run.note.size(), limits::kHistoryNoteBytes));
+  // A serial and a note are text that JSON, the report and a terminal show: UTF-8, no control character (an
+  // escape sequence would reach the terminal of whoever reads the history).
+  if (!valid_utf8(run.unit))
+    throw Error("--unit: the serial is not valid UTF-8 text; give it as text (letters, digits, signs).");
+  if (!valid_utf8(run.note)) throw Error("--note: the note is not valid UTF-8 text.");
+  if (control(run.note))
+    throw Error(
+        "--note: the note holds a control character (a line break, an escape, ...); write it on one line.");
   days_since_epoch(run.date, "the run's date");
   if (!is_sha256_hex(run.record_sha256))
     throw Error(

@@ -68,6 +68,14 @@ std::string type_name(const nlohmann::json& v) {
 }
 
 /// An optional number: absent or null = none; a number (finite) = it; anything else refused naming the key.
+/// A standard uncertainty below zero is no uncertainty: refused, naming the result and the key.
+void refuse_negative_std(const std::optional<double>& std, std::string_view result_name,
+                         const std::string& key) {
+  if (std && *std < 0)
+    throw Error(
+        fmt::format("{}: {}.std is {}; a standard uncertainty cannot be negative.", result_name, key, *std));
+}
+
 std::optional<double> optional_number(const nlohmann::json& object, const char* name,
                                       std::string_view result_name, const std::string& key) {
   const auto it = object.find(name);
@@ -137,6 +145,7 @@ void read_coefficients(const nlohmann::json& c, const std::string& channel, std:
     v.name = name;
     v.value = optional_number(entry, "value", result_name, k);
     v.std = optional_number(entry, "std", result_name, k);
+    refuse_negative_std(v.std, result_name, k);
     v.unit = optional_string(entry, "unit", result_name, k);
     const auto id = entry.find("identifiable");
     if (id == entry.end() || id->is_null())
@@ -166,6 +175,7 @@ void read_machine_errors(const nlohmann::json& result, std::string_view result_n
     if (harmonic > 0 || !part.empty()) m.name += fmt::format(":{}:{}", harmonic, part);
     m.value = optional_number(e, "value", result_name, k);
     m.std = optional_number(e, "std", result_name, k);
+    refuse_negative_std(m.std, result_name, k);
     m.unit = optional_string(e, "unit", result_name, k);
     run.machine_errors.push_back(std::move(m));
   }
@@ -230,6 +240,37 @@ void read_quality(const nlohmann::json& result, std::string_view result_name, Ru
 }
 
 }  // namespace
+
+bool valid_utf8(std::string_view text) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    std::size_t n = 0;
+    std::uint32_t cp = 0;
+    if (b < 0x80) {
+      ++i;
+      continue;
+    } else if ((b & 0xE0) == 0xC0) {
+      n = 1, cp = b & 0x1Fu;
+    } else if ((b & 0xF0) == 0xE0) {
+      n = 2, cp = b & 0x0Fu;
+    } else if ((b & 0xF8) == 0xF0) {
+      n = 3, cp = b & 0x07u;
+    } else {
+      return false;  // a continuation byte where a character starts, or 0xF8..0xFF
+    }
+    if (i + n >= text.size()) return false;  // cut short
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto c = static_cast<unsigned char>(text[i + k]);
+      if ((c & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (c & 0x3Fu);
+    }
+    const std::uint32_t smallest[] = {0, 0x80, 0x800, 0x10000};
+    if (cp < smallest[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += n + 1;
+  }
+  return true;
+}
 
 double days_since_epoch(std::string_view iso_date, std::string_view what) {
   std::string_view s = iso_date;

@@ -75,6 +75,10 @@ struct Run {
 /// a date that does not exist (2026-02-30), or one outside the years 1900-9999.
 double days_since_epoch(std::string_view iso_date, std::string_view what);
 
+/// True when `text` is well-formed UTF-8 (no overlong form, no surrogate, nothing above U+10FFFF): what a
+/// unit's serial and a run's note must be, since JSON, the report and a terminal show them.
+bool valid_utf8(std::string_view text);
+
 /// The run stated by a calibration result (calibrate's JSON): sensor, channels, coefficients, machine errors,
 /// misfit and data quality, gyrocal's version, method and compensation, the record's path and (when the
 /// result holds them) `record_sha256` and `config_sha256`. unit, date, date_source and note are left for the
