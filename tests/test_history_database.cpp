@@ -630,6 +630,18 @@ TEST(HistoryDatabase, ANewerSchemaOrACorruptFileIsRefusedAndLeftUntouched) {
     EXPECT_NE(e.find("corrupt.sqlite"), std::string::npos) << e;
     EXPECT_NE(e.find("corrupt"), std::string::npos) << e;
   }
+  // The header of a b-tree page overwritten (a probe's case: PRAGMA quick_check then answers ~100 lines): the
+  // refusal is one sentence, naming the first problem and counting the others.
+  const fs::path page = dir / "page.sqlite";
+  make_history(page, 30);
+  {
+    std::fstream f(page, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(4096);
+    for (int i = 0; i < 16; ++i) f.put(static_cast<char>(0x5A));
+  }
+  const std::string page_refusal = refusal_leaves_file_untouched(page, Database::Mode::kRead);
+  EXPECT_NE(page_refusal.find("page.sqlite"), std::string::npos) << page_refusal;
+  EXPECT_EQ(page_refusal.find('\n'), std::string::npos) << page_refusal;
   // gyrocal's application_id on a file lacking the tables.
   const fs::path bare = dir / "bare.sqlite";
   sqlite_query(bare, "PRAGMA application_id = " + std::to_string(kApplicationId));

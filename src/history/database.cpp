@@ -305,10 +305,20 @@ void check_with_sqlite_connection(const fs::path& path) {
     Statement q(db.get(), "PRAGMA quick_check", path);
     std::string first;
     std::size_t problems = 0;
+    // One problem a line (a row may hold several lines): the message names the first and counts the others.
     while (q.step()) {
-      const std::string line = q.text(0);
-      if (line == "ok") continue;
-      if (problems++ == 0) first = line;
+      const std::string text = q.text(0);
+      if (text == "ok") continue;
+      const std::size_t before = problems;
+      std::size_t at = 0;
+      while (at < text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        const std::string line = text.substr(at, end - at);
+        at = end + 1;
+        if (line.empty() || line.starts_with("*** in database")) continue;
+        if (problems++ == 0) first = line;
+      }
+      if (problems == before && problems++ == 0) first = text.substr(0, text.find('\n'));  // any other answer
     }
     if (problems > 0)
       throw Error(
