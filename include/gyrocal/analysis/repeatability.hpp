@@ -1,10 +1,10 @@
 #pragma once
 // Repeatability of one quantity (a coefficient, a machine error) over a unit's calibration runs
-// (docs/history.md, "The statistics"): its weighted mean, the run-to-run standard deviation (IEEE Std 952/1293's
-// turn-on-to-turn-on repeatability) with a chi-square interval, the runs' own stated sigma beside it with the test
-// of whether it explains the scatter, a linear trend in time, and the control charts of the NIST/SEMATECH
-// e-Handbook section 6.3.2 (individuals chart with moving-range limits, EWMA). Pure statistics: no file, no
-// database.
+// (docs/history.md, "The statistics"): its weighted mean, the run-to-run standard deviation (IEEE Std
+// 952/1293's turn-on-to-turn-on repeatability) with a chi-square interval, the runs' own stated sigma beside
+// it with the test of whether it explains the scatter, a linear trend in time, and the control charts of the
+// NIST/SEMATECH e-Handbook section 6.3.2 (individuals chart with moving-range limits, EWMA). Pure statistics:
+// no file, no database.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -57,8 +57,9 @@ struct Repeatability {
   std::optional<std::array<double, 2>> limits;
   std::optional<double> chart_sigma;
   std::vector<std::int64_t> flagged;
-  /// The EWMA z_i = lambda x_i + (1 - lambda) z_(i-1), z_0 = the centre, per run in date order, its limits per
-  /// run (centre -/+ ewma_k sigma sqrt(lambda/(2-lambda) (1-(1-lambda)^(2i)))) and the runs where it left them.
+  /// The EWMA z_i = lambda x_i + (1 - lambda) z_(i-1), z_0 = the centre, per run in date order, its limits
+  /// per run (centre -/+ ewma_k sigma sqrt(lambda/(2-lambda) (1-(1-lambda)^(2i)))) and the runs where it left
+  /// them.
   std::vector<double> ewma;
   std::vector<std::array<double, 2>> ewma_limits;
   std::vector<std::int64_t> ewma_flagged;
