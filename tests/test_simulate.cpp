@@ -296,13 +296,15 @@ class SimulateCommand : public testing::Test {
 TEST_F(SimulateCommand, WritesTheDefaultTestAsAValidRecord) {
   const fs::path record = dir_ / "record.csv";
   std::string out;
-  // Progress shows after 1 s even when standard error is a file (a line per tenth); a sanitizer build on a busy
-  // machine takes longer than that, so the delay is moved out of reach: what must stay empty is every warning.
+  // Progress shows after 1 s even when standard error is a file (a line per tenth); a sanitizer build on a
+  // busy machine takes longer than that, so the delay is moved out of reach: what must stay empty is every
+  // warning.
   ::setenv("GYROCAL_PROGRESS_AFTER_S", "3600", 1);
   const int status = run("simulate --out " + record.string(), &out);
   ::unsetenv("GYROCAL_PROGRESS_AFTER_S");
   ASSERT_EQ(status, 0) << read(dir_ / "stderr.txt");
-  EXPECT_TRUE(read(dir_ / "stderr.txt").empty()) << read(dir_ / "stderr.txt");  // no warning on the default test
+  EXPECT_TRUE(read(dir_ / "stderr.txt").empty())
+      << read(dir_ / "stderr.txt");  // no warning on the default test
   RecordReader reader(record);
   const std::vector<RecordSample> rows = read_all(reader);
   const Scenario s = default_scenario();
