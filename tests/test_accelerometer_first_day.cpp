@@ -14,7 +14,9 @@
 
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/record/record.hpp"
 #include "support/cli_run.hpp"
 
 namespace gyrocal {
@@ -132,6 +134,103 @@ TEST(AccelerometerGammaList, InitSaysWhatGammaDegSets) {
   EXPECT_NE(comment.find("seven values of its harmonic content"), std::string::npos) << comment;
   EXPECT_NE(comment.find("reduction = \"window\""), std::string::npos) << comment;
   fs::remove_all(dir);
+}
+
+// ---- c. The reader's refusals name the key that fixes them ----
+
+/// The lab's [record] (the probe's DAQ export): ';', ms, counts, a decimal comma, a units row and a two-line
+/// preamble, with the keys given in `keys` (skip_rows, units_row, decimal).
+RecordLayout daq_layout(const std::string& keys) {
+  const Scenario s = parse_scenario(
+      "[sensor]\nkind = \"accelerometer\"\n[record]\ndelimiter = \";\"\ntime_column = \"Zeit_ms\"\n"
+      "time_unit = \"ms\"\nmain_angle_column = \"Enc_Arm_cnt\"\ncounter_angle_column = \"Enc_Plat_cnt\"\n"
+      "position_angle_column = \"Enc_Pos_cnt\"\nmain_counts_per_revolution = 1048576\n"
+      "counter_counts_per_revolution = 1048576\nposition_counts_per_revolution = 262144\n"
+      "output_column = \"U_acc_V\"\noutput_scale_per_g = 1.3\n" +
+          keys,
+      "rig_daq.toml");
+  EXPECT_TRUE(s.record.has_value());
+  return s.record.value_or(RecordLayout{});
+}
+
+const char* const kDaqFile =
+    "CF-2 centrifuge DAQ export v3.2\n"
+    "Operator: test; Date: 2026-11-27\n"
+    "Zeit_ms;U_acc_V;Temp_C;Enc_Pos_cnt;Enc_Arm_cnt;Enc_Plat_cnt\n"
+    "ms;V;degC;cnt;cnt;cnt\n"
+    "0;0,0000938;21,5;0;0;0\n"
+    "5;0,0001012;21,5;0;100;1048476\n"
+    "10;0,0000977;21,5;0;200;1048376\n";
+
+/// The refusal reading kDaqFile through `layout` (empty when it reads), and the rows read.
+std::string daq_refusal(const RecordLayout& layout, std::size_t* rows = nullptr) {
+  try {
+    RecordReader reader = RecordReader::from_string(kDaqFile, layout, "daq.csv");
+    RecordSample sample;
+    std::size_t n = 0;
+    while (reader.next(sample)) ++n;
+    if (rows) *rows = n;
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RecordRefusalHints, EachNamesTheKeyThatReadsTheFile) {
+  const std::string all = "skip_rows = 2\nunits_row = true\ndecimal = \",\"\n";
+  std::size_t rows = 0;
+  EXPECT_EQ(daq_refusal(daq_layout(all), &rows), "");
+  EXPECT_EQ(rows, 3u);
+  // The preamble: its first line is one column at ';'.
+  const std::string preamble = daq_refusal(daq_layout("units_row = true\ndecimal = \",\"\n"));
+  EXPECT_NE(preamble.find("daq.csv, line 1"), std::string::npos) << preamble;
+  EXPECT_NE(preamble.find("record.skip_rows"), std::string::npos) << preamble;
+  // The units row under the header.
+  const std::string units = daq_refusal(daq_layout("skip_rows = 2\ndecimal = \",\"\n"));
+  EXPECT_NE(units.find("line 4"), std::string::npos) << units;
+  EXPECT_NE(units.find("'ms'"), std::string::npos) << units;
+  EXPECT_NE(units.find("record.units_row = true"), std::string::npos) << units;
+  // The decimal comma.
+  const std::string comma = daq_refusal(daq_layout("skip_rows = 2\nunits_row = true\n"));
+  EXPECT_NE(comma.find("line 5"), std::string::npos) << comma;
+  EXPECT_NE(comma.find("'0,0000938'"), std::string::npos) << comma;
+  EXPECT_NE(comma.find("record.decimal = \",\""), std::string::npos) << comma;
+  // A word in a later row is no units row, and names neither key.
+  std::string later = kDaqFile;
+  later.replace(later.find("5;0,0001012"), 11, "5;overload");
+  try {
+    RecordReader reader = RecordReader::from_string(later, daq_layout(all), "daq.csv");
+    RecordSample sample;
+    while (reader.next(sample)) {
+    }
+    ADD_FAILURE() << "a word among the rows is read";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("'overload', which is not a number"), std::string::npos) << m;
+    EXPECT_EQ(m.find("units_row"), std::string::npos) << m;
+    EXPECT_EQ(m.find("record.decimal"), std::string::npos) << m;
+  }
+}
+
+// A preamble line that the delimiter does split (a "key; value" line) names none of the configured columns:
+// the refusal names record.skip_rows too.
+TEST(RecordRefusalHints, APreambleLineThatSplitsNamesSkipRows) {
+  std::string text = kDaqFile;
+  text.replace(0, text.find('\n') + 1, "");  // the second preamble line first: "Operator: test; Date: ..."
+  const std::string m = [&] {
+    try {
+      RecordReader reader =
+          RecordReader::from_string(text, daq_layout("units_row = true\ndecimal = \",\"\n"), "daq.csv");
+      RecordSample sample;
+      while (reader.next(sample)) {
+      }
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_NE(m.find("is not a column of the header line"), std::string::npos) << m;
+  EXPECT_NE(m.find("record.skip_rows"), std::string::npos) << m;
 }
 
 }  // namespace
