@@ -18,6 +18,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/record/record.hpp"
 #include "support/cli_run.hpp"
+#include "support/rig_record.hpp"
 
 namespace gyrocal {
 namespace {
@@ -231,6 +232,101 @@ TEST(RecordRefusalHints, APreambleLineThatSplitsNamesSkipRows) {
   }();
   EXPECT_NE(m.find("is not a column of the header line"), std::string::npos) << m;
   EXPECT_NE(m.find("record.skip_rows"), std::string::npos) << m;
+}
+
+// ---- d. Unit hints that name the right key ----
+
+constexpr std::int64_t kArmCounts = std::int64_t{1} << 20, kPositionCounts = std::int64_t{1} << 18;
+
+std::int64_t wrapped_count(double deg, std::int64_t per_rev) {
+  const auto c = static_cast<std::int64_t>(std::llround(deg * static_cast<double>(per_rev) / 360.0));
+  return ((c % per_rev) + per_rev) % per_rev;
+}
+
+/// The test generator's rig record of small_accelerometer (rates 0, 6, 12 rad/s: they differ by 2) as the
+/// lab's DAQ writes it: ms, counts (main and counter 2^20, position 2^18), ';', the output in g. With
+/// `counter_reversed` the counter encoder counts the other way.
+void write_counts_record(const fs::path& path, bool counter_reversed) {
+  const Scenario s = small_accelerometer({0, 90, 180, 270});
+  std::ofstream out(path);
+  out << "t_ms;arm;plat;pos;acc\n";
+  testing::rig_rows(s, testing::RigImperfections{}, testing::RigMotion{}, 7, [&](const testing::RigRow& r) {
+    const double counter = counter_reversed ? -r.counter_angle_deg : r.counter_angle_deg;
+    out << fmt::format("{};{};{};{};{:.17g}\n", std::llround(r.time_s * 1e3),
+                       wrapped_count(r.main_angle_deg, kArmCounts), wrapped_count(counter, kArmCounts),
+                       wrapped_count(r.position_angle_deg, kPositionCounts), r.output);
+  });
+}
+
+/// small_accelerometer's configuration with `rates` and a [record] mapping the counts record: the main
+/// and counter columns as given, the counts per revolution as given.
+std::string counts_toml(const std::vector<double>& rates, const std::string& main, const std::string& counter,
+                        std::int64_t position_counts, std::int64_t main_counts = kArmCounts) {
+  Scenario s = small_accelerometer({0, 90, 180, 270});
+  s.test.rates_rad_s = rates;
+  s.centrifuge.rate_rad_s = rates[1];
+  return scenario_to_toml(s) +
+         fmt::format(
+             "[record]\ndelimiter = \";\"\ntime_column = \"t_ms\"\ntime_unit = \"ms\"\n"
+             "main_angle_column = \"{}\"\ncounter_angle_column = \"{}\"\nposition_angle_column = \"pos\"\n"
+             "main_counts_per_revolution = {}\ncounter_counts_per_revolution = {}\n"
+             "position_counts_per_revolution = {}\noutput_column = \"acc\"\n",
+             main, counter, main_counts, kArmCounts, position_counts);
+}
+
+TEST(RecordUnitHints, EachMistakeNamesItsOwnKeyNotTheMainEncoder) {
+  const fs::path dir = fresh_test_folder("gyrocal-hints");
+  write_counts_record(dir / "daq.csv", false);
+  write_counts_record(dir / "reversed.csv", true);
+  const std::vector<double> rates = {0.0, 6.0, 12.0};
+  // The mapping right: the record calibrates (so each refusal below is its mistake's).
+  EXPECT_EQ(test::calibrate_in(dir, "daq.csv", counts_toml(rates, "arm", "plat", kPositionCounts)).status, 0);
+  struct Mistake {
+    std::string what, record, toml;
+    std::vector<std::string> said, not_said;
+  };
+  const std::vector<Mistake> mistakes = {
+      {"position counts 2^20 for an encoder of 2^18",
+       "daq.csv",
+       counts_toml(rates, "arm", "plat", kArmCounts),
+       {"record.position_counts_per_revolution = 1048576 the encoder's? It reads 1/4 of the angle",
+        "262144 (2^18)"},
+       {"main_counts_per_revolution =", "counter_counts_per_revolution =", "2x", "1/2 of"}},
+      {"the counter encoder counting the other way",
+       "reversed.csv",
+       counts_toml(rates, "arm", "plat", kPositionCounts),
+       {"does the counter encoder count the other way? Negate the counter angle"},
+       {"counts_per_revolution =", "2x", "1/2 of"}},
+      {"main and counter columns swapped",
+       "daq.csv",
+       counts_toml(rates, "plat", "arm", kPositionCounts),
+       {"the main axis turns at -6 rad/s and the counter platform at 6 rad/s",
+        "are the main and counter columns swapped (record.main_angle_column, record.counter_angle_column)"},
+       {"counts_per_revolution =", "2^1"}},
+      {"a plan whose rates are off by no clean factor",
+       "daq.csv",
+       counts_toml({0.0, 5.0, 10.0}, "arm", "plat", kPositionCounts),
+       {"no unit explains it: is [test] rates_rad_s the test's?"},
+       {"counts_per_revolution =", "2^"}},
+      {"main counts 2^19 for 2^20, with rates that differ by 2",
+       "daq.csv",
+       counts_toml(rates, "arm", "plat", kPositionCounts, kArmCounts / 2),
+       {"the main axis turns at 2x the planned rate",
+        "is record.main_counts_per_revolution = 524288 the encoder's? It reads 2x the angle"},
+       {"position_counts_per_revolution ="}},
+  };
+  for (const Mistake& m : mistakes) {
+    const test::CliOutcome o = test::calibrate_in(dir, m.record, m.toml);
+    EXPECT_EQ(o.status, 1) << m.what;
+    EXPECT_NE(o.err.find("the record has no usable dwell"), std::string::npos) << m.what << ": " << o.err;
+    const std::size_t hint = o.err.find("Check the units: ");
+    ASSERT_NE(hint, std::string::npos) << m.what << ": " << o.err;
+    const std::string h = o.err.substr(hint);
+    for (const std::string& part : m.said) EXPECT_NE(h.find(part), std::string::npos) << m.what << ": " << h;
+    for (const std::string& part : m.not_said)
+      EXPECT_EQ(h.find(part), std::string::npos) << m.what << ": " << h;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
