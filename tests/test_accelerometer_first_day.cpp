@@ -3,8 +3,10 @@
 // naming the right key, `noise` on a record with bias instability, and the data-quality listing. Each case
 // failed before its fix.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -12,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
@@ -327,6 +330,72 @@ TEST(RecordUnitHints, EachMistakeNamesItsOwnKeyNotTheMainEncoder) {
       EXPECT_EQ(h.find(part), std::string::npos) << m.what << ": " << h;
   }
   fs::remove_all(dir);
+}
+
+// ---- e. noise: no spurious quantization term beside bias instability ----
+
+/// A static accelerometer's output, g, with the test's own generator: white noise of density n_ug
+/// (ug/sqrt(Hz): a sample's std n sqrt(fs)), a bias instability B_ug made as a sum of first-order
+/// Gauss-Markov processes with correlation times 1, 10, 100, 1000 s and variances w_i B^2 (the weights that
+/// make their Allan deviation ~0.664 B from 2 s on; below 2 s it falls, as any such bias's does), and the
+/// output rounded to a 1 ug grid (referred to the input, K1 = 1.3 V/g, written in V with 9 decimals as a DAQ
+/// would).
+std::vector<double> static_output_g(std::uint64_t seed, double fs, std::size_t n, double n_ug, double b_ug) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  const double times[4] = {1.0, 10.0, 100.0, 1000.0};
+  const double weights[4] = {0.909825, 0.698491, 0.750247, 0.696083};
+  double state[4];
+  for (int i = 0; i < 4; ++i) state[i] = b_ug * std::sqrt(weights[i]) * normal(rng);
+  std::vector<double> out(n);
+  const double white = n_ug * std::sqrt(fs);
+  for (std::size_t k = 0; k < n; ++k) {
+    double bias = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      const double a = std::exp(-1.0 / (fs * times[i]));
+      state[i] = a * state[i] + b_ug * std::sqrt(weights[i] * (1.0 - a * a)) * normal(rng);
+      bias += state[i];
+    }
+    const double ug = std::round(1e6 + bias + white * normal(rng));  // 1 g plus the noise, on a 1 ug grid
+    // As the DAQ writes it: V at 1.30127 V/g with 9 decimals, read back in g.
+    out[k] = std::round(ug * 1e-6 * 1.30127 * 1e9) / 1e9 / 1.30127;
+  }
+  return out;
+}
+
+// Over seeds of 10 ug/sqrt(Hz) white noise and 5 ug bias instability (an hour at 100 Hz each): no velocity
+// quantization term is fitted (the record has none: its 1 ug rounding is white), N is within 3 of its
+// stated sigma on every seed and unbiased over them, and the 1 ug grid is found although the values went
+// through 9 decimals of volts (a rounding of 4e-4 of a step). Before: a spurious term on 4 of 10 seeds, N
+// 0.5 % low (-2.5 sigma), and no grid.
+TEST(AccelerometerNoiseFit, BiasInstabilityDrawsNoSpuriousQuantizationTerm) {
+  const bool sanitized = std::getenv("GYROCAL_SANITIZED") != nullptr;
+  const int seeds = sanitized ? 3 : 6;
+  const double fs = 100.0, n_true = 10.0;
+  const auto n = static_cast<std::size_t>(3600 * fs);
+  std::vector<double> time(n);
+  for (std::size_t k = 0; k < n; ++k) time[k] = static_cast<double>(k) / fs;
+  RecordNoiseOptions options;
+  options.sensor = SensorKind::kAccelerometer;
+  double z_sum = 0.0;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const RecordNoise r = characterise_samples_noise(
+        time, static_output_g(static_cast<std::uint64_t>(seed), fs, n, n_true, 5.0), "static.csv", options);
+    EXPECT_FALSE(r.noise.term(NoiseTerm::AngleQuantization).present)
+        << "seed " << seed << ": velocity quantization " << sensor_term(r, NoiseTerm::AngleQuantization).value
+        << " ug s";
+    const FittedNoiseTerm nt = sensor_term(r, NoiseTerm::AngleRandomWalk);
+    ASSERT_TRUE(nt.present) << seed;
+    const double z = (nt.value - n_true) / nt.std;
+    EXPECT_LT(std::abs(z), 3.0) << "seed " << seed << ": N " << nt.value << " +- " << nt.std;
+    z_sum += z;
+    ASSERT_TRUE(r.resolution.has_value()) << "seed " << seed << ": the 1 ug grid is not found";
+    EXPECT_NEAR(*r.resolution, 1.0, 1e-3) << seed;
+  }
+  // The mean z over the seeds: -1.3 (N 0.15 % low), what remains of the bias instability's Allan deviation
+  // falling below its floor under 2 s, where the fit's flat term over-predicts it (docs/noise.md); with the
+  // spurious term, seeds that drew it gave N 0.5 % low against a sigma twice as large.
+  EXPECT_LT(std::abs(z_sum / seeds), 2.0) << z_sum / seeds;
 }
 
 }  // namespace
