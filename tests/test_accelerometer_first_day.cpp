@@ -3,6 +3,7 @@
 // naming the right key, `noise` on a record with bias instability, and the data-quality listing. Each case
 // failed before its fix.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -396,6 +397,62 @@ TEST(AccelerometerNoiseFit, BiasInstabilityDrawsNoSpuriousQuantizationTerm) {
   // falling below its floor under 2 s, where the fit's flat term over-predicts it (docs/noise.md); with the
   // spurious term, seeds that drew it gave N 0.5 % low against a sigma twice as large.
   EXPECT_LT(std::abs(z_sum / seeds), 2.0) << z_sum / seeds;
+}
+
+// ---- b. plan: every g-level, the test's duration and the record's size ----
+
+// A static set and two speeds: plan names each rate's g-level (omega^2 R0 / g, computed here), and the
+// duration, rows and size of the record simulate then writes (the rows counted in the file, its size within
+// 2 %).
+TEST(PlanStatesTheTest, EveryGLevelTheDurationAndTheRecordSize) {
+  const fs::path dir = fresh_test_folder("gyrocal-plan-size");
+  const Scenario s = small_accelerometer({0, 90, 180, 270});
+  write_text(dir / "acc.toml", scenario_to_toml(s));
+  const test::CliOutcome plan = run_cli("plan --config " + (dir / "acc.toml").string(), dir);
+  ASSERT_EQ(plan.status, 0) << plan.err;
+  for (const double rate : {6.0, 12.0}) {
+    const double ar = rate * rate * s.centrifuge.radius_m / s.site.gravity_m_s2;
+    const std::string level = fmt::format("{} rad/s: Ar = {:.4g} g", rate, ar);
+    EXPECT_NE(plan.out.find(level), std::string::npos) << level << "\n" << plan.out;
+  }
+  EXPECT_NE(plan.out.find("0 rad/s: static"), std::string::npos) << plan.out;
+  const test::CliOutcome sim = run_cli(
+      "simulate --config " + (dir / "acc.toml").string() + " --out " + (dir / "acc.csv").string(), dir);
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  std::size_t rows = 0;
+  {
+    std::ifstream in(dir / "acc.csv");
+    std::string line;
+    bool header = false;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      if (!header) {
+        header = true;
+        continue;
+      }
+      ++rows;
+    }
+  }
+  const auto bytes = static_cast<double>(fs::file_size(dir / "acc.csv"));
+  // "The test lasts D s (H h); simulate writes N rows, about X kB."
+  const std::size_t at = plan.out.find("The test lasts ");
+  ASSERT_NE(at, std::string::npos) << plan.out;
+  double duration = 0, hours = 0, size = 0;
+  unsigned long long planned_rows = 0;
+  char unit[8] = {};
+  ASSERT_EQ(std::sscanf(plan.out.c_str() + at,
+                        "The test lasts %lf s (%lf h); simulate writes %llu rows, about %lf %7s", &duration,
+                        &hours, &planned_rows, &size, unit),
+            5)
+      << plan.out.substr(at);
+  EXPECT_EQ(planned_rows, rows);
+  EXPECT_NEAR(duration, static_cast<double>(rows) / s.test.sample_rate_hz,
+              1.0 / s.test.sample_rate_hz + 0.05);
+  const double scale = std::string(unit).starts_with("kB")   ? 1e3
+                       : std::string(unit).starts_with("MB") ? 1e6
+                                                             : 1.0;
+  EXPECT_NEAR(size * scale / bytes, 1.0, 0.02) << size << " " << unit << " for " << bytes << " bytes";
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/simulate/simulator.hpp"
 #include "tables.hpp"
 
 namespace gyrocal::cli {
@@ -55,6 +56,18 @@ std::string reduction_text(const Scenario& s, const ReduceOptions& reduce, std::
     text += fmt::format("each dwell {} at [test] gamma_deg",
                         harmonic ? "fitted with its harmonics and read" : "averaged around each gamma");
   return text + fmt::format("; {} reduced positions.", reduced);
+}
+
+/// Every rate of the test with its centripetal level Ar = omega^2 R0 / g (g-levels, the static set's 0 g).
+std::string g_levels_text(const Scenario& s) {
+  std::string levels;
+  for (const double rate : s.test.rates_rad_s) {
+    const double ar = rate * rate * s.centrifuge.radius_m / s.site.gravity_m_s2;
+    levels += fmt::format("{}{} rad/s: {}", levels.empty() ? "" : "; ", rate,
+                          rate == 0.0 ? std::string("static") : fmt::format("Ar = {:.4g} g", ar));
+  }
+  return fmt::format("The rates and their g-levels (Ar = omega^2 R0 / g at R0 = {} m): {}.",
+                     s.centrifuge.radius_m, levels);
 }
 
 /// The reduction of reduction_text as JSON: method, reduced positions, a spinning dwell's gamma (deg).
@@ -126,6 +139,10 @@ void register_plan(CLI::App& app) {
               test_positions(s.test).size(), position_factors(s.test), s.test.revolutions,
               s.test.sample_rate_hz);
     print_out("{}\n", reduction_text(s, options.reduce, r.positions.size()));
+    print_out("{}\n", g_levels_text(s));
+    const RecordSize size = estimate_record_size(s);
+    print_out("The test lasts {:.1f} s ({:.2f} h); simulate writes {} rows, about {}.\n", size.duration_s,
+              size.duration_s / 3600.0, size.rows, size_text(size.bytes));
     if (s.sensor_kind == SensorKind::kAccelerometer)
       print_out(
           "Predicted from the configured noise (white {} ug/sqrt(Hz)); estimates are the configured "
