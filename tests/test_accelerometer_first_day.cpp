@@ -21,6 +21,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/record/record.hpp"
+#include "gyrocal/sensor/accelerometer.hpp"
 #include "support/cli_run.hpp"
 #include "support/rig_record.hpp"
 
@@ -452,6 +453,38 @@ TEST(PlanStatesTheTest, EveryGLevelTheDurationAndTheRecordSize) {
                        : std::string(unit).starts_with("MB") ? 1e6
                                                              : 1.0;
   EXPECT_NEAR(size * scale / bytes, 1.0, 0.02) << size << " " << unit << " for " << bytes << " bytes";
+  fs::remove_all(dir);
+}
+
+// ---- f. A simulated record with K1 != 1: its column's scale stated, noise referred to the input ----
+
+// simulate's accel_g column holds the sensor's output, K1 per g; the record's metadata says so
+// (output_scale_per_g = K1) and noise states N in ug referred to the input: 10 ug/sqrt(Hz), not 13.
+TEST(AccelerometerRecordScale, NoiseOfARecordWithK1NotOneIsInMicroG) {
+  const fs::path dir = fresh_test_folder("gyrocal-k1-noise");
+  Scenario s = default_scenario();
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  s.accelerometer.coefficients[AccelCoefficient::K1] = 1.30127;
+  s.accelerometer.noise = AccelerometerNoise{};
+  s.accelerometer.noise.velocity_random_walk_ug_rt_hz = 10.0;
+  s.test.sample_rate_hz = 100.0;
+  s.test.rates_rad_s = {0.0};
+  s.test.beta_rad = {kPi / 2};
+  s.test.gamma_rad = {0.0};
+  s.test.settle_s = 0.0;
+  s.test.static_hold_s = 600.0;
+  write_text(dir / "static.toml", scenario_to_toml(s));
+  const test::CliOutcome sim = run_cli(
+      "simulate --config " + (dir / "static.toml").string() + " --out " + (dir / "static.csv").string(), dir);
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  EXPECT_NE(test::slurp(dir / "static.csv").find("\n# output_scale_per_g = 1.30127\n"), std::string::npos);
+  const test::CliOutcome noise = run_cli("noise " + (dir / "static.csv").string() + " --json -", dir);
+  ASSERT_EQ(noise.status, 0) << noise.err;
+  const nlohmann::json j = nlohmann::json::parse(noise.out);
+  const double n = j["terms"]["velocity_random_walk_ug_rt_hz"]["value"].get<double>();
+  const double sigma = j["terms"]["velocity_random_walk_ug_rt_hz"]["std"].get<double>();
+  EXPECT_LT(std::abs(n - 10.0), 4.0 * sigma) << n << " +- " << sigma;
   fs::remove_all(dir);
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <span>
 
 #include <fmt/format.h>
@@ -336,7 +337,19 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
                     "sensor whose output the record holds.",
                     name, reader.output_column(), reader.output_unit(), to_string(sensor)));
   }
-  const double to_noise_unit = sensor == SensorKind::kAccelerometer ? kMicroGPerG : 1.0;
+  // gyrocal's own accelerometer record holds the output in units of K1 per g, which its metadata states
+  // (output_scale_per_g, written by simulate): the noise is referred to the input, in ug. A layout's
+  // [record] output_scale_per_g has already read a rig's column into g.
+  double to_noise_unit = sensor == SensorKind::kAccelerometer ? kMicroGPerG : 1.0;
+  if (sensor == SensorKind::kAccelerometer && !layout)
+    for (const auto& [key, value] : reader.metadata())
+      if (key == "output_scale_per_g") {
+        const double scale = std::strtod(value.c_str(), nullptr);
+        if (!std::isfinite(scale) || scale == 0.0)
+          throw Error(fmt::format("{}: its metadata output_scale_per_g = {} is not a finite non-zero number.",
+                                  name, value));
+        to_noise_unit /= std::abs(scale);
+      }
   MotionCheck motion;
   EvenSampling sampling(name, options);
   std::vector<double> rate_deg_h;

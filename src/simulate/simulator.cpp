@@ -117,6 +117,9 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
     // An accelerometer's record: its kind, noise ([accelerometer.noise] keys) and truth (parameter table).
     const Accelerometer& a = scenario.accelerometer;
     m.emplace_back("sensor", std::string(Accelerometer::kind));
+    // The output column holds the sensor's output, K1 per g (docs/records.md, "An accelerometer's record"):
+    // in g only when K1 is 1. `noise` divides by it to state the noise referred to the input, in ug.
+    m.emplace_back("output_scale_per_g", fmt::format("{}", a.coefficients[AccelCoefficient::K1]));
     for (const AccelerometerNoiseKey& key : kAccelerometerNoiseKeys)
       m.emplace_back(fmt::format("noise_{}", key.key), fmt::format("{}", a.noise.*key.member));
     for (std::size_t i = 0; i < kNumAccelCoefficients; ++i)
