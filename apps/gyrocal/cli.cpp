@@ -102,6 +102,14 @@ const char* const kCompensationHelp =
     "perpendicularity, wobble tilt and rate mismatch only (nothing to do with --seed, the random seed of "
     "simulate and montecarlo); or full (default), every configured machine error";
 
+std::string size_text(std::uintmax_t bytes) {
+  if (bytes >= 1000000000000) return fmt::format("{:.1f} TB", static_cast<double>(bytes) / 1e12);
+  if (bytes >= 1000000000) return fmt::format("{:.1f} GB", static_cast<double>(bytes) / 1e9);
+  if (bytes >= 1000000) return fmt::format("{:.1f} MB", static_cast<double>(bytes) / 1e6);
+  if (bytes >= 1000) return fmt::format("{:.1f} kB", static_cast<double>(bytes) / 1e3);
+  return fmt::format("{} bytes", bytes);
+}
+
 Scenario load_configuration(const std::string& path) {
   return path.empty() ? default_scenario() : load_scenario(path);
 }

@@ -1,6 +1,7 @@
 #pragma once
 // Shared pieces of the command line: reading the configuration, writing outputs. No physics here.
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -17,6 +18,9 @@
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 
 namespace gyrocal::cli {
+
+/// A file's size as a user reads it: "16.7 MB", "512 bytes" (powers of 1000).
+std::string size_text(std::uintmax_t bytes);
 
 /// The built-in default scenario, or the configuration file at `path` when it is not empty.
 Scenario load_configuration(const std::string& path);

@@ -17,14 +17,6 @@
 namespace gyrocal::cli {
 namespace {
 
-std::string size_text(std::uintmax_t bytes) {
-  if (bytes >= 1000000000000) return fmt::format("{:.1f} TB", static_cast<double>(bytes) / 1e12);
-  if (bytes >= 1000000000) return fmt::format("{:.1f} GB", static_cast<double>(bytes) / 1e9);
-  if (bytes >= 1000000) return fmt::format("{:.1f} MB", static_cast<double>(bytes) / 1e6);
-  if (bytes >= 1000) return fmt::format("{:.1f} kB", static_cast<double>(bytes) / 1e3);
-  return fmt::format("{} bytes", bytes);
-}
-
 /// A floor on a simulated row's length: five numbers, four commas and a newline, the noisy gyro output
 /// alone taking 15 or more characters (a typical row is about 65 bytes).
 constexpr std::uint64_t kMinRowBytes = 24;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <span>
 
 #include <fmt/format.h>
@@ -215,9 +216,12 @@ void check_output_is_noise(std::span<const double> rate_deg_h, const std::string
 
 /// One g in the unit an accelerometer's output is characterised in (ug).
 constexpr double kMicroGPerG = 1e6;
-/// A grid of output values: every distinct value within this many steps of the grid (the values' rounding is
-/// ~1e-10 step for a 1 ug step at 1 g).
-constexpr double kGridTolerance = 1e-4;
+/// A grid of output values: every distinct value within this many steps of the grid. gyrocal's own record
+/// keeps it to ~1e-10 step (a 1 ug step at 1 g); a rig's channel written in its own unit rounds it further (a
+/// 1 ug step of a 1.30127 V/g channel written in V with 9 decimals is 1301.27 nV, rounded by up to 3.8e-4 of
+/// a step). 1 % of a step still tells a grid from a continuous output, which the count of distinct values
+/// (at most a quarter of the rows) already refuses.
+constexpr double kGridTolerance = 1e-2;
 
 /// `output` (deg/h, or ug for an accelerometer) characterised for `sensor`.
 RecordNoise characterise(std::span<const double> output, double interval_s, const std::string& name,
@@ -333,7 +337,19 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
                     "sensor whose output the record holds.",
                     name, reader.output_column(), reader.output_unit(), to_string(sensor)));
   }
-  const double to_noise_unit = sensor == SensorKind::kAccelerometer ? kMicroGPerG : 1.0;
+  // gyrocal's own accelerometer record holds the output in units of K1 per g, which its metadata states
+  // (output_scale_per_g, written by simulate): the noise is referred to the input, in ug. A layout's
+  // [record] output_scale_per_g has already read a rig's column into g.
+  double to_noise_unit = sensor == SensorKind::kAccelerometer ? kMicroGPerG : 1.0;
+  if (sensor == SensorKind::kAccelerometer && !layout)
+    for (const auto& [key, value] : reader.metadata())
+      if (key == "output_scale_per_g") {
+        const double scale = std::strtod(value.c_str(), nullptr);
+        if (!std::isfinite(scale) || scale == 0.0)
+          throw Error(fmt::format("{}: its metadata output_scale_per_g = {} is not a finite non-zero number.",
+                                  name, value));
+        to_noise_unit /= std::abs(scale);
+      }
   MotionCheck motion;
   EvenSampling sampling(name, options);
   std::vector<double> rate_deg_h;

@@ -37,8 +37,9 @@ Scenario default_accelerometer_scenario() {
   // truth and noise ([accelerometer], [accelerometer.noise]), and a test that identifies all eleven
   // coefficients: a static set (the main axis stopped, the platform indexed to each gamma) and two speeds
   // break the one-speed degeneracy of K0, K2, Kpp, Koo; four beta reverse the input axis against gravity and
-  // the centripetal force; eight gamma keep a revolution's third harmonic (four would fold K3 onto the
-  // scale).
+  // the centripetal force; eight gamma set the static holds (a spinning dwell is reduced to its harmonic
+  // content, seven values, whatever gamma lists; with reduction = "window" eight gamma keep its third
+  // harmonic, where four would fold K3 onto the scale).
   Scenario s = default_scenario();
   s.sensor_kind = SensorKind::kAccelerometer;
   s.accelerometer = Accelerometer{};

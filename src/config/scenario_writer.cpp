@@ -230,7 +230,17 @@ std::string scenario_to_toml(const Scenario& s) {
   w.key("revolutions", std::to_string(t.revolutions), "whole main-axis revolutions per beta and rate");
   w.key("settle_s", toml_number(t.settle_s), "discarded after each change of beta or rate, s");
   w.key("beta_deg", number_array(t.beta_rad, kDegToRad), "position-platform angles, deg");
-  w.key("gamma_deg", number_array(t.gamma_rad, kDegToRad), "arm angles read out at each beta, deg");
+  // An accelerometer's spinning dwells are reduced to their harmonic content (seven values) whatever the
+  // list holds, unless [calibration] reduction = "window" reads them at these gamma (docs/accelerometer.md).
+  if (s.sensor_kind == SensorKind::kAccelerometer)
+    w.key(
+        "gamma_deg", number_array(t.gamma_rad, kDegToRad),
+        "arm angles, deg: the static holds' platform indices; a spinning dwell\nis reduced to the seven "
+        "values "
+        "of its harmonic content whatever this lists, unless\n[calibration] reduction = \"window\" reads it "
+        "at these (then keep seven or more: at four,\ncos^3 = cos folds K3 onto the scale)");
+  else
+    w.key("gamma_deg", number_array(t.gamma_rad, kDegToRad), "arm angles read out at each beta, deg");
   w.key("rates_rad_s", number_array(t.rates_rad_s, 1.0),
         "main rates, rad/s; absent = [centrifuge] rate_rad_s");
   w.key("counter_rate_offsets_rad_s", number_array(t.counter_rate_offsets_rad_s, 1.0),

@@ -471,11 +471,18 @@ struct RecordReader::State {
     if (columns.size() == 1) {
       fail(
           fmt::format("record.delimiter {} splits nothing in the header line {}: it is one column, but the "
-                      "record's time and output are two",
-                      delimiter_text(), header));
+                      "record's time and output are two; if lines come before the header (a preamble), set "
+                      "record.skip_rows to their number (now {}), else record.delimiter to the file's",
+                      delimiter_text(), header, layout->skip_rows));
     }
     slot.assign(columns.size(), -1);
     const auto mapped = mapped_columns();
+    // A line that names none of the configured columns is likely a preamble's (record.skip_rows).
+    bool names_any = false;
+    for (const auto& [key, configured] : mapped)
+      if (!configured->empty() &&
+          std::find(columns.begin(), columns.end(), trim(*configured)) != columns.end())
+        names_any = true;
     for (std::size_t s = 0; s < mapped.size(); ++s) {
       const auto& [key, configured] = mapped[s];
       if (configured->empty()) continue;
@@ -494,8 +501,12 @@ struct RecordReader::State {
       if (index == columns.size()) {
         const std::string problem = fmt::format(
             "record.{} = '{}' is not a column of the header line {} (split at record.delimiter "
-            "{}, the columns found are {})",
-            key, printable(wanted), header, delimiter_text(), found);
+            "{}, the columns found are {}){}",
+            key, printable(wanted), header, delimiter_text(), found,
+            names_any ? ""
+                      : fmt::format("; the line names none of the configured columns: if lines come before "
+                                    "the header (a preamble), set record.skip_rows to their number (now {})",
+                                    layout->skip_rows));
         // An angle column left at its default name may be missing: it is absent (a noise logger's record);
         // a calibration then refuses the record with this sentence (require_angles).
         if (s >= 1 && s <= 3 && RecordLayout::is_default_angle_name(wanted)) {
@@ -671,6 +682,27 @@ struct RecordReader::State {
         column + 1, printable(columns[column]), raw, conversion, limits::kOutputMagnitude, unit));
   }
 
+  /// The key that would read a field that is not a number, for the refusal (docs/records.md, "Refusals"):
+  /// a number with the other decimal mark names record.decimal; a word in the first row under a header
+  /// names record.units_row. Empty when neither fits (or for gyrocal's own format).
+  std::string not_a_number_hint(std::string_view field) const {
+    if (!layout) return {};
+    const char other = decimal == '.' ? ',' : '.';
+    if (field.find(other) != std::string_view::npos) {
+      std::string swapped(field);
+      std::replace(swapped.begin(), swapped.end(), other, '.');
+      double value = 0;
+      const auto r = fast_float::from_chars(swapped.data(), swapped.data() + swapped.size(), value);
+      if (r.ec == std::errc() && r.ptr == swapped.data() + swapped.size())
+        return fmt::format(": it is a number with the decimal mark '{}', which record.decimal = \"{}\" reads",
+                           other, other);
+    }
+    if (!have_previous && !layout->units_row)
+      return ": if this line, the first under the header, gives the columns' units, set record.units_row = "
+             "true to skip it";
+    return {};
+  }
+
   /// Parses one row into the value slots; false for a blank line (or a comment line of a layout).
   template <bool kBlankDelimited>
   bool parse_row(std::string_view text, double* values) {
@@ -720,8 +752,8 @@ struct RecordReader::State {
           }
           const std::string_view field_text = trim({field, static_cast<std::size_t>(field_end - field)});
           if (field_text.empty()) fail(fmt::format("column {} ({}) is empty", i + 1, printable(columns[i])));
-          fail(fmt::format("column {} ({}) is {}, which is not a number", i + 1, printable(columns[i]),
-                           quote(field_text)));
+          fail(fmt::format("column {} ({}) is {}, which is not a number{}", i + 1, printable(columns[i]),
+                           quote(field_text), not_a_number_hint(field_text)));
         }
         if (!std::isfinite(values[s])) {
           fail(fmt::format("column {} ({}) is {}; a record holds finite numbers only", i + 1,

@@ -11,6 +11,11 @@
 namespace gyrocal {
 namespace {
 
+/// How close a steady run's rate is to a planned rate (or to a clean factor of one) to count as at it:
+/// 1 %. A run's rate is fitted over seconds of encoder readings, far closer than this; a clean factor
+/// within 3 % (power_of) let 1/8.17 read as 1/8 when the main and counter columns were swapped.
+constexpr double kRateMatch = 0.01;
+
 /// The q-quantile of v (reorders v); 0 for none.
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
@@ -186,64 +191,190 @@ std::string RecordSummary::describe(const TestSpec& plan, const std::optional<Re
         named[i] = true;
       }
     }
-    // The spinning runs' main rates against the planned rates: a unit mistake reads every run at one factor
-    // (a power of 2 for counts per revolution, 180/pi for degrees and radians), whichever rate it turned at;
-    // the factor most runs share is named, with a run that shows it. Failing one, the longest run against its
-    // nearest planned rate.
-    const auto clean = [](double ratio) {
-      return std::abs(std::log(ratio)) > std::log(1.05) &&
-             (power_of(ratio, 2.0) || power_of(ratio, kRadToDeg) || power_of(ratio, 1000.0));
+    // The steady runs against the plan's rates (docs/records.md, "When no dwell is found"). A spinning run
+    // at a planned rate (within kRateMatch) is no evidence of a unit: a plan whose rates differ by 2 (5 g and
+    // 20 g) would otherwise read every run at its other rate as a "2x" unit mistake.
+    const auto near = [](double a, double b) { return b != 0.0 && std::abs(a / b - 1.0) < kRateMatch; };
+    const auto at_planned = [&](double rate) {
+      for (const double planned : plan.rates_rad_s)
+        if (near(rate, planned)) return true;
+      return false;
     };
+    std::vector<const RejectedRun*> spinning;
+    const auto length = [](const RejectedRun* r) { return r->end_s - r->start_s; };
+    double spinning_s = 0.0;  // the runs weigh by their length: a platform's index move is short
+    for (const RejectedRun* r : longest)
+      if (!r->is_static && r->main_rate_rad_s != 0.0) spinning.push_back(r), spinning_s += length(r);
+    // The signs: the main axis at -rate and the counter platform at +rate (the two columns swapped, or both
+    // encoders counting the other way); the main axis at a planned rate and the counter platform turning
+    // with it instead of at minus its rate (the counter encoder counting the other way); the counter standing
+    // still while the main axis turns (the counter angle logged against the ground, not the arm). Each
+    // named when runs of at least half the spinning time show it.
+    const RejectedRun* swapped = nullptr;
+    const RejectedRun* counter_reversed = nullptr;
+    const RejectedRun* counter_grounded = nullptr;
+    double swapped_s = 0.0, reversed_s = 0.0, grounded_s = 0.0;
+    for (const RejectedRun* r : spinning) {
+      const double m = r->main_rate_rad_s, c = r->counter_rate_rad_s;
+      if (at_planned(-m) && near(c, -m)) {
+        if (!swapped) swapped = r;
+        swapped_s += length(r);
+      } else if (at_planned(m) && near(c, m)) {
+        if (!counter_reversed) counter_reversed = r;
+        reversed_s += length(r);
+      } else if (at_planned(m) && std::abs(c) < 0.01 * std::abs(m)) {
+        if (!counter_grounded) counter_grounded = r;
+        grounded_s += length(r);
+      }
+    }
+    const double half = 0.5 * spinning_s;
+    if (swapped && swapped_s >= half && !named[0]) {
+      hints.push_back(fmt::format(
+          "the main axis turns at {:.6g} rad/s and the counter platform at {:.6g} rad/s, where the plan has "
+          "the main axis at {:.6g} and the counter platform at minus it: are the main and counter columns "
+          "swapped (record.main_angle_column, record.counter_angle_column), or do both encoders count the "
+          "other way?",
+          swapped->main_rate_rad_s, swapped->counter_rate_rad_s, -swapped->main_rate_rad_s));
+      named[0] = named[1] = true;
+    } else if (counter_reversed && reversed_s >= half && !named[1]) {
+      hints.push_back(fmt::format(
+          "the counter platform turns at {:.6g} rad/s with the main axis ({:.6g} rad/s), where the plan has "
+          "it at minus the main rate: does the counter encoder count the other way? Negate the counter "
+          "angle in the record (360 deg minus the reading)",
+          counter_reversed->counter_rate_rad_s, counter_reversed->main_rate_rad_s));
+      named[0] = named[1] = true;
+    } else if (counter_grounded && grounded_s >= half && !named[1]) {
+      hints.push_back(fmt::format(
+          "the counter platform stands still ({:.3g} rad/s) while the main axis turns at {:.6g} rad/s, where "
+          "the plan has it at minus the main rate: does the counter column hold the platform's angle "
+          "against the ground? gyrocal reads it relative to the arm (the ground's angle minus the main "
+          "angle)",
+          counter_grounded->counter_rate_rad_s, counter_grounded->main_rate_rad_s));
+      named[0] = named[1] = true;
+    }
+    // The main and position columns swapped: the position angle turns like the main axis while the main
+    // angle moves only between dwells.
+    if (!named[0] && step90[2] > 0.5 * planned_step && step90[0] < 0.25 * step90[2]) {
+      hints.push_back(fmt::format(
+          "the position angle changes by up to {:.4g} deg a row, as the main axis at the plan's rates, and "
+          "the "
+          "main angle by up to {:.4g}: are the main and position columns swapped (record.main_angle_column, "
+          "record.position_angle_column)?",
+          step90[2], step90[0]));
+      named[0] = named[2] = true;
+    }
+    // A unit mistake reads every run off the plan at one clean factor (a power of 2 for counts per
+    // revolution, 180/pi for degrees and radians, a power of 1000), whichever rate it turned at; the factor
+    // most such runs share is named, with a run that shows it.
+    const auto clean = [](double ratio) {
+      if (!(ratio > 0.0) || std::abs(std::log(ratio)) < std::log(1.05)) return false;
+      for (const double base : {2.0, kRadToDeg, 1000.0}) {
+        const double k = std::round(std::log(ratio) / std::log(base));
+        if (std::abs(ratio / std::pow(base, k) - 1.0) < kRateMatch) return true;
+      }
+      return false;
+    };
+    // Runs count by their length. A unit is named when runs off the plan's rates are at least a quarter of
+    // the spinning time (else the main axis keeps the plan) and its factor explains at least as long as they
+    // last.
     const RejectedRun* spin = nullptr;
-    double nearest = 0.0, ratio = 0.0;
-    int best_votes = 0;
-    for (const RejectedRun* r : longest) {
-      if (r->is_static || r->main_rate_rad_s == 0.0) continue;
+    const RejectedRun* unmatched = nullptr;
+    double nearest = 0.0, ratio = 0.0, unmatched_s = 0.0, best_s = 0.0;
+    for (const RejectedRun* r : spinning)
+      if (!at_planned(r->main_rate_rad_s)) {
+        if (!unmatched) unmatched = r;
+        unmatched_s += length(r);
+      }
+    for (const RejectedRun* r : spinning) {
+      if (at_planned(r->main_rate_rad_s)) continue;
       for (double planned : plan.rates_rad_s) {
         if (planned == 0.0) continue;
         const double q = std::abs(r->main_rate_rad_s / planned);
         if (!clean(q)) continue;
-        int votes = 0;
-        for (const RejectedRun* o : longest)
+        // Every run read at q, at the plan's rates or not, supports it: with rates 6 and 12 a main axis read
+        // at 2x turns at 12 and 24, where 4x would explain the 24 only.
+        double support = 0.0;
+        for (const RejectedRun* o : spinning) {
           for (double p2 : plan.rates_rad_s)
-            if (!o->is_static && p2 != 0.0 && std::abs(std::abs(o->main_rate_rad_s / p2) / q - 1.0) < 0.03)
-              ++votes;
-        if (votes > best_votes) best_votes = votes, spin = r, nearest = std::abs(planned), ratio = q;
+            if (p2 != 0.0 && std::abs(std::abs(o->main_rate_rad_s / p2) / q - 1.0) < kRateMatch) {
+              support += length(o);
+              break;
+            }
+        }
+        if (support > best_s) best_s = support, spin = r, nearest = std::abs(planned), ratio = q;
       }
     }
-    if (spin == nullptr) {
-      for (const RejectedRun* r : longest) {
-        if (r->is_static || r->main_rate_rad_s == 0.0) continue;
-        spin = r;
-        for (double planned : plan.rates_rad_s)
-          if (planned != 0.0 &&
-              (nearest == 0.0 || std::abs(std::log(std::abs(r->main_rate_rad_s / planned))) <
-                                     std::abs(std::log(std::abs(r->main_rate_rad_s) / nearest))))
-            nearest = std::abs(planned);
-        ratio = nearest > 0.0 ? std::abs(spin->main_rate_rad_s) / nearest : 0.0;
-        break;
-      }
-    }
+    if (unmatched_s < 0.25 * spinning_s) unmatched = nullptr, spin = nullptr;
+    if (best_s < unmatched_s) spin = nullptr;
     if (spin != nullptr && !named[0]) {
-      if (nearest > 0.0 && std::abs(std::log(ratio)) > std::log(1.05)) {
-        hints.push_back(fmt::format("the main axis turns at {} the planned rate ({:.6g} rad/s for {}): {}",
-                                    times(ratio), spin->main_rate_rad_s, nearest,
-                                    angle_unit_hint(layout, 0, ratio)));
-        named[0] = true;
+      hints.push_back(fmt::format("the main axis turns at {} the planned rate ({:.6g} rad/s for {}): {}",
+                                  times(ratio), spin->main_rate_rad_s, nearest,
+                                  angle_unit_hint(layout, 0, ratio)));
+      named[0] = true;
+      // The counter platform against the planned rate, at a clean factor of its own.
+      const double counter_ratio = std::abs(spin->counter_rate_rad_s) / nearest;
+      if (!named[1] && clean(counter_ratio)) {
+        hints.push_back(
+            fmt::format("the counter platform turns at {} the planned rate ({:.6g} rad/s against {:.6g}): {}",
+                        times(counter_ratio), spin->counter_rate_rad_s, nearest,
+                        angle_unit_hint(layout, 1, counter_ratio)));
+        named[1] = true;
+      }
+    } else if (unmatched != nullptr && !named[0]) {
+      // Off the plan by no clean factor: no unit explains it.
+      std::string rates_text;
+      for (double r : plan.rates_rad_s) rates_text += fmt::format("{}{}", rates_text.empty() ? "" : ", ", r);
+      hints.push_back(fmt::format(
+          "the main axis turns at {:.6g} rad/s, which is neither a planned rate ([{}] rad/s) nor one at a "
+          "clean factor (a power of 2, 180/pi, a power of 1000), so no unit explains it: is [test] "
+          "rates_rad_s the test's?",
+          unmatched->main_rate_rad_s, rates_text));
+      named[0] = true;
+    } else if (!spinning.empty() && !named[1]) {
+      // The main axis at the plan's rates: the counter platform at a clean factor of minus the main rate.
+      const RejectedRun* r = spinning.front();
+      const double counter_ratio = std::abs(r->counter_rate_rad_s / r->main_rate_rad_s);
+      if (clean(counter_ratio)) {
+        hints.push_back(fmt::format(
+            "the counter platform turns at {} the main axis' rate ({:.6g} rad/s against {:.6g}): {}",
+            times(counter_ratio), r->counter_rate_rad_s, r->main_rate_rad_s,
+            angle_unit_hint(layout, 1, counter_ratio)));
+        named[1] = true;
       }
     }
-    if (spin != nullptr) {
-      // The counter platform against minus the main rate, or, when the main axis is itself off, against the
-      // planned rate.
-      const double reference = named[0] ? nearest : std::abs(spin->main_rate_rad_s);
-      const double counter_ratio = std::abs(spin->counter_rate_rad_s) / reference;
-      if (!named[1] && reference > 0.0 && counter_ratio > 0.0 &&
-          std::abs(std::log(counter_ratio)) > std::log(1.05)) {
-        hints.push_back(
-            fmt::format("the counter platform turns at {} the {} ({:.6g} rad/s against {:.6g}): {}",
-                        times(counter_ratio), named[0] ? "planned rate" : "main axis' rate",
-                        spin->counter_rate_rad_s, reference, angle_unit_hint(layout, 1, counter_ratio)));
+    // The position platform: the runs' beta against the plan's, at one clean factor (its counts per
+    // revolution, or its unit).
+    if (!named[2]) {
+      const auto planned_beta = [&](double beta_deg) {
+        for (const double b : plan.beta_rad) {
+          const double d = std::remainder(beta_deg - b * kRadToDeg, 360.0);
+          if (std::abs(d) < 0.5) return true;
+        }
+        return false;
+      };
+      const RejectedRun* off = nullptr;
+      double beta_ratio = 0.0, beta_planned = 0.0;
+      int beta_votes = 0;
+      for (const RejectedRun* r : longest) {
+        if (std::abs(r->beta_deg) < 0.5 || planned_beta(r->beta_deg)) continue;
+        for (const double b : plan.beta_rad) {
+          const double bd = b * kRadToDeg;
+          if (std::abs(bd) < 0.5) continue;
+          const double q = r->beta_deg / bd;
+          if (!clean(q)) continue;
+          int votes = 0;
+          for (const RejectedRun* o : longest)
+            for (const double b2 : plan.beta_rad)
+              if (std::abs(b2) * kRadToDeg >= 0.5 &&
+                  std::abs(o->beta_deg / (b2 * kRadToDeg) / q - 1.0) < 0.01)
+                ++votes;
+          if (votes > beta_votes) beta_votes = votes, off = r, beta_ratio = q, beta_planned = bd;
+        }
       }
+      if (off != nullptr)
+        hints.push_back(
+            fmt::format("the position platform reads beta {:.6g} deg where the plan has {:.6g} deg: {}",
+                        off->beta_deg, beta_planned, angle_unit_hint(layout, 2, beta_ratio)));
     }
   }
   if (!hints.empty()) {

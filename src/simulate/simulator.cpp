@@ -1,6 +1,8 @@
 #include "gyrocal/simulate/simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -38,6 +40,32 @@ std::string list(const std::vector<double>& values, double scale) {
   return s + "]";
 }
 
+/// The sensor's noise: the gyro's in deg/h, the accelerometer's referred to its input and scaled by K1.
+using NoiseGenerator = std::variant<GyroNoiseGenerator, AccelerometerNoiseGenerator>;
+
+NoiseGenerator make_noise(const Scenario& scenario, double fs, std::uint64_t seed) {
+  return scenario.sensor_kind == SensorKind::kAccelerometer
+             ? NoiseGenerator(std::in_place_type<AccelerometerNoiseGenerator>, scenario.accelerometer.noise,
+                              scenario.accelerometer.coefficients[AccelCoefficient::K1], fs, seed)
+             : NoiseGenerator(std::in_place_type<GyroNoiseGenerator>, scenario.noise, fs, seed);
+}
+
+/// The row at time t: the encoders' readings and the sensor's output with the generator's next noise.
+void sample_at(const CentrifugeModel& model, const Sensor& sensor, const Timeline& timeline, double t,
+               NoiseGenerator& noise, RecordSample& sample) {
+  const JointState joints = joint_state_at(timeline, t);
+  const GyroInputs inputs = exact_inputs(model, joints);
+  sample.time_s = t;
+  sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
+  sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
+  sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
+  // The sensor's noise-free output at the exact inputs (Gyro: docs/physics.md sections 6 and 15, the sensed
+  // rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
+  // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
+  const double clean = sensor_output(sensor, inputs);
+  sample.output = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
+}
+
 /// The simulation loop; `sink` is a template parameter so that the record writer's call is direct.
 template <typename Sink>
 SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed,
@@ -45,27 +73,11 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
   const CentrifugeModel model = scenario.model();
   const double fs = scenario.test.sample_rate_hz;
   const Sensor sensor = scenario.sensor();
-  // The sensor's noise: the gyro's in deg/h, the accelerometer's referred to its input and scaled by K1.
-  std::variant<GyroNoiseGenerator, AccelerometerNoiseGenerator> noise =
-      scenario.sensor_kind == SensorKind::kAccelerometer
-          ? decltype(noise)(std::in_place_type<AccelerometerNoiseGenerator>, scenario.accelerometer.noise,
-                            scenario.accelerometer.coefficients[AccelCoefficient::K1], fs, seed)
-          : decltype(noise)(std::in_place_type<GyroNoiseGenerator>, scenario.noise, fs, seed);
+  NoiseGenerator noise = make_noise(scenario, fs, seed);
   const std::uint64_t n = sample_count(timeline, fs);
   RecordSample sample;
   for (std::uint64_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / fs;
-    const JointState joints = joint_state_at(timeline, t);
-    const GyroInputs inputs = exact_inputs(model, joints);
-    sample.time_s = t;
-    sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
-    sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
-    sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
-    // The sensor's noise-free output at the exact inputs (Gyro: docs/physics.md sections 6 and 15, the sensed
-    // rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
-    // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
-    const double clean = sensor_output(sensor, inputs);
-    sample.output = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
+    sample_at(model, sensor, timeline, static_cast<double>(k) / fs, noise, sample);
     sink(sample);
     if (options.progress && (k + 1) % kProgressEverySamples == 0) {
       options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
@@ -105,6 +117,9 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
     // An accelerometer's record: its kind, noise ([accelerometer.noise] keys) and truth (parameter table).
     const Accelerometer& a = scenario.accelerometer;
     m.emplace_back("sensor", std::string(Accelerometer::kind));
+    // The output column holds the sensor's output, K1 per g (docs/records.md, "An accelerometer's record"):
+    // in g only when K1 is 1. `noise` divides by it to state the noise referred to the input, in ug.
+    m.emplace_back("output_scale_per_g", fmt::format("{}", a.coefficients[AccelCoefficient::K1]));
     for (const AccelerometerNoiseKey& key : kAccelerometerNoiseKeys)
       m.emplace_back(fmt::format("noise_{}", key.key), fmt::format("{}", a.noise.*key.member));
     for (std::size_t i = 0; i < kNumAccelCoefficients; ++i)
@@ -154,6 +169,42 @@ SimulationSummary simulate_record(const Scenario& scenario, const SimulationOpti
       run(scenario, timeline, seed, options, [&writer](const RecordSample& s) { writer.write(s); });
   writer.finish();
   return summary;
+}
+
+RecordSize estimate_record_size(const Scenario& scenario) {
+  const Timeline timeline = make_timeline(scenario.test, scenario.model());
+  const double fs = scenario.test.sample_rate_hz;
+  RecordSize size;
+  size.rows = sample_count(timeline, fs);
+  size.duration_s = timeline.duration_s;
+  const std::string_view column =
+      std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());
+  // The head exactly, then up to kSampledRows rows spread evenly over the test, written as simulate writes
+  // them: the mean row's length times the rows.
+  constexpr std::uint64_t kSampledRows = 2000;
+  std::ostringstream head;
+  RecordWriter(head, simulation_metadata(scenario, timeline, scenario.test.seed), {}, column).finish();
+  const std::uint64_t stride = std::max<std::uint64_t>(1, size.rows / kSampledRows);
+  std::ostringstream rows;
+  RecordWriter writer(rows, {}, {}, column);
+  const std::size_t rows_head = rows.str().size();
+  const CentrifugeModel model = scenario.model();
+  const Sensor sensor = scenario.sensor();
+  NoiseGenerator noise = make_noise(scenario, fs, scenario.test.seed);
+  RecordSample sample;
+  std::uint64_t written = 0;
+  for (std::uint64_t k = 0; k < size.rows; k += stride, ++written) {
+    sample_at(model, sensor, timeline, static_cast<double>(k) / fs, noise, sample);
+    writer.write(sample);
+  }
+  writer.finish();
+  const auto row_bytes = static_cast<double>(rows.str().size() - rows_head);
+  size.bytes =
+      head.str().size() +
+      (written == 0 ? 0
+                    : static_cast<std::uint64_t>(std::llround(row_bytes / static_cast<double>(written) *
+                                                              static_cast<double>(size.rows))));
+  return size;
 }
 
 }  // namespace gyrocal

@@ -45,6 +45,17 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
 SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& options,
                            const SampleSink& sink);
 
+/// What `simulate` would write for the scenario's test, without simulating it (plan prints it): its rows, its
+/// duration, s, and its size, bytes: the metadata and header exactly, the rows as the mean length of up to
+/// 2000 rows simulated at instants spread evenly over the test (the rows' numbers take their shortest exact
+/// form, whose length varies by a few characters) times their number.
+struct RecordSize {
+  std::uint64_t rows = 0;
+  double duration_s = 0.0;
+  std::uint64_t bytes = 0;
+};
+RecordSize estimate_record_size(const Scenario& scenario);
+
 /// Simulates the scenario's test into a record (metadata, header, rows) written to `out`. Throws Error as
 /// simulate() does, or if writing fails.
 SimulationSummary simulate_record(const Scenario& scenario, const SimulationOptions& options,
