@@ -95,6 +95,13 @@ bool MonteCarloOptions::IsValid(std::string* error) const {
   return false;
 }
 
+void MonteCarloSource::add_to(Scenario& s, double amount_si) const {
+  if (gravity)
+    s.site.gravity_m_s2 += amount_si;
+  else
+    term.add_to(s.errors, amount_si);
+}
+
 MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw Error("Monte Carlo options: " + error + ".");
@@ -109,6 +116,14 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (const MachineErrorParameter& e : m.calibration.estimate) e.set(m.told.errors, 0.0);
   }
   for (const auto& [term, u] : nonzero_error_terms(scenario.uncertainty)) m.sources.push_back({term, u});
+  if (scenario.gravity_uncertainty_m_s2 > 0.0) {
+    // The local gravity: the record is taken under the drawn g, the calibration told the configured one
+    // (an accelerometer reads the radius as omega^2 R / g: R0 u_g / g of radius, docs/montecarlo.md).
+    MachineErrorTerm g;
+    g.error = "gravity";
+    g.unit = "m/s^2";
+    m.sources.push_back({g, scenario.gravity_uncertainty_m_s2, true});
+  }
   const ReduceOptions& ro = options.calibration.reduce;
 
   const bool gyro = scenario.sensor_kind == SensorKind::kGyro;
@@ -209,7 +224,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     Eigen::VectorXd side[2];
     for (int k = 0; k < 2; ++k) {
       Scenario drawn = scenario;
-      m.sources[s].term.add_to(drawn.errors, (k == 0 ? 1.0 : -1.0) * m.sources[s].std_si);
+      m.sources[s].add_to(drawn, (k == 0 ? 1.0 : -1.0) * m.sources[s].std_si);
       // The drawn machine's outputs; the channels of the configured machine on its encoder lines.
       PlannedSensorTest p = planned(drawn, model0, false, false);
       const Reduction& r = p.reduction;
@@ -293,8 +308,7 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     }
     // The same draws of the machine errors as the fast mode, then the whole pipeline.
     Scenario s = m.scenario;
-    for (std::size_t c = 0; c < ns; ++c)
-      m.sources[c].term.add_to(s.errors, m.sources[c].std_si * rng.normal());
+    for (std::size_t c = 0; c < ns; ++c) m.sources[c].add_to(s, m.sources[c].std_si * rng.normal());
     // Reduced as calibrate reduces the sensor's record (an accelerometer's spinning dwells to their whole
     // harmonic content).
     Reducer reducer(reduction_plan(s.test, s.sensor_kind, m.calibration.reduce), m.calibration.reduce,

@@ -41,6 +41,8 @@ constexpr Range kRateError{-1e5, 1e5, false};
 // Physically generous ranges (core/limits.hpp): beyond them the model's products leave a double's range
 // ([gyro] dF = 1e308 made `plan` say "Observation 0 is not finite").
 constexpr Range kGravity{0.0, limits::kGravityMS2, true, "limits::kGravityMS2, ten times the Earth's"};
+constexpr Range kGravityUncertainty{0.0, limits::kGravityUncertaintyMS2, false,
+                                    "limits::kGravityUncertaintyMS2, 10 % of the Earth's gravity"};
 constexpr Range kEarthRate{0.0, limits::kEarthRateRadS, false, "limits::kEarthRateRadS"};
 constexpr Range kRadius{0.0, limits::kRadiusM, true,
                         "limits::kRadiusM, 100 times the largest centrifuge's arm"};

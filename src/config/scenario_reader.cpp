@@ -288,6 +288,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
                   test_table ? test_table->get("rates_rad_s") : nullptr, s);
 
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
+  uncertainty.number("gravity_m_s2", 1.0, kGravityUncertainty, s.gravity_uncertainty_m_s2);
   read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
 
   Section calibration(reader, top.table("calibration"), "calibration");

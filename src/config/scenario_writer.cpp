@@ -256,6 +256,9 @@ std::string scenario_to_toml(const Scenario& s) {
       "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
       "and phase_deg its nominal phase.");
   write_errors(w, s.uncertainty);
+  w.key("gravity_m_s2", toml_number(s.gravity_uncertainty_m_s2),
+        "local gravity's ([site] gravity_m_s2), m/s^2: 1e-5 m/s^2 is 1 ppm, which reads as 1 um of radius at "
+        "1 m");
 
   w.section("calibration", "The calibration's choices; the command line's options override them.");
   std::string names = "[";

@@ -3,6 +3,7 @@
 // Identification's orchestration: the record reduced, the model's channels of the sensor, then the fit the
 // options ask for (closed forms, least squares, self-calibration) and the misfit rule. Each step lives in its
 // own file of src/identify (docs/architecture.md, "identify").
+#include <algorithm>
 #include <optional>
 #include <span>
 #include <string>
@@ -36,6 +37,28 @@ std::vector<PositionChannels> model_channels(const Reduction& reduction, const C
 }  // namespace gyrocal::identify_detail
 
 namespace gyrocal {
+namespace {
+
+/// An accelerometer's radius estimated from its data is omega^2 R / g: stated with the gravity it assumes
+/// (docs/calibration.md, "The radius is measured against gravity").
+void warn_radius_is_over_gravity(const CentrifugeModel& model, const CalibrationOptions& options,
+                                 CalibrationResult& r) {
+  const bool radius =
+      std::any_of(options.estimate.begin(), options.estimate.end(), [](const MachineErrorParameter& p) {
+        const std::string name = p.error_name();
+        return name == "radius_error" || name == "radius_stretch";
+      });
+  if (!radius) return;
+  const double g = model.site().gravity_m_s2;
+  const double r0 = model.geometry().radius_m;
+  r.warnings.push_back(fmt::format(
+      "the radius is measured as omega^2 R / g with the configured local gravity g = {:.9g} m/s^2 ([site] "
+      "gravity_m_s2): a gravity off by 1 ppm ({:.2g} m/s^2) reads as a radius error of 1 ppm, {:.3g} um at "
+      "R0 = {:g} m (R0 (g0/g - 1)); give the local gravity to the radius's precision.",
+      g, 1e-6 * g, r0, r0));
+}
+
+}  // namespace
 
 using namespace identify_detail;
 
@@ -88,6 +111,7 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
       refuse_setup_mistake_before_estimating(reduction, channels, model, options, r.g_level);
     // No closed-form alternatives: they would compensate the configured errors, not the estimated ones.
     r = self_calibrate(reduction, channels, model, options, r);
+    if (options.sensor == SensorKind::kAccelerometer) warn_radius_is_over_gravity(model, options, r);
   } else if (options.method == Method::kClosedForm) {
     closed_form_identify(reduction, channels, model, options, r);
   } else {

@@ -50,10 +50,17 @@ struct MonteCarloOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// An error source: one [uncertainty] entry (a scalar, a harmonic term, a vector component).
+/// An error source: one [uncertainty] entry (a scalar, a harmonic term, a vector component, or the local
+/// gravity).
 struct MonteCarloSource {
   MachineErrorTerm term;
   double std_si = 0.0;  ///< its standard uncertainty, SI
+  /// The local gravity ([uncertainty] gravity_m_s2): drawn into the site's gravity, not the machine's errors
+  /// (term holds its label "gravity" and unit m/s^2 only).
+  bool gravity = false;
+
+  /// Adds `amount_si` of this source to the scenario (the site's gravity or a machine error).
+  void add_to(Scenario& s, double amount_si) const;
 };
 
 /// The fast mode's linear model of one scenario and calibration: estimate error = bias + G * xi, xi standard

@@ -27,6 +27,9 @@ struct Scenario {
   GyroNoise noise;               ///< [gyro.noise]
   TestSpec test;                 ///< [test]
   CentrifugeErrors uncertainty;  ///< [uncertainty]: standard uncertainty of each error (Monte Carlo)
+  /// [uncertainty] gravity_m_s2: the standard uncertainty of the local gravity ([site] gravity_m_s2), m/s^2
+  /// (Monte Carlo). The radius is measured as omega^2 R / g, so 1 ppm of g reads as 1 ppm of R (1 um at 1 m).
+  double gravity_uncertainty_m_s2 = 0.0;
   /// [calibration] estimate: machine errors estimated from the data (--estimate; docs/self_calibration.md),
   /// names as model/machine_errors.hpp parses them. Empty by default.
   std::vector<std::string> estimate;

@@ -108,6 +108,9 @@ inline constexpr double kAccelerometerScale = 1e12;
 inline constexpr double kRadiusM = 1000.0;
 /// Local gravity ([site] gravity_m_s2), m/s^2: ten times the Earth's.
 inline constexpr double kGravityMS2 = 100.0;
+/// The local gravity's standard uncertainty ([uncertainty] gravity_m_s2), m/s^2: 1 m/s^2 (10 % of the
+/// Earth's) is no survey's; it keeps a Monte Carlo draw of the gravity positive by ten of them.
+inline constexpr double kGravityUncertaintyMS2 = 1.0;
 /// The Earth rate ([site] earth_rate_rad_s), rad/s: 1.4e4 times the Earth's.
 inline constexpr double kEarthRateRadS = 1.0;
 
