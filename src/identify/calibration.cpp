@@ -13,6 +13,7 @@
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/misfit.hpp"
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
@@ -105,7 +106,9 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
     r.data_quality.rejected.push_back({x.start_s, x.end_s, x.reason});
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
-  if (options.test_misfit) refuse_constant_output(reduction, options.output);
+  if (options.test_misfit)
+    refuse_constant_output(reduction, options.output, noise_free_level(reduction, channels, options.sensor),
+                           options.sensor);
   if (!options.estimate.empty()) {
     if (options.test_misfit)
       refuse_setup_mistake_before_estimating(reduction, channels, model, options, r.g_level);
@@ -116,6 +119,7 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
     closed_form_identify(reduction, channels, model, options, r);
   } else {
     least_squares_identify(reduction, channels, model, options, r);
+
     // The closed form's second expressions are a useful cross-check whenever the plan holds the 16 positions.
     if (options.sensor == SensorKind::kGyro && !sixteen_positions(reduction.positions).empty()) {
       CalibrationResult cf;
@@ -126,7 +130,11 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
       r.alternatives = cf.alternatives;
     }
   }
+  const bool accelerometer = options.sensor == SensorKind::kAccelerometer;
+  // A K1 no accelerometer has (a wrong output column) is refused before its residuals are judged.
+  if (options.test_misfit && accelerometer) refuse_insignificant_k1(options, r);
   if (options.test_misfit) apply_misfit_rule(reduction, channels, model, options, r);
+  if (options.test_misfit && accelerometer) check_accelerometer_after_misfit(reduction, channels, options, r);
   return r;
 }
 
@@ -151,6 +159,7 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
   if (layout) {
     o.output.scale_key = std::string(layout->output_scale_key());
     o.output.scale = layout->output_scale();
+    o.output.column = layout->output_column;
   }
   // The output's range is kept for the misfit's causes (identify/misfit.hpp: a flat top).
   // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_channels.hpp).

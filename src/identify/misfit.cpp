@@ -101,10 +101,10 @@ std::optional<Reduction> mirror_beta(const Reduction& r) {
   return permute_outputs(r, partner, slots);
 }
 
-/// A standard error below 1e-6 deg/h is a noise-free output's rounding (1e-10..1e-8 deg/h), not noise: no
-/// gyro's reduced output is that quiet (0.002 deg/rt(h) over a few seconds leaves ~1e-2 deg/h).
-bool without_noise(double std_err_deg_h) {
-  return !(std_err_deg_h > 1e-6);
+/// A standard error at or below `noise_free` (kGyroNoiseFreeDegH for the gyro; for an accelerometer
+/// kAccelerometerNoiseFreeRelative of the record's own g) is a noise-free output's rounding, not noise.
+bool without_noise(double std_err, double noise_free) {
+  return !(std_err > noise_free);
 }
 
 std::string number(double v) {
@@ -134,13 +134,14 @@ double weight_dof(const Reduction& reduction) {
   return measured ? sum : std::numeric_limits<double>::infinity();
 }
 
-MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof) {
+MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof, double noise_free) {
   MisfitTest t;
   t.chi2 = chi2;
   t.dof = dof;
   t.weight_dof = weight_dof(reduction);
-  const bool measured = std::any_of(reduction.positions.begin(), reduction.positions.end(),
-                                    [](const ReducedPosition& p) { return !without_noise(p.std_err_deg_h); });
+  const bool measured =
+      std::any_of(reduction.positions.begin(), reduction.positions.end(),
+                  [&](const ReducedPosition& p) { return !without_noise(p.std_err_deg_h, noise_free); });
   // A prediction's covariance is known (its outputs are noise-free by construction): nothing to test.
   t.tested = measured && dof > 0 && std::isfinite(t.weight_dof);
   t.p_value = t.tested ? misfit_p_value(chi2, dof, t.weight_dof) : 1.0;
@@ -205,19 +206,33 @@ std::vector<MisfitCause> gyro_misfit_causes(const OutputConfiguration& output) {
   return causes;
 }
 
-void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output) {
+std::vector<MisfitCause> accelerometer_misfit_causes() {
+  std::vector<MisfitCause> causes;
+  for (MisfitCause& c : gyro_misfit_causes(OutputConfiguration{}))
+    if (c.name.find("counted the other way") != std::string::npos) causes.push_back(std::move(c));
+  return causes;
+}
+
+void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output, double noise_free,
+                            SensorKind sensor) {
   if (reduction.positions.size() < 2) return;
   const double v0 = reduction.positions.front().mean_deg_h;
   bool constant = true;
   double largest = 0.0;
   for (const ReducedPosition& p : reduction.positions) {
-    if (!without_noise(p.std_err_deg_h)) return;
+    if (!without_noise(p.std_err_deg_h, noise_free)) return;
     // Constant relative to the values' own magnitude: outputs of 1e-299 deg/h that differ by a third between
     // positions vary (a scale wrong by 1e300), and were called constant against an absolute 1e-9.
     if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean_deg_h))))
       constant = false;
     largest = std::max(largest, std::abs(p.mean_deg_h));
   }
+  if (constant && sensor != SensorKind::kGyro)
+    throw Error(fmt::format(
+        "the {} output is the constant {} (as read: {} = {}) at every one of the {} positions, with no "
+        "scatter at all: a dead or disconnected sensor (or a [record] output_column that names a column "
+        "that does not change); nothing can be calibrated from it.",
+        to_string(sensor), number(v0), output.scale_key, number(output.scale), reduction.positions.size()));
   if (constant)
     throw Error(fmt::format(
         "the gyro output is the constant {} deg/h at every one of the {} positions, with no scatter at all: "

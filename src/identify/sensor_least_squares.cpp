@@ -18,6 +18,7 @@
 #include "gyrocal/identify/identifiability.hpp"
 
 #include "fit_refusals.hpp"
+#include "misfit_rule.hpp"
 #include "position_covariance.hpp"
 
 namespace gyrocal::identify_detail {
@@ -303,8 +304,13 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
           "seven numbers of a revolution (--reduction harmonic, docs/accelerometer.md).",
           fewest));
   }
-  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
-  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
+  // The floor in the output's own g (min_std_err_deg_h is read as g for an accelerometer), so that the
+  // weights do not depend on the unit the output is read in ([record] output_scale_per_g).
+  const double floor =
+      options.min_std_err_deg_h *
+      (options.sensor == SensorKind::kAccelerometer ? accelerometer_output_per_g(reduction, channels) : 1.0);
+  const Eigen::MatrixXd covariance = position_covariance(reduction, floor);
+  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, floor);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
   if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
   LeastSquaresOptions lso = options.least_squares;

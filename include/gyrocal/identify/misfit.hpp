@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/sensor/sensor.hpp"
 
 namespace gyrocal {
 
@@ -48,10 +49,25 @@ struct MisfitTest {
   double scale = 1.0;  ///< the factor every stated std was multiplied by (1: the weights' own)
 };
 
-/// The test of a fit (chi2, dof) of `reduction`. Not tested when every position's standard error is zero (a
-/// noise-free record: the weights are the floor, not a measurement) or when no dwell's level is measured (a
-/// prediction: its outputs are noise-free by construction).
-MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof);
+/// The gyro's noise-free level, deg/h: a standard error at or below it is a noise-free output's rounding
+/// (1e-10..1e-8 deg/h), not noise; no gyro's reduced output is that quiet (0.002 deg/rt(h) over a few seconds
+/// leaves ~1e-2 deg/h). The gyro's reduction is in deg/h whatever the [record] scale (the scale is divided
+/// out, and a wrong one is a misfit of its own), so the level is in the sensor's unit.
+inline constexpr double kGyroNoiseFreeDegH = 1e-6;
+
+/// An accelerometer's noise-free level, as a fraction of the record's own g (its output per g as read,
+/// identify/misfit_rule.hpp):
+/// 1e-12 g, i.e. 1e-6 ug, whatever unit the output is read in. Rounding a double leaves ~1e-16 of the
+/// outputs (a few g); no accelerometer's reduced output is quieter than ~1e-3 ug (1 ug/rt(Hz) over a
+/// thousand seconds).
+inline constexpr double kAccelerometerNoiseFreeRelative = 1e-12;
+
+/// The test of a fit (chi2, dof) of `reduction`. Not tested when every position's standard error is at or
+/// below `noise_free` (the reduction's units; a noise-free record: the weights are the floor, not a
+/// measurement) or when no dwell's level is measured (a prediction: its outputs are noise-free by
+/// construction).
+MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof,
+                       double noise_free = kGyroNoiseFreeDegH);
 
 /// The extremes of a record's output and how many samples sit exactly on them: a saturated or clipped channel
 /// holds its limit over many samples (a flat top), a noisy output reaches its extreme once. Streaming, O(1).
@@ -73,7 +89,8 @@ class OutputRange {
 /// the output to deg/h and its configured value; and, when the record was read, its output's range.
 struct OutputConfiguration {
   std::string scale_key = "output_scale_per_deg_h";
-  double scale = 1.0;  ///< output units per deg/h, as configured
+  double scale = 1.0;  ///< output units per deg/h (per g for an accelerometer), as configured
+  std::string column;  ///< the [record] output_column read, empty for gyrocal's own record
   OutputRange range;   ///< the record's output (in deg/h) as read; empty when not tracked
 };
 
@@ -91,12 +108,20 @@ struct MisfitCause {
 /// the position platform's angle counted the other way (positions in another order).
 std::vector<MisfitCause> gyro_misfit_causes(const OutputConfiguration& output);
 
+/// An accelerometer's causes that are transforms of the reduced output: the position platform's and the
+/// counter platform's angles counted the other way. Its sign and unit cannot misfit (K1 is fitted: they
+/// are judged against the configured scale once fitted, identify/misfit_rule.hpp), and the radius, the
+/// local gravity and the counter encoder's zero are refits (identify/misfit_rule.cpp).
+std::vector<MisfitCause> accelerometer_misfit_causes();
+
 /// The reduction with every reduced output (values, standard errors, covariances) multiplied by `factor`.
 Reduction scale_outputs(const Reduction& reduction, double factor);
 
-/// Throws gyrocal::Error when the output is one constant at every position with no scatter at all: a dead
-/// or disconnected sensor (or an output column that does not change) calibrates nothing.
-void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output);
+/// Throws gyrocal::Error when the output is one constant at every position with no scatter at all (every
+/// standard error at or below `noise_free`, the reduction's units): a dead or disconnected sensor (or an
+/// output column that does not change) calibrates nothing. `sensor` words the message.
+void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output,
+                            double noise_free = kGyroNoiseFreeDegH, SensorKind sensor = SensorKind::kGyro);
 
 /// A cause read from the data rather than a refit, for a misfitting record: more than 0.5 % of the record's
 /// samples (and at least 10) exactly at its largest or smallest output (a flat top: saturated or clipped), or
