@@ -100,7 +100,9 @@ const char* const kCompensationHelp =
     "What is subtracted from each measurement before the fit: none; seed, the correction of the seed paper "
     "this method comes from (Wang & Meng 2017, docs/physics.md section 8): the counter platform's "
     "perpendicularity, wobble tilt and rate mismatch only (nothing to do with --seed, the random seed of "
-    "simulate and montecarlo); or full (default), every configured machine error";
+    "simulate and montecarlo); or full (default), every configured machine error. none and seed are a "
+    "gyro's; "
+    "an accelerometer is calibrated with full";
 
 Scenario load_configuration(const std::string& path) {
   return path.empty() ? default_scenario() : load_scenario(path);
@@ -279,8 +281,9 @@ void ProgressBar::operator()(double fraction) {
 void add_gyro_model_option(CLI::App* sub, std::string& value) {
   sub->add_option(
          "--gyro-model", value,
-         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
-         "misalignments, by least squares); default: [calibration] gyro_model, else drift")
+         "A gyro's model (an accelerometer has one, IEEE 1293's): drift (the ten drift coefficients) or "
+         "drift+rate (also the scale-factor error and the input axis' misalignments, by least squares); "
+         "default: [calibration] gyro_model, else drift")
       ->check(CLI::IsMember({"drift", "drift+rate"}));
 }
 
