@@ -90,7 +90,7 @@ TEST(AccelerometerSensitivity, ShiftIsTheFiniteDifferenceOfTwoSimulatedCalibrati
   EXPECT_TRUE(study.closed_form_names.empty());
   ASSERT_EQ(study.least_squares_names.size(), kNumAccelCoefficients);
   EXPECT_EQ(study.units.at("delta_p"), "urad");
-  EXPECT_EQ(study.units.at("K1"), "output/g");
+  EXPECT_EQ(study.units.at("K1"), "g/g");  // gyrocal's own record is in g
 
   Scenario perfect = s;
   perfect.errors = CentrifugeErrors{};

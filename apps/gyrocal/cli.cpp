@@ -100,7 +100,9 @@ const char* const kCompensationHelp =
     "What is subtracted from each measurement before the fit: none; seed, the correction of the seed paper "
     "this method comes from (Wang & Meng 2017, docs/physics.md section 8): the counter platform's "
     "perpendicularity, wobble tilt and rate mismatch only (nothing to do with --seed, the random seed of "
-    "simulate and montecarlo); or full (default), every configured machine error";
+    "simulate and montecarlo); or full (default), every configured machine error. none and seed are a "
+    "gyro's; "
+    "an accelerometer is calibrated with full";
 
 std::string size_text(std::uintmax_t bytes) {
   if (bytes >= 1000000000000) return fmt::format("{:.1f} TB", static_cast<double>(bytes) / 1e12);
@@ -287,8 +289,9 @@ void ProgressBar::operator()(double fraction) {
 void add_gyro_model_option(CLI::App* sub, std::string& value) {
   sub->add_option(
          "--gyro-model", value,
-         "drift (the ten coefficients) or drift+rate (also the scale-factor error and the input axis' "
-         "misalignments, by least squares); default: [calibration] gyro_model, else drift")
+         "A gyro's model (an accelerometer has one, IEEE 1293's): drift (the ten drift coefficients) or "
+         "drift+rate (also the scale-factor error and the input axis' misalignments, by least squares); "
+         "default: [calibration] gyro_model, else drift")
       ->check(CLI::IsMember({"drift", "drift+rate"}));
 }
 

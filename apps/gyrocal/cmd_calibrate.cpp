@@ -28,18 +28,23 @@ void register_calibrate(CLI::App& app) {
     bool force = false;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* sub = app.add_subcommand("calibrate", "Reduce a record and identify the drift coefficients");
+  CLI::App* sub = app.add_subcommand("calibrate",
+                                     "Reduce a record and identify the sensor's coefficients (a gyro's drift "
+                                     "coefficients, an accelerometer's IEEE 1293 coefficients)");
   sub->add_option("RECORD", opt->record, "Test record (CSV, docs/contract.md)")->required();
   sub->add_option(
       "--config", opt->config,
       "Configuration file (TOML): the machine, site and plan of the test, and the record's layout "
       "([record])");
-  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+  sub->add_option(
+         "--method", opt->method,
+         "closed-form (a gyro's 16-position test) or least-squares (default; an accelerometer's only)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation, kCompensationHelp)
       ->check(CLI::IsMember({"none", "seed", "full"}));
   sub->add_option("--reduction", opt->reduction,
-                  "harmonic (harmonic fit in gamma with drift) or window (mean around each gamma); default: "
+                  "harmonic (harmonic fit in gamma with a linear trend in time) or window (mean around each "
+                  "gamma); default: "
                   "[calibration] reduction, else harmonic")
       ->check(CLI::IsMember({"harmonic", "window"}));
   sub->add_option(

@@ -16,6 +16,7 @@
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/coefficient_order.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -108,11 +109,11 @@ void accelerometer_demo(const std::string& out, bool force) {
   j["radius_from_the_sensor"] = calibration_to_json(results.back())["machine_errors"];
   print_out("\nsensitivity study (each machine error alone, exact shifts) and a fast Monte Carlo...\n");
   const SensitivityResult sensitivity = sensitivity_study(s);
-  j["sensitivity"] = sensitivity_to_json(sensitivity);
+  j["sensitivity"] = in_coefficient_order(sensitivity_to_json(sensitivity), s.sensor_kind);
   MonteCarloOptions mc;
   mc.trials = 20000;
   const MonteCarloResult budget = monte_carlo(s, mc);
-  j["montecarlo"] = montecarlo_to_json(budget);
+  j["montecarlo"] = in_coefficient_order(montecarlo_to_json(budget), s.sensor_kind);
   print_out("{} machine-error rows studied; {} Monte Carlo trials ({} mode)\n", sensitivity.rows.size(),
             budget.trials, to_string(budget.mode));
 

@@ -71,7 +71,8 @@ void register_inputs(CLI::App& app) {
     bool force = false;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* sub = app.add_subcommand("inputs", "Exact and nominal inputs to the gyro at one instant");
+  CLI::App* sub = app.add_subcommand(
+      "inputs", "Exact and nominal inputs to the sensor (inertial rate and specific force) at one instant");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--beta-deg", opt->beta_deg, "Position-platform angle beta, deg")
       ->required()

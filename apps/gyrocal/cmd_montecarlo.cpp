@@ -11,6 +11,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/result/coefficient_order.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal::cli {
@@ -91,7 +92,9 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--threads", opt->threads,
                   fmt::format("Worker threads, 0 to {}; default (0): all cores", limits::kThreads))
       ->transform(integer_between(0, limits::kThreads));
-  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+  sub->add_option(
+         "--method", opt->method,
+         "closed-form (a gyro's 16-position test) or least-squares (default; an accelerometer's only)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation,
                   std::string(kCompensationHelp) +
@@ -133,7 +136,7 @@ void register_montecarlo(CLI::App& app) {
     if (!opt->json.empty()) {
       nlohmann::json j = montecarlo_to_json(result);
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
-      write_result(opt->json, std::move(j), "montecarlo", opt->force);
+      write_result(opt->json, in_coefficient_order(j, result.sensor), "montecarlo", opt->force);
     }
     if (opt->json != "-") print_out("{}", montecarlo_table(result, seconds));
   });

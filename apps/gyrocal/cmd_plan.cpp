@@ -96,7 +96,9 @@ void register_plan(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "plan", "Identifiability and predicted uncertainty of the configured test, before running it");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
-  sub->add_option("--method", opt->method, "closed-form or least-squares (default)")
+  sub->add_option(
+         "--method", opt->method,
+         "closed-form (a gyro's 16-position test) or least-squares (default; an accelerometer's only)")
       ->check(CLI::IsMember({"closed-form", "least-squares"}));
   sub->add_option("--compensation", opt->compensation, kCompensationHelp)
       ->check(CLI::IsMember({"none", "seed", "full"}));

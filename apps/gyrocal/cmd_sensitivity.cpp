@@ -12,6 +12,7 @@
 #include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/result/coefficient_order.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
 
 namespace gyrocal::cli {
@@ -219,7 +220,7 @@ void register_sensitivity(CLI::App& app) {
       "sensitivity",
       "The seed paper's error study (Wang & Meng 2017, the paper this method comes from; docs/physics.md "
       "section 10): the exact shift of every estimate per machine error alone, with each compensation "
-      "(none, seed = the paper's correction, full)");
+      "(none, seed = the paper's correction, full; an accelerometer's: none and full)");
   sub->add_option("--config", opt->config, "Configuration file (TOML); default: the built-in scenario");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   add_force_flag(sub, opt->force);
@@ -244,7 +245,7 @@ void register_sensitivity(CLI::App& app) {
     if (!opt->json.empty()) {
       nlohmann::json j = sensitivity_to_json(result);
       j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
-      write_result(opt->json, std::move(j), "sensitivity", opt->force);
+      write_result(opt->json, in_coefficient_order(j, result.sensor), "sensitivity", opt->force);
     }
     if (opt->json != "-")
       print_out("{}", result.sensor == SensorKind::kGyro ? sensitivity_table(result)

@@ -29,7 +29,7 @@ int checked_exit(int status) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "gyrocal: calibrate a gyroscope's drift coefficients on a centrifuge with a counter-rotating platform"};
+      "gyrocal: calibrate a gyroscope or an accelerometer on a centrifuge with a counter-rotating platform"};
   // At most one subcommand; none at all lists them (below).
   app.require_subcommand(0, 1);
   app.set_version_flag("--version", std::string("gyrocal ") + GYROCAL_VERSION);

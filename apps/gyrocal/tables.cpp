@@ -15,6 +15,13 @@ std::string value_std(double v, double s) {
 
 }  // namespace
 
+PrintedUnit printed_unit(std::string_view unit) {
+  // A length (a radius, a runout, a lever arm, a stretch per (rad/s)^2) is measured to microns: printed in
+  // them, "0.00002984 +- 0.00000061 m" being unreadable. The JSON keeps the SI unit (docs/contract.md).
+  if (unit == "m" || unit.starts_with("m/")) return {1e6, "um" + std::string(unit.substr(1))};
+  return {1.0, std::string(unit)};
+}
+
 std::string format_value_std(double value, double std_dev) {
   if (!std::isfinite(value)) return fmt::format("{}", value);
   if (!(std::isfinite(std_dev) && std_dev > 0.0)) return fmt::format("{:.6g}", value);
@@ -64,16 +71,18 @@ std::string result_table(const CalibrationResult& r) {
     // The self-calibration: each estimate beside its configured value, and its correlation with the
     // coefficients it trades against (dI, dOS) or any other beyond 0.5.
     out += fmt::format("\nmachine errors estimated ({} Gauss-Newton iterations)\n", r.iterations);
-    out += fmt::format("{:<30} {:>30} {:>12}  {:<8} {}\n", "error", "estimate ± std", "configured", "unit",
+    out += fmt::format("{:<30} {:>30} {:>12}  {:<12} {}\n", "error", "estimate ± std", "configured", "unit",
                        "correlations");
     for (const MachineErrorEstimate& e : r.machine_errors) {
       std::string correlations;
       for (const auto& [name, rho] : e.correlations)
         if (std::isfinite(rho) && (name == "dI" || name == "dOS" || std::abs(rho) > 0.5))
           correlations += fmt::format("{}{} {:+.2f}", correlations.empty() ? "" : ", ", name, rho);
-      out += fmt::format("{:<30} {:>30} {:>12.6g}  {:<8} {}\n", e.parameter.label(),
-                         e.identifiable ? value_std(e.value, e.std) : std::string("not identifiable"),
-                         e.configured, e.unit, correlations);
+      const PrintedUnit shown = printed_unit(e.unit);
+      out += fmt::format("{:<30} {:>30} {:>12.6g}  {:<12} {}\n", e.parameter.label(),
+                         e.identifiable ? value_std(e.value * shown.factor, e.std * shown.factor)
+                                        : std::string("not identifiable"),
+                         e.configured * shown.factor, shown.unit, correlations);
     }
   }
   if (!r.alternatives.empty()) {

@@ -2,6 +2,7 @@
 // Text tables of results for the terminal. Formatting only.
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrocal/analysis/record_noise.hpp"
@@ -15,6 +16,14 @@ namespace gyrocal::cli {
 /// to the same last digit (0.0700 ± 0.0018; scientific for large or tiny magnitudes); the value alone to 6
 /// significant digits when the std is zero or unknown.
 std::string format_value_std(double value, double std_dev);
+
+/// How a unit is printed for people: a length in m (and m/(rad/s)^2) as um (um/(rad/s)^2), factor 1e6; any
+/// other unit as it is, factor 1. The JSON keeps the contract's SI units.
+struct PrintedUnit {
+  double factor = 1.0;  ///< the value in `unit` is the value in the SI unit times this
+  std::string unit;
+};
+PrintedUnit printed_unit(std::string_view unit);
 
 /// Coefficients (value ± std, unit), combinations, alternatives, warnings of one result.
 std::string result_table(const CalibrationResult& result);

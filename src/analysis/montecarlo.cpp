@@ -128,6 +128,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
 
   const bool gyro = scenario.sensor_kind == SensorKind::kGyro;
   m.calibration.sensor = scenario.sensor_kind;
+  if (scenario.record) m.calibration.output_unit = scenario.record->column_unit();  // K1's unit
   if (!gyro && options.self)
     throw Error(
         "Monte Carlo: compensation self is the gyro's; for an accelerometer, --estimate in calibrate and "

@@ -167,6 +167,7 @@ SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const Sensi
   const CentrifugeModel base_model = base.model();
   CalibrationOptions o = options.calibration;
   o.sensor = scenario.sensor_kind;
+  if (scenario.record) o.output_unit = scenario.record->column_unit();  // K1's unit
   o.method = Method::kLeastSquares;
   o.compensation = Compensation::kFull;
   o.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;

@@ -182,6 +182,8 @@ RecordLayout read_record(const Reader& reader, Section& section, const toml::tab
       layout.*member = reader.number(*node, section.path(key),
                                      key.ends_with("_angle_offset_deg") ? kEncoderAngle : kAnyValue);
   }
+  if (const toml::node* node = section.find("output_unit"))
+    layout.output_unit_name = reader.string(*node, section.path("output_unit"));
   if (const toml::node* node = section.find("skip_rows"))
     layout.skip_rows = reader.integer(*node, section.path("skip_rows"), 0, INT64_MAX);
   if (const toml::node* node = section.find("units_row"))

@@ -109,12 +109,17 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
           "output units per g (e.g. mV per g), non-zero, negative for an inverted output");
     w.key("output_offset", toml_number(l.output_offset),
           "what the output reads at zero specific force, its own units: g = (output - offset) / scale");
+    if (!l.output_unit_name.empty())
+      w.key("output_unit", toml_string(l.output_unit_name),
+            "the output column's unit (\"V\", \"mA\"): K1 is reported in it per g (\"V/g\")");
   } else {
     w.key("output_column", toml_string(l.output_column), "the gyro's output");
     w.key("output_scale_per_deg_h", toml_number(l.output_scale_per_deg_h),
           "output units per deg/h (e.g. mV per deg/h), non-zero, negative for an inverted output");
     w.key("output_offset", toml_number(l.output_offset),
           "what the output reads at zero rate, its own units: deg/h = (output - offset) / scale");
+    if (!l.output_unit_name.empty())
+      w.key("output_unit", toml_string(l.output_unit_name), "the output column's unit (\"mV\")");
   }
   w.key("main_angle_offset_deg", toml_number(l.main_angle_offset_deg),
         "what the main angle reads (deg) at its zero: subtracted");
@@ -126,18 +131,50 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
         "the numbers' decimal mark, \".\" or \",\" (then delimiter \";\")");
 }
 
-/// The keys, each with its value and comment; the key `commented_out` (if any) as a comment line, which the
-/// reader does not see.
+/// An accelerometer's own words for the comments the tables write in the gyro's (its axes I, O, S; its
+/// "drift"): the mount's axes are the accelerometer's i, p, o (docs/accelerometer.md). Keyed by the key,
+/// which is unique across the sections written.
+constexpr std::pair<std::string_view, std::string_view> kAccelerometerComments[] = {
+    {"radius_m", "R0, nominal arm radius to the accelerometer's reference point (its proof mass), m"},
+    {"heading_deg", "psi0: direction of the input axis i at beta = 0, from North toward West, deg"},
+    {"counter_rate_mismatch_rad_s",
+     "delta omega: the counter platform's rate error, at which its heading turns about Up, rad/s"},
+    {"mount_misalignment_arcsec", "accelerometer mounting misalignment about i, p, o, arcsec"},
+    {"lever_arm_m",
+     "accelerometer reference point's offset in position-platform axes (i, p, o at beta = 0), m"},
+    {"sample_rate_hz", "output and encoder sampling rate, Hz"},
+    {"reduction",
+     "\"harmonic\" (fit in gamma with a linear trend in time) or \"window\" (mean around each gamma); as "
+     "--reduction"},
+    {"linear_drift",
+     "harmonic fit and window mean: a linear trend in time, so a slow change of the bias does not bias the "
+     "values at the dwell's mid-time"},
+    {"model_samples_per_revolution",
+     "the model's channels on every k-th sample, keeping this many per revolution; 0 = every sample, the "
+     "only choice exact on any configuration"},
+};
+
+/// The comment of `key` for the scenario's sensor: an accelerometer's own words where the gyro's would
+/// name its axes or its drift, else `comment`.
+std::string_view comment_for(SensorKind kind, std::string_view key, std::string_view comment) {
+  if (kind != SensorKind::kAccelerometer) return comment;
+  for (const auto& [k, text] : kAccelerometerComments)
+    if (k == key) return text;
+  return comment;
+}
+
+/// The keys, each with its value and comment (in the sensor's words); the key `commented_out` (if any) as a
+/// comment line, which the reader does not see.
 template <class S, std::size_t N>
-void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source,
+void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& source, SensorKind kind,
                    std::string_view commented_out = {}) {
   for (const NumberKey<S>& k : keys) {
-    writer.key(k.key, toml_number(in_file_unit(source.*k.member, k.to_si)), k.comment,
-               k.key == commented_out);
+    writer.key(k.key, toml_number(in_file_unit(source.*k.member, k.to_si)),
+               comment_for(kind, k.key, k.comment), k.key == commented_out);
   }
 }
 
-void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
+void write_errors(TomlWriter& writer, const CentrifugeErrors& errors, SensorKind kind) {
   for (const ErrorKey& key : error_keys()) {
     const MachineErrorField& f = *key.field;
     std::string value;
@@ -154,7 +191,7 @@ void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
         break;
       }
     }
-    writer.key(key.key, value, f.comment);
+    writer.key(key.key, value, comment_for(kind, key.key, f.comment));
   }
 }
 
@@ -179,7 +216,7 @@ std::string scenario_to_toml(const Scenario& s) {
       "none).");
 
   w.section("site", "");
-  write_numbers(w, kSiteKeys, s.site);
+  write_numbers(w, kSiteKeys, s.site, s.sensor_kind);
 
   // One rate, one place: when the centrifuge's rate is the one the reader derives from [test] rates_rad_s
   // (its first non-zero rate), the key is written commented out, so that editing the test's rates moves both.
@@ -196,10 +233,10 @@ std::string scenario_to_toml(const Scenario& s) {
                                 "set the test's rates there.\nGiven here, it must be one of them "
                                 "(it is the rate of `gyrocal inputs`)."
                               : "");
-  write_numbers(w, kCentrifugeKeys, s.centrifuge, rate_follows_test ? "rate_rad_s" : "");
+  write_numbers(w, kCentrifugeKeys, s.centrifuge, s.sensor_kind, rate_follows_test ? "rate_rad_s" : "");
 
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
-  write_errors(w, s.errors);
+  write_errors(w, s.errors, s.sensor_kind);
 
   if (s.sensor_kind == SensorKind::kAccelerometer) write_accelerometer(w, s);
   if (s.sensor_kind == SensorKind::kGyro) {
@@ -219,14 +256,15 @@ std::string scenario_to_toml(const Scenario& s) {
           "[dO, dS]: the input axis tilted toward O and toward S, arcsec");
 
     w.section("gyro.noise", "");
-    write_numbers(w, kNoiseKeys, s.noise);
+    write_numbers(w, kNoiseKeys, s.noise, s.sensor_kind);
   }
 
   const TestSpec& t = s.test;
   w.section("test",
             "The test: at each rate and beta, the output is read as the arm passes each gamma. A rate of 0\n"
             "means the main axis stopped and the platform indexed to each gamma.");
-  w.key("sample_rate_hz", toml_number(t.sample_rate_hz), "gyro and encoder sampling rate, Hz");
+  w.key("sample_rate_hz", toml_number(t.sample_rate_hz),
+        comment_for(s.sensor_kind, "sample_rate_hz", "gyro and encoder sampling rate, Hz"));
   w.key("revolutions", std::to_string(t.revolutions), "whole main-axis revolutions per beta and rate");
   w.key("settle_s", toml_number(t.settle_s), "discarded after each change of beta or rate, s");
   w.key("beta_deg", number_array(t.beta_rad, kDegToRad), "position-platform angles, deg");
@@ -255,7 +293,7 @@ std::string scenario_to_toml(const Scenario& s) {
       "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry, same keys and units, all zero\n"
       "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
       "and phase_deg its nominal phase.");
-  write_errors(w, s.uncertainty);
+  write_errors(w, s.uncertainty, s.sensor_kind);
   w.key("gravity_m_s2", toml_number(s.gravity_uncertainty_m_s2),
         "local gravity's ([site] gravity_m_s2), m/s^2: 1e-5 m/s^2 is 1 ppm, which reads as 1 um of radius at "
         "1 m");
@@ -270,7 +308,9 @@ std::string scenario_to_toml(const Scenario& s) {
     w.key("gyro_model", s.gyro_model == GyroModel::kDrift ? "\"drift\"" : "\"drift+rate\"",
           "\"drift\" or \"drift+rate\" (docs/physics.md section 15)");
   w.key("reduction", s.reduce.method == ReduceOptions::Method::kWindowMean ? "\"window\"" : "\"harmonic\"",
-        "\"harmonic\" (fit in gamma with drift) or \"window\" (mean around each gamma); as --reduction");
+        comment_for(s.sensor_kind, "reduction",
+                    "\"harmonic\" (fit in gamma with drift) or \"window\" (mean around each gamma); as "
+                    "--reduction"));
 
   w.section(
       "reduce",
@@ -278,10 +318,10 @@ std::string scenario_to_toml(const Scenario& s) {
       "the key's unit, its default and the reason for it; the ranges are checked when the file is read.");
   const ReduceOptions defaults;
   for (const ReduceKey& k : kReduceKeys) {
-    w.key(
-        k.key, reduce_value(k, s.reduce),
-        wrapped(std::string(k.unit) + "; default " + reduce_value(k, defaults) + ": " + std::string(k.reason),
-                kReduceCommentWidth));
+    w.key(k.key, reduce_value(k, s.reduce),
+          wrapped(std::string(k.unit) + "; default " + reduce_value(k, defaults) + ": " +
+                      std::string(comment_for(s.sensor_kind, k.key, k.reason)),
+                  kReduceCommentWidth));
   }
 
   constexpr std::string_view kHistoryNote =
@@ -311,6 +351,7 @@ std::string scenario_to_toml(const Scenario& s) {
     if (s.sensor_kind == SensorKind::kAccelerometer) {
       layout.output_quantity = OutputQuantity::kSpecificForce;
       layout.output_column = std::string(Accelerometer::native_column);
+      layout.output_unit_name = std::string(Accelerometer::output_unit);  // shown, commented out
     }
     write_record_keys(keys, layout);
     w.section_commented("record", kRecordNote, keys.text());

@@ -88,8 +88,16 @@ void write_accelerometer(TomlWriter& w, const Scenario& s) {
             "The accelerometer's IEEE 1293 coefficients (docs/accelerometer.md): the truth, for simulation.");
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
     const SensorParameter& p = kAccelerometerParameters[k];
-    w.key(p.key, toml_number(s.accelerometer.coefficients.values[k]),
-          std::string(p.meaning) + ", " + std::string(p.unit));
+    // K1 in the output column's unit per g; the tilts with their names in IEEE Std 1293's convention, which
+    // names each angle for the axis the input axis turns about (docs/accelerometer.md).
+    std::string note = std::string(p.meaning) + ", " + std::string(p.unit);
+    if (p.name == "K1")
+      note = "scale factor, the output's unit per g ([record] output_unit; g/g for gyrocal's own record)";
+    else if (p.name == "delta_p")
+      note = "input axis tilted toward p (IEEE 1293's delta_o), urad";
+    else if (p.name == "delta_o")
+      note = "input axis tilted toward o (IEEE 1293's -delta_p), urad";
+    w.key(p.key, toml_number(s.accelerometer.coefficients.values[k]), note);
   }
   w.section("accelerometer.noise", "");
   for (const AccelerometerNoiseKey& k : kAccelerometerNoiseKeys)

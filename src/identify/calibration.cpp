@@ -160,6 +160,7 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
     o.output.scale_key = std::string(layout->output_scale_key());
     o.output.scale = layout->output_scale();
     o.output.column = layout->output_column;
+    o.output_unit = layout->column_unit();
   }
   // The output's range is kept for the misfit's causes (identify/misfit.hpp: a flat top).
   // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_channels.hpp).

@@ -9,6 +9,7 @@ namespace gyrocal {
 CalibrationOptions calibration_options(const Scenario& scenario, const CalibrationChoices& choices) {
   CalibrationOptions options;
   options.sensor = scenario.sensor_kind;
+  if (scenario.record) options.output_unit = scenario.record->column_unit();
   options.method = parse_method(choices.method);
   options.compensation = parse_compensation(choices.compensation);
   options.estimate = choices.estimate

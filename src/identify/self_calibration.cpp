@@ -29,6 +29,31 @@ constexpr double kMinErrorEffectDegH = 1e-9;
 /// judgement as LeastSquaresOptions::max_relative_std).
 constexpr double kMaxErrorStdOverTypical = 100.0;
 
+/// The covariance of (the sensor's coefficients, the estimated errors) from that of (its products, the
+/// errors), `cov` with the `nc` products first: the delta method with the Jacobian of from_products by
+/// central differences (exact to rounding for the ratios it takes), the errors' block unchanged.
+Eigen::MatrixXd coefficient_error_covariance(SensorKind kind, const std::vector<double>& products,
+                                             const Eigen::MatrixXd& cov, Eigen::Index nc) {
+  const Sensor sensor = sensor_of(kind);
+  const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(products.data(), nc);
+  const Eigen::MatrixXd cu = cov.topLeftCorner(nc, nc);
+  const std::vector<bool> all(static_cast<std::size_t>(nc), true);
+  const auto values = [&](const Eigen::VectorXd& x) {
+    return std::visit([&](const auto& s) { return s.from_products(x, cu, all).values; }, sensor);
+  };
+  const Eigen::Index np = values(u).size(), n = cov.rows();
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(np + (n - nc), n);
+  for (Eigen::Index j = 0; j < nc; ++j) {
+    const double h = 1e-6 * std::max(std::abs(u[j]), 1e-3);
+    Eigen::VectorXd up = u, down = u;
+    up[j] += h;
+    down[j] -= h;
+    jacobian.block(0, j, np, 1) = (values(up) - values(down)) / (2.0 * h);
+  }
+  jacobian.bottomRightCorner(n - nc, n - nc).setIdentity();
+  return jacobian * cov * jacobian.transpose();
+}
+
 /// `model` with the parameters `ps` set to `values_si`.
 CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
                             const std::vector<double>& values_si) {
@@ -346,11 +371,27 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
       return cov(x, y) / std::sqrt(cov(x, x) * cov(y, y));
     };
     if (options.sensor != SensorKind::kGyro) {
-      // With the sensor's products (K1*K0, K1, ...), as solved.
-      const std::vector<std::string_view> un =
-          std::visit([](const auto& s) { return s.unknown_names(); }, sensor_of(options.sensor));
-      for (std::size_t c = 0; c < un.size(); ++c)
-        e.correlations.emplace_back(std::string(un[c]), corr(nc + ai, static_cast<Eigen::Index>(c)));
+      // With the sensor's coefficients, by their names (docs/contract.md): the covariance of the products
+      // and the errors carried to the coefficients by the delta method, J = d(coefficients)/d(products)
+      // (exact for the ratios an accelerometer takes: K1 = u_K1, Kx = u_x / u_K1).
+      // A scale factor that is not identifiable divides nothing out: no correlation is stated.
+      Eigen::MatrixXd joint;
+      if (r.sensor_products.size() == static_cast<std::size_t>(nc)) try {
+          joint = coefficient_error_covariance(options.sensor, r.sensor_products, cov, nc);
+        } catch (const Error&) {
+          joint.resize(0, 0);
+        }
+      const Eigen::Index np = joint.rows() - (cov.rows() - nc);
+      const std::span<const SensorParameter> table =
+          std::visit([](const auto& s) { return s.parameters(); }, sensor_of(options.sensor));
+      for (std::size_t c = 0; c < table.size() && c < r.sensor_coefficients.size(); ++c) {
+        const auto ci = static_cast<Eigen::Index>(c);
+        e.correlations.emplace_back(
+            std::string(table[c].name),
+            r.sensor_coefficients[c].identifiable && ci < np && joint.size() > 0
+                ? joint(ci, np + ai) / std::sqrt(joint(ci, ci) * joint(np + ai, np + ai))
+                : std::numeric_limits<double>::quiet_NaN());
+      }
     }
     for (std::size_t c = 0; c < kNumCoefficients && options.sensor == SensorKind::kGyro; ++c)
       e.correlations.emplace_back(std::string(kCoefficientNames[c]),

@@ -261,7 +261,12 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
   const auto nc = static_cast<Eigen::Index>(unknown_names.size());
   const auto n = nc + extra.columns.cols();
+  // The products named by their coefficients (docs/contract.md promises coefficient names in every message
+  // and correlation): a product K1*Kx moves as Kx at K1 fixed, so a direction or a collinearity among the
+  // products reads the same among the coefficients.
   std::vector<std::string> names(unknown_names.begin(), unknown_names.end());
+  if (table.size() == unknown_names.size())
+    for (std::size_t j = 0; j < table.size(); ++j) names[j] = std::string(table[j].name);
   names.insert(names.end(), extra.names.begin(), extra.names.end());
   Eigen::MatrixXd design(m, n);
   Eigen::VectorXd observations(m);
@@ -368,7 +373,11 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     const SensorParameter& par = table[static_cast<std::size_t>(k)];
     SensorCoefficientEstimate e;
     e.name = std::string(par.name);
-    e.unit = std::string(par.unit);
+    // K1 in the output column's unit per g ([record] output_unit), the others in the table's.
+    e.unit =
+        options.sensor == SensorKind::kAccelerometer && k == static_cast<Eigen::Index>(AccelCoefficient::K1)
+            ? scale_factor_unit(options.output_unit)
+            : std::string(par.unit);
     e.identifiable = pe.identifiable[static_cast<std::size_t>(k)];
     if (e.identifiable) {
       e.value = pe.values[k];

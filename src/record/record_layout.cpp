@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
 
 namespace gyrocal {
 
@@ -128,6 +129,22 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                             "record.output_scale_per_g instead",
                             output_scale_per_deg_h));
   }
+  if (output_unit_name.size() > limits::kOutputUnitBytes)
+    return fail("output_unit", fmt::format("record.output_unit '{}...' is {} bytes long, more than the {} a "
+                                           "unit's name may have (it is printed in every table)",
+                                           output_unit_name.substr(0, limits::kOutputUnitBytes),
+                                           output_unit_name.size(), limits::kOutputUnitBytes));
+  for (char c : output_unit_name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (std::isalnum(u) == 0 || u >= 0x80) {
+      if (std::string_view("/^*._%-").find(c) != std::string_view::npos) continue;
+      return fail(
+          "output_unit",
+          fmt::format("record.output_unit '{}' holds {}: a unit's name is letters, digits and / ^ * . _ "
+                      "% - (\"V\", \"mV\", \"mA\", \"counts\"; \"u\" for micro)",
+                      output_unit_name, printable(c)));
+    }
+  }
   const std::array<std::pair<std::string_view, double>, 4> offsets = {{
       {"output_offset", output_offset},
       {"main_angle_offset_deg", main_angle_offset_deg},
@@ -215,6 +232,14 @@ double RecordLayout::output_scale() const {
 
 std::string_view RecordLayout::output_unit() const {
   return output_quantity == OutputQuantity::kSpecificForce ? "g" : "deg/h";
+}
+
+std::string RecordLayout::column_unit() const {
+  return output_unit_name.empty() ? std::string(output_unit()) : output_unit_name;
+}
+
+std::string accelerometer_output_unit(const std::optional<RecordLayout>& layout) {
+  return layout ? layout->column_unit() : std::string("g");
 }
 
 std::string_view RecordLayout::output_scale_key() const {

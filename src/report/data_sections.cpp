@@ -179,9 +179,13 @@ void positions(const json& result, Page& page, std::string& out) {
     const std::string where = fmt::format("positions[{}]", k);
     expect(p[k], json::value_t::object, where);
     const json& q = p[k];
-    const auto index = number(q, "index", where), residual = scaled(number(q, "residual_deg_h", where)),
-               std_err = scaled(number(q, "std_err_deg_h", where)),
-               mean = scaled(number(q, "mean_deg_h", where));
+    // The keys of any sensor (mean, std_err, residual), else a gyro's result of an earlier version's.
+    const auto either = [&](const char* key, const char* earlier) {
+      return find(q, key) != nullptr ? number(q, key, where) : number(q, earlier, where);
+    };
+    const auto index = number(q, "index", where), residual = scaled(either("residual", "residual_deg_h")),
+               std_err = scaled(either("std_err", "std_err_deg_h")),
+               mean = scaled(either("mean", "mean_deg_h"));
     const int d = decimals_for(std_err);
     rows.push_back({num_cell(num(index)), num_cell(num(number(q, "beta_deg", where))),
                     num_cell(num(number(q, "gamma_deg", where))),

@@ -57,6 +57,11 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
   j["alternatives"] = nlohmann::ordered_json::array();
   for (const NamedEstimate& c : r.alternatives) j["alternatives"].push_back(named_estimate_to_json(c));
+  // Positions keyed for any sensor (docs/contract.md, "Result"): mean, std_err and residual in `unit`, the
+  // sensor's output unit as the reader gives it (deg/h, g). A gyro's also keep their earlier keys
+  // mean_deg_h, std_err_deg_h and residual_deg_h for one version, for readers of older results.
+  const bool gyro = r.sensor == SensorKind::kGyro;
+  const std::string position_unit = gyro ? "deg/h" : std::string(Accelerometer::output_unit);
   j["positions"] = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const ReducedPosition& p = r.positions[i];
@@ -64,12 +69,20 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
                                 {"beta_deg", p.beta_rad * kRadToDeg},
                                 {"gamma_deg", p.gamma_rad * kRadToDeg},
                                 {"rate_rad_s", p.rate_rad_s},
-                                {"mean_deg_h", p.mean_deg_h},
-                                {"std_err_deg_h", number_or_null(p.std_err_deg_h)},
-                                {"samples", p.samples},
-                                {"outliers", p.outliers}};
+                                {"mean", p.mean_deg_h},
+                                {"std_err", number_or_null(p.std_err_deg_h)},
+                                {"unit", position_unit}};
+    if (gyro) {
+      e["mean_deg_h"] = p.mean_deg_h;
+      e["std_err_deg_h"] = number_or_null(p.std_err_deg_h);
+    }
+    e["samples"] = p.samples;
+    e["outliers"] = p.outliers;
     if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
-    if (i < r.residuals_deg_h.size()) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
+    if (i < r.residuals_deg_h.size()) {
+      e["residual"] = number_or_null(r.residuals_deg_h[i]);
+      if (gyro) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
+    }
     j["positions"].push_back(e);
   }
   j["method"] = to_string(r.method);

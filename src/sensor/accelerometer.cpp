@@ -25,6 +25,10 @@ std::array<double, kNumAccelCoefficients> accelerometer_regressors(const Eigen::
           kMicro * ao};
 }
 
+std::string scale_factor_unit(std::string_view output_unit) {
+  return (output_unit.empty() ? std::string(Accelerometer::output_unit) : std::string(output_unit)) + "/g";
+}
+
 double accelerometer_output(const AccelerometerCoefficients& c, const Eigen::Vector3d& f) {
   const std::array<double, kNumAccelCoefficients> r = accelerometer_regressors(f);
   double inner = r[kScale];  // a_i

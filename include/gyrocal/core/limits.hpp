@@ -68,6 +68,11 @@ inline constexpr std::size_t kRecordMetadataLines = 4096;
 /// The most bytes of metadata held (keys and values together). gyrocal writes ~1 kB.
 inline constexpr std::size_t kRecordMetadataBytes = std::size_t{1} << 20;
 
+/// The longest [record] output_unit, bytes: 16. A unit's name ("V", "mV", "mA", "counts", "mV/V") is a few
+/// characters; it becomes K1's unit ("V/g") in every table, whose unit column is 8-12 wide, in the result's
+/// JSON and in the calibration history, so a longer text is a mistake (a column name or a sentence typed
+/// there) rather than a unit.
+inline constexpr std::size_t kOutputUnitBytes = 16;
 /// The largest magnitude of a record's output, in its unit (deg/h, or g for an accelerometer; a layout's
 /// after its offset and scale): 1e50. No sensor writes a value within many orders of magnitude of it; the
 /// bound keeps what the reduction and the noise fit form of the outputs inside a double's range: the fourth

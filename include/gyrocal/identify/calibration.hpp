@@ -69,6 +69,10 @@ struct CalibrationOptions {
   /// What the configuration says about the output (its [record] scale), for the fix a misfit's cause names;
   /// calibrate_record sets it from the record's layout.
   OutputConfiguration output;
+  /// The unit of the record's output column ([record] output_unit, e.g. "V"): an accelerometer's K1 is
+  /// reported in it per g (scale_factor_unit). Empty: the sensor's own unit (g). calibrate_record sets it
+  /// from the record's layout, calibration_options from the scenario's.
+  std::string output_unit;
 
   bool IsValid(std::string* error) const;
 };
@@ -145,7 +149,7 @@ struct DataQuality {
 /// stay in CalibrationResult::coefficients): value and std in the table's unit, NaN when not identifiable.
 struct SensorCoefficientEstimate {
   std::string name;  ///< as in the table and the JSON ("K0", "delta_p")
-  std::string unit;  ///< the table's ("ug", "output/g", "urad")
+  std::string unit;  ///< the table's ("ug", "urad"; K1's in the output's unit per g, "V/g")
   double value = std::numeric_limits<double>::quiet_NaN();
   double std = std::numeric_limits<double>::quiet_NaN();
   bool identifiable = false;

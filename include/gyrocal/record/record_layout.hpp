@@ -63,6 +63,11 @@ struct RecordLayout {
   /// output_scale_per_g. Finite and non-zero, negative for an inverted output. Default 1; must stay 1 when
   /// output_quantity is kRate.
   double output_scale_per_g = 1.0;
+  /// The unit of the output column as the lab names it ([record] output_unit: "V", "mV", "mA", "counts"):
+  /// an accelerometer's scale factor K1 is reported in it per g ("V/g"). Empty (the default): the unit the
+  /// reader gives, output_unit() ("g" or "deg/h"). At most limits::kOutputUnitBytes letters, digits and
+  /// / ^ * . _ % - (it is printed in every table and stored with every result).
+  std::string output_unit_name;
   /// What the output column reads at zero input, in the column's own units (e.g. mV): subtracted before the
   /// scale, deg/h (or g) = (value - output_offset) / output_scale(). Finite; default 0.
   double output_offset = 0.0;
@@ -89,6 +94,8 @@ struct RecordLayout {
   double output_scale() const;
   /// The unit the reader gives the output in: "deg/h" for a rate, "g" for a specific force.
   std::string_view output_unit() const;
+  /// The unit of the output column: output_unit_name, or output_unit() when it is empty.
+  std::string column_unit() const;
   /// The [record] key of the scale that applies ("output_scale_per_deg_h" or "output_scale_per_g").
   std::string_view output_scale_key() const;
   /// True when `name` is the default name of an angle column ("main_angle_deg", …): such a column may be
@@ -103,6 +110,10 @@ struct RecordLayout {
 /// whose accel_g column is in g, and for a layout of a gyro's rate). The accelerometer's scale factor K1 in
 /// the rig's own output units per g is this times the K1 fitted to the rows the reader gives (in g).
 double output_scale_per_g(const std::optional<RecordLayout>& layout);
+
+/// The unit an accelerometer's output column is read in: the layout's column_unit(), "g" without a layout
+/// (gyrocal's own record, whose accel_g column is in g).
+std::string accelerometer_output_unit(const std::optional<RecordLayout>& layout);
 
 /// Throws gyrocal::Error, naming `record_name` and the [record] keys left empty, when `layout` lacks an angle
 /// column: a calibration reduces the record by its angles. Nothing happens for nullopt (gyrocal's own format

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -22,10 +23,11 @@ namespace gyrocal {
 enum class AccelCoefficient : std::size_t { K0, K1, K2, K3, Kip, Kio, Kpo, Kpp, Koo, delta_p, delta_o };
 inline constexpr std::size_t kNumAccelCoefficients = 11;
 
-/// The accelerometer's parameter table: name, unit, [accelerometer] key, meaning; all identified.
+/// The accelerometer's parameter table: name, unit, [accelerometer] key, meaning; all identified. K1's unit
+/// is that of gyrocal's own record (g per g); a rig's output column gives it its own (scale_factor_unit).
 inline constexpr std::array<SensorParameter, kNumAccelCoefficients> kAccelerometerParameters = {{
     {"K0", "ug", "K0_ug", "bias", true},
-    {"K1", "output/g", "K1", "scale factor, output units per g", true},
+    {"K1", "g/g", "K1", "scale factor, output units per g", true},
     {"K2", "ug/g^2", "K2_ug_g2", "second-order nonlinearity, per a_i^2", true},
     {"K3", "ug/g^3", "K3_ug_g3", "third-order nonlinearity, per a_i^3", true},
     {"Kip", "ug/g^2", "Kip_ug_g2", "cross-coupling, per a_i*a_p", true},
@@ -36,6 +38,10 @@ inline constexpr std::array<SensorParameter, kNumAccelCoefficients> kAcceleromet
     {"delta_p", "urad", "delta_p_urad", "input axis tilted toward p", true},
     {"delta_o", "urad", "delta_o_urad", "input axis tilted toward o", true},
 }};
+
+/// The unit of the scale factor K1 for an output column read in `output_unit` ([record] output_unit): "V/g"
+/// for "V"; "g/g" for gyrocal's own record, whose output is in g (the table's unit). Empty: "g/g".
+std::string scale_factor_unit(std::string_view output_unit);
 
 /// The coefficients in the table's units: K1 in output units per g, the others in ug, ug/g^n or urad.
 struct AccelerometerCoefficients {
