@@ -488,5 +488,44 @@ TEST(AccelerometerRecordScale, NoiseOfARecordWithK1NotOneIsInMicroG) {
   fs::remove_all(dir);
 }
 
+// ---- g. The data-quality listing without clutter ----
+
+// A static set's indexing moves (the main axis stopped, the counter platform turning between holds) are
+// counted in one line; a static hold that ends because the machine starts to move says so in rad/s, not as a
+// change relative to a stopped rate; a short static hold is measured against [test] static_hold_s, not
+// revolutions. The record's holds last 2 s, the configuration plans 4 s.
+TEST(DataQualityListing, IndexingMovesInOneLineStoppedRatesInRadPerSecondHoldsInSeconds) {
+  const fs::path dir = fresh_test_folder("gyrocal-quality");
+  const Scenario s = small_accelerometer({0, 90, 180, 270});
+  write_text(dir / "acc.toml", scenario_to_toml(s));
+  ASSERT_EQ(
+      run_cli("simulate --config " + (dir / "acc.toml").string() + " --out " + (dir / "acc.csv").string(),
+              dir)
+          .status,
+      0);
+  Scenario longer = s;
+  longer.test.static_hold_s = 4.0;
+  write_text(dir / "longer.toml", scenario_to_toml(longer));
+  const test::CliOutcome o =
+      run_cli("calibrate " + (dir / "acc.csv").string() + " --config " + (dir / "longer.toml").string(), dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string text = o.out + o.err;
+  std::size_t listed = 0, counted = 0;
+  for (std::size_t at = 0; (at = text.find("\n- ", at)) != std::string::npos; ++at) {
+    const std::string line = text.substr(at + 1, text.find('\n', at + 1) - at - 1);
+    if (line.find("no dwell from the steady run") != std::string::npos &&
+        line.find("stands still while the counter platform turns") != std::string::npos)
+      ++listed;
+    if (line.find("indexing moves") != std::string::npos) ++counted;
+  }
+  EXPECT_EQ(listed, 0u) << text;
+  EXPECT_EQ(counted, 1u) << text;
+  EXPECT_EQ(text.find("(relative; rate_steadiness"), std::string::npos) << text;
+  EXPECT_NE(text.find("the stopped machine starts to move"), std::string::npos) << text;
+  EXPECT_NE(text.find("s planned ([test] static_hold_s)"), std::string::npos) << text;
+  EXPECT_EQ(text.find("s planned (8 revolutions)"), std::string::npos) << text;
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace gyrocal

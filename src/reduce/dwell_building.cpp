@@ -159,10 +159,13 @@ void Reducer::State::finish_run(Run& r) {
   // Checks a test engineer wants to hear about.
   const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
   if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
+    // A static hold is planned in seconds ([test] static_hold_s), a spinning dwell in revolutions.
+    const std::string planned = d.is_static && plan.static_hold_s > 0.0
+                                    ? std::string("[test] static_hold_s")
+                                    : fmt::format("{} revolutions", plan.revolutions);
     warnings.add("short",
-                 fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({} revolutions): {}.",
-                             at(d.first_time_s), what, measured, d.planned_duration_s, plan.revolutions,
-                             r.quality.ended),
+                 fmt::format("{}: {} lasted {:.3f} s of the {:.3f} s planned ({}): {}.", at(d.first_time_s),
+                             what, measured, d.planned_duration_s, planned, r.quality.ended),
                  place);
   }
   // A rate that wanders: the main encoder's scatter about its line beyond its white part (half the mean

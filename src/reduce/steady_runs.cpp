@@ -312,9 +312,16 @@ bool Reducer::State::check_rate(Run& r, const Row& u, double t, double t_record)
       r.rate_theta = rt;
       r.rate_psi = rp;
     } else if (change > options.rate_steadiness) {
-      end_run(fmt::format("the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window "
-                          "ending at t = {:.3f} s",
-                          change, options.rate_steadiness, t_record),
+      // With both axes about stopped the relative change has no meaning (it is relative to the stopped
+      // tolerance): the change is said in rad/s.
+      const bool stopped = std::abs(r.rate_theta) < tol0_deg && std::abs(r.rate_psi) < tol0_deg;
+      end_run(stopped
+                  ? fmt::format("the stopped machine starts to move (its rate changes by {:.3g} rad/s) in "
+                                "the window ending at t = {:.3f} s",
+                                change * scale * kDegToRad, t_record)
+                  : fmt::format("the rate changes by {:.2e} (relative; rate_steadiness {:.0e}) in the window "
+                                "ending at t = {:.3f} s",
+                                change, options.rate_steadiness, t_record),
               Ending::kLeft);
       return false;
     }
