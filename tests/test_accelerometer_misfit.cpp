@@ -57,7 +57,8 @@ struct Outcome {
 /// with `config`'s machine as calibrate_record does (the output's range kept); `scale` is the configured
 /// [record] output_scale_per_g, by which the output (in the record's units) is divided as the reader does.
 Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t seed, const Fault& fault,
-                  double scale = 1.0, const std::string& column = "", CalibrationOptions o = {}) {
+                  double scale = 1.0, const std::string& column = "", CalibrationOptions o = {},
+                  const std::function<void(Reduction&)>& edit = nullptr) {
   o.sensor = SensorKind::kAccelerometer;
   o.output.scale_key = "output_scale_per_g";
   o.output.scale = scale;
@@ -72,7 +73,8 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
     o.output.range.push(x.output);
     reducer.push(x);
   });
-  const Reduction r = reducer.finish();
+  Reduction r = reducer.finish();
+  if (edit) edit(r);
   const CentrifugeModel model = config.model();
   Outcome out;
   try {
@@ -224,17 +226,67 @@ TEST(AccelerometerMisfit, ThePositionPlatformCountedTheOtherWayIsNamed) {
   EXPECT_TRUE(has(out.message, "position_angle_column")) << out.message;
 }
 
+TEST(AccelerometerMisfit, TheCounterPlatformCountedTheOtherWayIsNamed) {
+  // The counter angle counted the other way: in each spinning dwell the output sensed at gamma is reduced at
+  // -gamma. Written out here on the reduction (the record itself would show a counter platform turning the
+  // wrong way, which the reducer refuses first): the value at slot k of the seven gammas 2 pi k / 7 is
+  // exchanged with that at slot 7 - k, their covariance with them. Static holds do not depend on gamma.
+  const Scenario s = small_test(10.0);
+  const auto mirror = [](Reduction& r) {
+    for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+      Dwell& w = r.dwells[d];
+      if (w.is_static) continue;
+      const int n = static_cast<int>(w.gammas_rad.size());
+      ASSERT_EQ(n, 7);
+      const DwellValues before = w.gyro;
+      for (int k = 0; k < n; ++k) {
+        const int m = (n - k) % n;
+        w.gyro.value[k] = before.value[m];
+        w.gyro.std_err[k] = before.std_err[m];
+        for (int l = 0; l < n; ++l) w.gyro.covariance(k, l) = before.covariance(m, (n - l) % n);
+      }
+      for (ReducedPosition& p : r.positions)
+        if (p.dwell == static_cast<int>(d)) {
+          p.mean_deg_h = w.gyro.value[static_cast<std::size_t>(p.gamma_slot)];
+          p.std_err_deg_h = w.gyro.std_err[static_cast<std::size_t>(p.gamma_slot)];
+        }
+    }
+  };
+  const Outcome out = calibrate(s, s, 12, nullptr, 1.0, "", {}, mirror);
+  ASSERT_TRUE(out.refused) << warnings_of(out.result);
+  EXPECT_TRUE(has(out.message, "counter_angle_column")) << out.message;
+  EXPECT_TRUE(has(out.message, "the output at gamma belongs to -gamma")) << out.message;
+}
+
+TEST(AccelerometerMisfit, TheCounterEncodersZeroIsNamedWithItsOffset) {
+  // The counter angle reads 3 counts of a 2^18 encoder (71.9 urad) more than the platform's angle relative
+  // to the arm: at 12 rad/s (about 15 g on this arm) that turns ~1 mg of the first harmonic into quadrature.
+  const double offset_rad = 3.0 * 2.0 * kPi / 262144.0;
+  const Scenario s = small_test(10.0);
+  const Outcome out =
+      calibrate(s, s, 13, [&](RecordSample& x) { x.counter_angle_deg += offset_rad * kRadToDeg; });
+  ASSERT_TRUE(out.refused) << warnings_of(out.result);
+  EXPECT_TRUE(has(out.message, "The data fit a counter encoder's zero")) << out.message;
+  const std::size_t at = out.message.find("the counter angle reads ");
+  ASSERT_NE(at, std::string::npos) << out.message;
+  EXPECT_NEAR(std::atof(out.message.c_str() + at + 24), offset_rad * 1e6, 0.1 * offset_rad * 1e6)
+      << out.message;
+}
+
 TEST(AccelerometerMisfit, AMisfitNoCauseExplainsListsWhatWasTriedAndWhatWasNot) {
   // A bias drifting 200 ug per minute (a warm-up): no set-up mistake explains it; the warning lists the
-  // causes tried (never an empty list) and names the output delay and the counter encoder's zero as not
-  // tried, with the estimate that measures the delay.
+  // causes tried (never an empty list) and names the output delay as not tried, with the estimate that
+  // measures it.
   const Scenario s = small_test(10.0);
   const Outcome out = calibrate(s, s, 8, [](RecordSample& x) { x.output += 200e-6 / 60.0 * x.time_s; });
   const std::string text = out.refused ? out.message : warnings_of(out.result);
-  EXPECT_TRUE(has(text, "none of the set-up mistakes tried (beta counted the other way")) << text;
+  EXPECT_TRUE(has(text,
+                  "none of the set-up mistakes tried (gamma counted the other way, beta counted the "
+                  "other way, the radius and the local gravity, the counter encoder's zero, the static "
+                  "holds' +-1 g)"))
+      << text;
   EXPECT_TRUE(has(text, "the radius and the local gravity")) << text;
   EXPECT_TRUE(has(text, "--estimate output_delay")) << text;
-  EXPECT_TRUE(has(text, "counter encoder's zero")) << text;
   EXPECT_FALSE(has(text, "()")) << text;
 }
 

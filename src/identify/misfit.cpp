@@ -79,6 +79,27 @@ std::optional<Reduction> mirror_gamma(const Reduction& r) {
   return permute_outputs(r, partner, slots);
 }
 
+/// An accelerometer's counter platform angle counted the other way: the output at gamma belongs to -gamma in
+/// each spinning dwell. A static hold is kept as it is: its gamma turns the sensor about the vertical, which
+/// holds gravity, so no static output depends on it (and its -gamma partner reads the same).
+std::optional<Reduction> mirror_spinning_gamma(const Reduction& r) {
+  std::vector<int> partner(r.dwells.size());
+  std::vector<std::vector<int>> slots(r.dwells.size());
+  for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+    partner[d] = static_cast<int>(d);
+    if (r.dwells[d].is_static) {
+      for (std::size_t k = 0; k < r.dwells[d].gammas_rad.size(); ++k) slots[d].push_back(static_cast<int>(k));
+      continue;
+    }
+    for (double g : r.dwells[d].gammas_rad) {
+      const int k = slot_of(r.dwells[d], -g);
+      if (k < 0) return std::nullopt;
+      slots[d].push_back(k);
+    }
+  }
+  return permute_outputs(r, partner, slots);
+}
+
 /// The position platform's angle counted the other way: the dwell measured at beta belongs to -beta.
 std::optional<Reduction> mirror_beta(const Reduction& r) {
   std::vector<int> partner(r.dwells.size(), -1);
@@ -210,6 +231,8 @@ std::vector<MisfitCause> accelerometer_misfit_causes() {
   std::vector<MisfitCause> causes;
   for (MisfitCause& c : gyro_misfit_causes(OutputConfiguration{}))
     if (c.name.find("counted the other way") != std::string::npos) causes.push_back(std::move(c));
+  // The static holds kept: each is a dwell of its own at one gamma, which the gyro's mirror cannot pair.
+  causes.front().transform = mirror_spinning_gamma;
   return causes;
 }
 

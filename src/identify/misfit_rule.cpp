@@ -193,6 +193,97 @@ std::string static_holds_cause(const Reduction& reduction, const std::vector<Pos
       100.0 * kStaticK1Tolerance, column);
 }
 
+/// The reduction as it would be had the counter encoder's zero been right: the reading gamma_read = gamma +
+/// `offset_rad` put each spinning dwell's output sensed at gamma at gamma + offset. A spinning dwell's values
+/// at 2N + 1 evenly spaced gammas are a trigonometric polynomial of order N, so the shift is exact: the value
+/// at slot gamma_k becomes the polynomial at gamma_k + offset (Dirichlet kernel interpolation), and the
+/// covariance M C M'. A static hold is left as it is: its gamma turns about the vertical, which holds
+/// gravity, so no static output depends on it. nullopt when a spinning dwell's gammas are not evenly spaced
+/// from 0 (values at [test] gamma_deg: no exact shift).
+std::optional<Reduction> shift_counter_zero(const Reduction& r, double offset_rad) {
+  Reduction out = r;
+  for (std::size_t d = 0; d < r.dwells.size(); ++d) {
+    const Dwell& w = r.dwells[d];
+    if (w.is_static) continue;
+    const auto n = static_cast<Eigen::Index>(w.gammas_rad.size());
+    if (n < 3 || n % 2 == 0 || static_cast<Eigen::Index>(w.gyro.value.size()) != n) return std::nullopt;
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (std::abs(w.gammas_rad[static_cast<std::size_t>(k)] -
+                   2.0 * kPi * static_cast<double>(k) / static_cast<double>(n)) > 1e-9)
+        return std::nullopt;
+    const int order = static_cast<int>((n - 1) / 2);
+    Eigen::MatrixXd m(n, n);
+    for (Eigen::Index k = 0; k < n; ++k)
+      for (Eigen::Index j = 0; j < n; ++j) {
+        const double x = w.gammas_rad[static_cast<std::size_t>(k)] + offset_rad -
+                         w.gammas_rad[static_cast<std::size_t>(j)];
+        double kernel = 1.0;
+        for (int h = 1; h <= order; ++h) kernel += 2.0 * std::cos(h * x);
+        m(k, j) = kernel / static_cast<double>(n);
+      }
+    DwellValues& v = out.dwells[d].gyro;
+    const Eigen::VectorXd shifted = m * Eigen::Map<const Eigen::VectorXd>(w.gyro.value.data(), n);
+    for (Eigen::Index k = 0; k < n; ++k) v.value[static_cast<std::size_t>(k)] = shifted[k];
+    if (w.gyro.covariance.rows() == n) {
+      v.covariance = m * w.gyro.covariance * m.transpose();
+      for (Eigen::Index k = 0; k < n && static_cast<std::size_t>(k) < v.std_err.size(); ++k)
+        v.std_err[static_cast<std::size_t>(k)] = std::sqrt(v.covariance(k, k));
+    }
+  }
+  for (ReducedPosition& q : out.positions) {
+    const DwellValues& v = out.dwells[static_cast<std::size_t>(q.dwell)].gyro;
+    const auto k = static_cast<std::size_t>(q.gamma_slot);
+    if (k < v.value.size()) q.mean_deg_h = v.value[k];
+    if (k < v.std_err.size() && std::isfinite(v.std_err[k])) q.std_err_deg_h = v.std_err[k];
+  }
+  return out;
+}
+
+/// An accelerometer's counter encoder zero refitted: the offset that minimises chi2 (three parabolic steps
+/// from 0, within 0.01 rad). Refuses the calibration naming it when the fit is then consistent.
+void refuse_counter_zero(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+                         const CentrifugeModel& model, const CalibrationOptions& options, double g_level,
+                         double noise_free, const std::string& stated) {
+  const auto chi2_at = [&](double offset) {
+    const std::optional<Reduction> fixed = shift_counter_zero(reduction, offset);
+    if (!fixed) return std::numeric_limits<double>::quiet_NaN();
+    try {
+      return plain_fit(*fixed, channels, model, options, g_level).chi2;
+    } catch (const Error&) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+  };
+  constexpr double kLargest = 0.01;  // rad: a zero off by more is not a few counts
+  double offset = 0.0, step = 1e-4;
+  for (int i = 0; i < 3; ++i) {
+    const double c0 = chi2_at(offset), cp = chi2_at(offset + step), cm = chi2_at(offset - step);
+    const double curvature = cp + cm - 2.0 * c0;
+    if (!std::isfinite(c0) || !std::isfinite(curvature) || !(curvature > 0.0)) return;
+    offset -= step * (cp - cm) / (2.0 * curvature);
+    if (!(std::abs(offset) <= kLargest)) return;
+    step = std::max(std::abs(offset) * 0.1, 1e-7);
+  }
+  const std::optional<Reduction> fixed = shift_counter_zero(reduction, offset);
+  if (!fixed) return;
+  // gamma, the arm's angle about the platform, counts against the counter angle (the platform's angle
+  // relative to the arm): a counter angle that reads c too much puts gamma at -c (checked against a record
+  // whose counter angle was offset, tests/test_accelerometer_misfit.cpp).
+  CalibrationResult f;
+  try {
+    f = plain_fit(*fixed, channels, model, options, g_level);
+  } catch (const Error&) {
+    return;
+  }
+  const MisfitTest ft = test_misfit(*fixed, f.chi2, f.dof, noise_free);
+  if (!(ft.tested && ft.p_value >= options.misfit.p_min)) return;
+  throw Error(fmt::format(
+      "calibration refused: {}. The data fit a counter encoder's zero: the counter angle reads {:.4g} urad "
+      "({:.3g} deg) more than the platform's angle relative to the arm, and corrected so the fit is "
+      "consistent (chi2/dof = {:.3g}, p = {:.2g}); subtract it from the record's counter angle column "
+      "([record] counter_angle_column) or set the encoder's zero on the rig.",
+      stated, -offset * 1e6, -offset * kRadToDeg, ft.dof > 0 ? ft.chi2 / ft.dof : 0.0, ft.p_value));
+}
+
 /// Tries each set-up mistake of the sensor's table on a misfitting record (`stated` says how it misfits):
 /// refuses the calibration naming the first the data fit (refit so, consistent and with a plausible scale-
 /// factor error), then a flat top read from the data. Returns the names of the mistakes tried.
@@ -229,6 +320,8 @@ std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
   if (options.sensor == SensorKind::kAccelerometer) {
     refuse_radius_or_gravity(reduction, channels, model, options, g_level, noise_free, stated);
     tried += (tried.empty() ? "" : ", ") + std::string("the radius and the local gravity");
+    refuse_counter_zero(reduction, channels, model, options, g_level, noise_free, stated);
+    tried += ", the counter encoder's zero";
     // Then the data: static holds that do not read +-K1 g.
     try {
       const CalibrationResult plain = plain_fit(reduction, channels, model, options, g_level);
@@ -256,10 +349,8 @@ std::string unexplained_misfit(const std::string& tried, SensorKind sensor) {
   return fmt::format(
       "none of the set-up mistakes tried ({}) explains it; not tried: an output delay (the output stamped "
       "after the instant it was sensed, by an acquisition filter's group delay or a multiplexer's skew, "
-      "turns "
-      "the first harmonic into quadrature: --estimate output_delay measures it) and the counter encoder's "
-      "zero (the counter angle's zero relative to the arm); check those, the output column ([record] "
-      "output_column), the configured machine and the plan",
+      "turns the first harmonic into quadrature: --estimate output_delay measures it); check it, the output "
+      "column ([record] output_column), the configured machine and the plan",
       tried);
 }
 
