@@ -137,8 +137,10 @@ void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& s
   }
 }
 
-void write_errors(TomlWriter& writer, const CentrifugeErrors& errors) {
+/// The keys of the machine-error table that `keys` holds, with their values in `errors`.
+void write_errors(TomlWriter& writer, const CentrifugeErrors& errors, ErrorKeys keys) {
   for (const ErrorKey& key : error_keys()) {
+    if (!holds(keys, *key.field)) continue;
     const MachineErrorField& f = *key.field;
     std::string value;
     switch (f.kind) {
@@ -199,7 +201,7 @@ std::string scenario_to_toml(const Scenario& s) {
   write_numbers(w, kCentrifugeKeys, s.centrifuge, rate_follows_test ? "rate_rad_s" : "");
 
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
-  write_errors(w, s.errors);
+  write_errors(w, s.errors, ErrorKeys::kMachine);
 
   if (s.sensor_kind == SensorKind::kAccelerometer) write_accelerometer(w, s);
   if (s.sensor_kind == SensorKind::kGyro) {
@@ -242,10 +244,10 @@ std::string scenario_to_toml(const Scenario& s) {
 
   w.section(
       "uncertainty",
-      "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry, same keys and units, all zero\n"
-      "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
-      "and phase_deg its nominal phase.");
-  write_errors(w, s.uncertainty);
+      "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry and of [record] output_delay_s,\n"
+      "same keys and units, all zero by default. In a harmonic term, the amplitude is the uncertainty\n"
+      "of that harmonic's amplitude and phase_deg its nominal phase.");
+  write_errors(w, s.uncertainty, ErrorKeys::kAll);
 
   w.section("calibration", "The calibration's choices; the command line's options override them.");
   std::string names = "[";
@@ -291,6 +293,11 @@ std::string scenario_to_toml(const Scenario& s) {
   if (s.record) {
     w.section("record", kRecordNote);
     write_record_keys(w, *s.record);
+    write_errors(w, s.errors, ErrorKeys::kRecord);
+  } else if (s.errors.output_delay_s != 0.0) {
+    // The acquisition's delay alone: the section (gyrocal's own format then needs no magic line).
+    w.section("record", kRecordNote);
+    write_errors(w, s.errors, ErrorKeys::kRecord);
   } else {
     // Commented out, so that the file reads back as the scenario it was written from.
     TomlWriter keys;
@@ -300,6 +307,7 @@ std::string scenario_to_toml(const Scenario& s) {
       layout.output_column = std::string(Accelerometer::native_column);
     }
     write_record_keys(keys, layout);
+    write_errors(keys, s.errors, ErrorKeys::kRecord);
     w.section_commented("record", kRecordNote, keys.text());
   }
   return w.text();
