@@ -67,6 +67,7 @@ CentrifugeErrors random_errors(std::mt19937_64& rng, double angle_scale) {
   e.position_angle_error_rad = a * u(rng);
   e.mount_misalignment_rad = a * Vector3d(u(rng), u(rng), u(rng));
   e.lever_arm_m = 0.05 * Vector3d(u(rng), u(rng), u(rng));
+  e.counter_angle_error_rad = a * u(rng);
   return e;
 }
 

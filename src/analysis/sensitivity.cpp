@@ -53,6 +53,8 @@ MachineErrorTerm make_term(int field, int harmonic, double phase_rad, int compon
 void field_terms(int fi, const CentrifugeErrors& errors, bool all,
                  std::vector<std::pair<MachineErrorTerm, double>>& out) {
   const MachineErrorField& f = field_info(fi);
+  // An error added after the study's rows were set enters it where configured (studied_when_zero).
+  all = all && f.studied_when_zero;
   switch (f.kind) {
     case Kind::kConstant: {
       const double v = errors.*f.scalar;

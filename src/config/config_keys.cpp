@@ -13,6 +13,11 @@ const std::vector<ErrorKey>& error_keys() {
   return keys;
 }
 
+bool holds(ErrorKeys keys, const MachineErrorField& field) {
+  if (keys == ErrorKeys::kAll) return true;
+  return (field.section == MachineErrorSection::kRecord) == (keys == ErrorKeys::kRecord);
+}
+
 /// The test's first non-zero rate, which [centrifuge] rate_rad_s follows when the file gives only [test]
 /// rates_rad_s; nullopt for a static test.
 std::optional<double> first_spinning_rate(const std::vector<double>& rates) {

@@ -119,6 +119,12 @@ struct ErrorKey {
 
 const std::vector<ErrorKey>& error_keys();
 
+/// Which keys of the machine-error table a section holds: [centrifuge.errors] the machine's, [record] the
+/// acquisition's (MachineErrorSection), [uncertainty] every one's.
+enum class ErrorKeys { kMachine, kRecord, kAll };
+/// Whether `keys` holds the field's key.
+bool holds(ErrorKeys keys, const MachineErrorField& field);
+
 /// A key of [reduce]: one ReduceOptions field (reduce/dwell_accumulator.hpp, where each default's full reason
 /// is written), in the unit its name carries (the field's own, so no conversion), as a number, an integer or
 /// a boolean (one member set). The comment gives the unit and the reason for the default, which `init` writes

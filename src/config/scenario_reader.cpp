@@ -134,9 +134,12 @@ void read_record_output(const Reader& reader, const toml::table& table, SensorKi
 }
 
 /// [record]: a rig's own record layout (docs/records.md), for `kind`'s sensor. The layout's own check
-/// (RecordLayout::IsValid) names the key; its line is that key's.
-RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table, SensorKind kind) {
+/// (RecordLayout::IsValid) names the key; its line is that key's. The acquisition's timing (output_delay_s)
+/// goes into `errors`, where the model and a self-calibration take it (model/machine_errors.hpp).
+RecordLayout read_record(const Reader& reader, Section& section, const toml::table& table, SensorKind kind,
+                         CentrifugeErrors& errors) {
   RecordLayout layout;
+  read_errors(reader, section, kAnyValue, errors, ErrorKeys::kRecord);
   read_record_output(reader, table, kind, layout);
   if (const toml::node* node = section.find("delimiter")) {
     const std::string text = reader.string(*node, section.path("delimiter"));
@@ -263,7 +266,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   const toml::table* errors_table = centrifuge.table("errors");
   read_numbers(centrifuge, kCentrifugeKeys, s.centrifuge);
   Section errors(reader, errors_table, "centrifuge.errors");
-  read_errors(reader, errors, kAnyValue, s.errors);
+  read_errors(reader, errors, kAnyValue, s.errors, ErrorKeys::kMachine);
 
   Section gyro(reader, top.table("gyro"), "gyro");
   const toml::table* noise_table = gyro.table("noise");
@@ -291,7 +294,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
 
   Section uncertainty(reader, top.table("uncertainty"), "uncertainty");
   uncertainty.number("gravity_m_s2", 1.0, kGravityUncertainty, s.gravity_uncertainty_m_s2);
-  read_errors(reader, uncertainty, kNonNegative, s.uncertainty);
+  read_errors(reader, uncertainty, kNonNegative, s.uncertainty, ErrorKeys::kAll);
 
   Section calibration(reader, top.table("calibration"), "calibration");
   if (const toml::node* node = calibration.find("estimate")) {
@@ -346,7 +349,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   // After [sensor]: the record's output is the sensor's, in its unit.
   if (const toml::table* record_table = top.table("record")) {
     Section record(reader, record_table, "record");
-    s.record = read_record(reader, record, *record_table, s.sensor_kind);
+    s.record = read_record(reader, record, *record_table, s.sensor_kind, s.errors);
   }
 
   top.reject_unknown();

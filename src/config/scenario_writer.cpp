@@ -174,8 +174,11 @@ void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& s
   }
 }
 
-void write_errors(TomlWriter& writer, const CentrifugeErrors& errors, SensorKind kind) {
+/// The keys of the machine-error table that `keys` holds, with their values in `errors` and the comments in the
+/// sensor's words.
+void write_errors(TomlWriter& writer, const CentrifugeErrors& errors, ErrorKeys keys, SensorKind kind) {
   for (const ErrorKey& key : error_keys()) {
+    if (!holds(keys, *key.field)) continue;
     const MachineErrorField& f = *key.field;
     std::string value;
     switch (f.kind) {
@@ -236,7 +239,7 @@ std::string scenario_to_toml(const Scenario& s) {
   write_numbers(w, kCentrifugeKeys, s.centrifuge, s.sensor_kind, rate_follows_test ? "rate_rad_s" : "");
 
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
-  write_errors(w, s.errors, s.sensor_kind);
+  write_errors(w, s.errors, ErrorKeys::kMachine, s.sensor_kind);
 
   if (s.sensor_kind == SensorKind::kAccelerometer) write_accelerometer(w, s);
   if (s.sensor_kind == SensorKind::kGyro) {
@@ -290,10 +293,10 @@ std::string scenario_to_toml(const Scenario& s) {
 
   w.section(
       "uncertainty",
-      "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry, same keys and units, all zero\n"
-      "by default. In a harmonic term, the amplitude is the uncertainty of that harmonic's amplitude\n"
-      "and phase_deg its nominal phase.");
-  write_errors(w, s.uncertainty, s.sensor_kind);
+      "Standard uncertainty (1 sigma) of each [centrifuge.errors] entry and of [record] output_delay_s,\n"
+      "same keys and units, all zero by default. In a harmonic term, the amplitude is the uncertainty\n"
+      "of that harmonic's amplitude and phase_deg its nominal phase.");
+  write_errors(w, s.uncertainty, ErrorKeys::kAll, s.sensor_kind);
   w.key("gravity_m_s2", toml_number(s.gravity_uncertainty_m_s2),
         "local gravity's ([site] gravity_m_s2), m/s^2: 1e-5 m/s^2 is 1 ppm, which reads as 1 um of radius at "
         "1 m");
@@ -344,6 +347,11 @@ std::string scenario_to_toml(const Scenario& s) {
   if (s.record) {
     w.section("record", kRecordNote);
     write_record_keys(w, *s.record);
+    write_errors(w, s.errors, ErrorKeys::kRecord, s.sensor_kind);
+  } else if (s.errors.output_delay_s != 0.0) {
+    // The acquisition's delay alone: the section (gyrocal's own format then needs no magic line).
+    w.section("record", kRecordNote);
+    write_errors(w, s.errors, ErrorKeys::kRecord, s.sensor_kind);
   } else {
     // Commented out, so that the file reads back as the scenario it was written from.
     TomlWriter keys;
@@ -354,6 +362,7 @@ std::string scenario_to_toml(const Scenario& s) {
       layout.output_unit_name = std::string(Accelerometer::output_unit);  // shown, commented out
     }
     write_record_keys(keys, layout);
+    write_errors(keys, s.errors, ErrorKeys::kRecord, s.sensor_kind);
     w.section_commented("record", kRecordNote, keys.text());
   }
   return w.text();

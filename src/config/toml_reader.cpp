@@ -18,14 +18,14 @@ std::string describe(const Range& range) {
   return (range.min_exclusive ? "> " : ">= ") + shortest(range.min) + why;
 }
 
-/// A machine error's range in its key's unit: `sign`'s lower end (any sign, or >= 0 for an uncertainty), and
-/// limits::kMachineErrorSi in SI, rounded down to one significant digit in the key's unit (200000 arcsec).
-Range machine_error_range(const Range& sign, double unit_to_si) {
-  const double max = limits::kMachineErrorSi / unit_to_si;
+/// A machine error's range in its key's unit: `sign`'s lower end (any sign, or >= 0 for an uncertainty or an
+/// error that is never negative), and the field's limit in SI (limits::kMachineErrorSi but for a delay),
+/// rounded down to one significant digit in the key's unit (200000 arcsec).
+Range machine_error_range(const Range& sign, const MachineErrorField& field) {
+  const double max = field.limit_si / field.unit_to_si;
   const double step = std::pow(10.0, std::floor(std::log10(max)));
   const double rounded = std::floor(max / step) * step;
-  return {sign.min == 0.0 ? 0.0 : -rounded, rounded, false,
-          "about 1 rad or 1 m, limits::kMachineErrorSi: no machine error is that large"};
+  return {sign.min == 0.0 || field.non_negative ? 0.0 : -rounded, rounded, false, field.limit_reason};
 }
 
 bool contains(const Range& range, double v) {
@@ -61,7 +61,7 @@ std::string type_name(const toml::node& node) {
 /// A harmonic series: an array of tables { harmonic, <amplitude_key>, phase_deg }.
 HarmonicSeries read_series(const Reader& reader, const toml::node& node, const std::string& path,
                            const ErrorKey& key) {
-  const Range amplitude = machine_error_range(kNonNegative, key.field->unit_to_si);
+  const Range amplitude = machine_error_range(kNonNegative, *key.field);
   const toml::array& items = reader.array(node, path);
   // Each term is a column of the model's work at every sample: the series is bounded (core/limits.hpp).
   if (items.size() > limits::kHarmonicTerms)
@@ -86,13 +86,15 @@ HarmonicSeries read_series(const Reader& reader, const toml::node& node, const s
 }
 
 /// [centrifuge.errors] or [uncertainty] (where every value is a standard uncertainty, so >= 0).
-void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors) {
+void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors,
+                 ErrorKeys keys) {
   for (const ErrorKey& key : error_keys()) {
+    if (!holds(keys, *key.field)) continue;
     const toml::node* node = section.find(key.key);
     if (node == nullptr) continue;
     const std::string path = section.path(key.key);
     const MachineErrorField& f = *key.field;
-    const Range bounded = machine_error_range(range, f.unit_to_si);
+    const Range bounded = machine_error_range(range, f);
     switch (f.kind) {
       case MachineErrorKind::kConstant:
         errors.*f.scalar = reader.number(*node, path, bounded) * f.unit_to_si;
@@ -107,7 +109,7 @@ void read_errors(const Reader& reader, Section& section, const Range& range, Cen
       }
     }
   }
-  section.reject_unknown();
+  if (keys != ErrorKeys::kRecord) section.reject_unknown();
 }
 
 std::vector<double> scaled(std::vector<double> values, double factor) {

@@ -21,7 +21,7 @@ std::string describe(const Range& range);
 
 /// A machine error's range in its key's unit: `sign`'s lower end (any sign, or >= 0 for an uncertainty), and
 /// limits::kMachineErrorSi in SI, rounded down to one significant digit in the key's unit (200000 arcsec).
-Range machine_error_range(const Range& sign, double unit_to_si);
+Range machine_error_range(const Range& sign, const MachineErrorField& field);
 
 /// True when v lies in range.
 bool contains(const Range& range, double v);
@@ -175,8 +175,11 @@ void read_numbers(Section& section, const NumberKey<S> (&keys)[N], S& target) {
 HarmonicSeries read_series(const Reader& reader, const toml::node& node, const std::string& path,
                            const ErrorKey& key);
 
-/// [centrifuge.errors] or [uncertainty] (where every value is a standard uncertainty, so >= 0).
-void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors);
+/// [centrifuge.errors], [uncertainty] (where every value is a standard uncertainty, so >= 0) or the
+/// acquisition's keys of [record]: the keys `keys` holds. Unknown keys are then refused, but in [record],
+/// whose other keys the caller reads.
+void read_errors(const Reader& reader, Section& section, const Range& range, CentrifugeErrors& errors,
+                 ErrorKeys keys);
 
 /// values, each times factor.
 std::vector<double> scaled(std::vector<double> values, double factor);

@@ -42,11 +42,13 @@ std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samp
   return at_least;  // not reached for >= 14 samples per revolution (reduce/feasibility.hpp)
 }
 
-/// The channels (kColumns values) of dwell d at joint state j; beta as planned (reduce/reducer.cpp: an
-/// encoder's mean at rest is biased by up to half a count).
+/// The channels (kColumns values) of dwell d at joint state j, the encoders at the output's stamp; beta as
+/// planned (reduce/reducer.cpp: an encoder's mean at rest is biased by up to half a count). The exact inputs
+/// are those the output holds (sensed_inputs: the joints the acquisition's delay earlier); the nominal ones
+/// are a perfect machine's and acquisition's.
 void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState j, double* v) {
   j.position_angle_rad = d.beta_rad;
-  const GyroInputs exact = exact_inputs(model, j);
+  const GyroInputs exact = sensed_inputs(model, j);
   const double offset = d.planned_counter_rate_offset_rad_s;
   const NominalInputs nominal = nominal_inputs(model, j, false, offset);
   v[0] = exact.rate_rad_s.x() * kRadPerSecToDegPerHour;

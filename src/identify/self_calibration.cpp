@@ -117,6 +117,17 @@ std::string error_advice(const MachineErrorParameter& p, const Reduction& reduct
         "dwell "
         "(e.g. 8 equally spaced) (docs/physics.md section 12).",
         p.harmonic, p.harmonic - 1, p.harmonic + 1, gammas);
+  if (p.info().scalar == &CentrifugeErrors::output_delay_s) {
+    // docs/calibration.md, "The acquisition's timing".
+    if (rates.empty())
+      return " A delay shows only while the arm turns (it shifts harmonic k of a spinning dwell by k omega "
+             "tau): add a non-zero rate to [test] rates_rad_s.";
+    if (rates.size() < 2)
+      return " A second non-zero speed would separate it: the quadrature it puts into the first harmonic "
+             "grows as omega^3 where the input axis' tilts' grows as omega^2; add a rate to [test] "
+             "rates_rad_s.";
+    return "";
+  }
   if (rates.size() < 2)
     return " A second non-zero speed would separate it: the machine's tilt term grows as omega and the drift "
            "terms as omega^2 (docs/physics.md section 12); add a rate to [test] rates_rad_s.";

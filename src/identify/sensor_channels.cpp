@@ -24,9 +24,10 @@ JointState line_joints(const Dwell& d, double main_rad, double counter_rad) {
   return j;
 }
 
-/// The sensor's design row at the joints as the reduction's columns: the known part, then the regressors.
+/// The sensor's design row at the joints (the encoders at the output's stamp) as the reduction's columns: the
+/// known part, then the regressors; at the inputs the output holds (sensed_inputs: the acquisition's delay).
 void design_columns(const Sensor& sensor, const CentrifugeModel& model, const JointState& j, double* out) {
-  const DesignRow row = sensor_design_row(sensor, exact_inputs(model, j));
+  const DesignRow row = sensor_design_row(sensor, sensed_inputs(model, j));
   out[0] = row.known;
   for (std::size_t k = 0; k < row.size; ++k) out[k + 1] = row.regressors[k];
 }

@@ -146,7 +146,10 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   const CentrifugeErrors& e = model.errors();
   const CentrifugeModel::PreparedErrors& h = model.prepared();
   const Joint th(j.main_angle_rad, j.main_rate_rad_s, j.main_accel_rad_s2);
-  const Joint ps(j.counter_angle_rad, j.counter_rate_rad_s, j.counter_accel_rad_s2);
+  // The platform's angle: the encoder's reading plus its zero's error (as beta' below).
+  const double psi = e.counter_angle_error_rad != 0.0 ? j.counter_angle_rad + e.counter_angle_error_rad
+                                                      : j.counter_angle_rad;
+  const Joint ps(psi, j.counter_rate_rad_s, j.counter_accel_rad_s2);
 
   FrameMotion f;
   // R_base; then the main-axis runout, (x, y, 0) in the base frame, a function of theta.
@@ -187,6 +190,23 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   in.rate_rad_s = f.rotation.transpose() * (we + f.angular_velocity);
   in.specific_force_g = f.rotation.transpose() * inertial_acceleration / g;
   return in;
+}
+
+JointState joints_before(const JointState& at_stamp, double delay_s) {
+  const double t = delay_s, half_t2 = 0.5 * delay_s * delay_s;
+  JointState j = at_stamp;
+  j.main_angle_rad += -j.main_rate_rad_s * t + j.main_accel_rad_s2 * half_t2;
+  j.main_rate_rad_s -= j.main_accel_rad_s2 * t;
+  j.counter_angle_rad += -j.counter_rate_rad_s * t + j.counter_accel_rad_s2 * half_t2;
+  j.counter_rate_rad_s -= j.counter_accel_rad_s2 * t;
+  j.position_angle_rad += -j.position_rate_rad_s * t + j.position_accel_rad_s2 * half_t2;
+  j.position_rate_rad_s -= j.position_accel_rad_s2 * t;
+  return j;
+}
+
+GyroInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp) {
+  const double delay = model.errors().output_delay_s;
+  return delay == 0.0 ? exact_inputs(model, at_stamp) : exact_inputs(model, joints_before(at_stamp, delay));
 }
 
 JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,

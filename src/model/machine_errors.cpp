@@ -30,6 +30,29 @@ MachineErrorField vector(std::string_view name, std::string_view unit, std::stri
   return {name, unit, suffix, to_si, typical, K::kVector, comment, nullptr, nullptr, member};
 }
 
+/// An error added after the sensitivity study's rows were set (issue 28): studied where configured.
+MachineErrorField acquisition(MachineErrorField f) {
+  f.studied_when_zero = false;
+  return f;
+}
+
+/// The acquisition's timing ([record] output_delay_s; docs/calibration.md, "The acquisition's timing"): a
+/// delay >= 0, s, up to limits::kOutputDelayS; 1 us typical (20 us shifts a 12 rad/s first harmonic by 2.4e-4
+/// rad).
+MachineErrorField output_delay() {
+  MachineErrorField f = acquisition(
+      constant("output_delay", "s", "s", 1.0, 1e-6,
+               "the output is stamped this long after the instant it was sensed (a filter's group delay), s",
+               &E::output_delay_s));
+  f.section = MachineErrorSection::kRecord;
+  f.limit_si = limits::kOutputDelayS;
+  f.limit_reason =
+      "limits::kOutputDelayS: an acquisition filter's group delay is microseconds to milliseconds; a longer "
+      "offset is a clock's, to be corrected in the time column";
+  f.non_negative = true;
+  return f;
+}
+
 std::vector<MachineErrorField> make_fields() {
   return {
       constant("base_tilt_x", "arcsec", "arcsec", kArcsec, kArcsec,
@@ -61,6 +84,9 @@ std::vector<MachineErrorField> make_fields() {
              "counter platform wobble about y, harmonics of psi_r, arcsec", &E::counter_wobble_y_rad),
       constant("counter_rate_mismatch", "rad/s", "rad_s", 1.0, 1e-6,
                "delta omega: platform heading drift about Up, rad/s", &E::counter_rate_mismatch_rad_s),
+      acquisition(constant("counter_angle_error", "arcsec", "arcsec", kArcsec, kArcsec,
+                           "added to the counter encoder's psi_r (its zero's error), arcsec",
+                           &E::counter_angle_error_rad)),
       constant("position_perpendicularity_x", "arcsec", "arcsec", kArcsec, kArcsec,
                "position platform tilt about x, arcsec", &E::position_perpendicularity_x_rad),
       constant("position_perpendicularity_z", "arcsec", "arcsec", kArcsec, kArcsec,
@@ -75,6 +101,7 @@ std::vector<MachineErrorField> make_fields() {
              "gyro mounting misalignment about I, O, S, arcsec", &E::mount_misalignment_rad),
       vector("lever_arm", "m", "m", 1.0, 1e-3,
              "gyro centre offset in position-platform axes (I, O, S at beta = 0), m", &E::lever_arm_m),
+      output_delay(),
   };
 }
 

@@ -54,7 +54,11 @@ NoiseGenerator make_noise(const Scenario& scenario, double fs, std::uint64_t see
 void sample_at(const CentrifugeModel& model, const Sensor& sensor, const Timeline& timeline, double t,
                NoiseGenerator& noise, RecordSample& sample) {
   const JointState joints = joint_state_at(timeline, t);
-  const GyroInputs inputs = exact_inputs(model, joints);
+  // The output stamped at t was sensed the acquisition's delay earlier ([record] output_delay_s): the
+  // machine's own motion at that instant (the encoders are read at t).
+  const double delay_s = model.errors().output_delay_s;
+  const GyroInputs inputs = delay_s == 0.0 ? exact_inputs(model, joints)
+                                           : exact_inputs(model, joint_state_at(timeline, t - delay_s));
   sample.time_s = t;
   sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
   sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
@@ -113,6 +117,10 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
       {"duration_s", fmt::format("{}", timeline.duration_s)},
       {"samples", fmt::format("{}", sample_count(timeline, test.sample_rate_hz))},
   };
+  // The acquisition's delay ([record] output_delay_s), written only where there is one, so that a plain
+  // record is what it always was.
+  if (scenario.errors.output_delay_s != 0.0)
+    m.emplace_back("output_delay_s", fmt::format("{}", scenario.errors.output_delay_s));
   if (scenario.sensor_kind == SensorKind::kAccelerometer) {
     // An accelerometer's record: its kind, noise ([accelerometer.noise] keys) and truth (parameter table).
     const Accelerometer& a = scenario.accelerometer;

@@ -42,7 +42,9 @@ inline Pose pose_at(const CentrifugeModel& m, double omega, double beta, Real t,
   const CentrifugeErrors& e = m.errors();
   const Real th = m.geometry().initial_main_angle_rad + omega * t + accel * t * t / 2;
   const Real thd = omega + accel * t;
-  const Real ps = -th + m.geometry().heading_rad + e.counter_rate_mismatch_rad_s * t;
+  // The platform's angle: the encoder's psi_r plus its zero's error.
+  const Real ps =
+      -th + m.geometry().heading_rad + e.counter_rate_mismatch_rad_s * t + e.counter_angle_error_rad;
   const Real bp = Real(beta) + beta_rate * t + e.position_angle_error_rad;
   const Matrix3r base = ry_l(e.base_tilt_y_rad) * rx_l(e.base_tilt_x_rad);
   const Matrix3r main = ry_l(e.main_perpendicularity_y_rad + series_l(e.main_wobble_y_rad, th)) *

@@ -96,6 +96,13 @@ inline constexpr double kEncoderAngleDeg = 1e10;
 /// A machine's errors are arcsec and micrometres (docs/sensitivity.md); beyond a radian or a metre the
 /// model's errors are no longer small, and their products can leave a double's range (issue 29, D13).
 inline constexpr double kMachineErrorSi = 1.0;
+/// The acquisition's delay ([record] output_delay_s, and its [uncertainty]), s: 0.1 s, and never negative (an
+/// output is stamped after it was sensed). An anti-alias filter's group delay or a multiplexer's skew is
+/// microseconds to a few milliseconds (a 4-pole 10 Hz Bessel filter's ~40 ms). The model takes the joints
+/// that long before the stamp on the dwell's line (docs/calibration.md, "The acquisition's timing"), which
+/// holds while the delay stays inside a dwell's guard at its ends ([reduce] leave_guard_s, default 0.25 s):
+/// a longer offset is a clock's between two loggers, to be corrected in the time column.
+inline constexpr double kOutputDelayS = 0.1;
 /// |gyro drift coefficient| ([gyro] dF, deg/h; dI, dO, dS, deg/h/g; dII ... dOS, deg/h/g^2): 1e7, 2800 deg/s,
 /// beyond any gyro's range ([gyro] dF = 1e308 gave "Observation 0 is not finite (inf)" in `plan`).
 inline constexpr double kGyroCoefficient = 1e7;

@@ -50,6 +50,9 @@ struct CentrifugeErrors {
   HarmonicSeries counter_wobble_x_rad;       ///< of psi_r, rad
   HarmonicSeries counter_wobble_y_rad;       ///< of psi_r, rad
   double counter_rate_mismatch_rad_s = 0.0;  ///< delta omega: platform heading drift about Up, rad/s
+  /// Added to the counter encoder's reading psi_r: the platform's angle is psi_r + this (its encoder's zero
+  /// is off by minus this), rad; its wobbles are harmonics of that angle.
+  double counter_angle_error_rad = 0.0;
   double position_perpendicularity_x_rad = 0.0;
   double position_perpendicularity_z_rad = 0.0;
   HarmonicSeries position_wobble_x_rad;                              ///< of beta', rad
@@ -57,6 +60,11 @@ struct CentrifugeErrors {
   double position_angle_error_rad = 0.0;                             ///< added to the commanded beta, rad
   Eigen::Vector3d mount_misalignment_rad = Eigen::Vector3d::Zero();  ///< about I, O, S, rad
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  ///< gyro centre offset, position-platform axes, m
+  /// The acquisition's timing ([record] output_delay_s, docs/records.md): the output is stamped this long
+  /// after the instant it was sensed (an anti-alias filter's group delay, a multiplexer's skew), s, >= 0. Not
+  /// the machine's, but held with its errors so that a self-calibration estimates it as one of them
+  /// (`--estimate output_delay`); sensed_inputs applies it.
+  double output_delay_s = 0.0;
 };
 
 /// The three joints at one instant. Encoder angles: the main axis theta, the counter-rotating platform
@@ -137,6 +145,17 @@ class CentrifugeModel {
 /// Exact inertial rate and specific force in gyro axes (docs/physics.md section 4), with analytic derivatives
 /// of the chain of section 3 (wobbles and runouts differentiated through their joint angle).
 GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
+
+/// The joints `delay_s` (s) before `at_stamp`, from its angles, rates and accelerations (second order in the
+/// delay: exact on a constant-rate line, whose acceleration is zero).
+JointState joints_before(const JointState& at_stamp, double delay_s);
+
+/// The inputs that the sensor's output stamped at the encoder readings `at_stamp` holds: exact_inputs at the
+/// joints the errors' output_delay_s earlier (joints_before), where the output's time meets the encoders'
+/// (docs/calibration.md, "The acquisition's timing"). exact_inputs itself, bit for bit, when the delay is 0.
+/// The model's channels of a calibration are evaluated through it; the simulator takes the timeline's joints
+/// at the earlier instant instead (an independent route).
+GyroInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
 /// theta = theta0 + omega*t, psi_r = -theta + psi0 + (delta_omega + offset)*t (docs/physics.md sections 3

@@ -9,12 +9,17 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrocal/core/limits.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 
 namespace gyrocal {
 
 /// How a machine error is given: one number, a harmonic series of its joint's angle, or three components.
 enum class MachineErrorKind { kConstant, kSeries, kVector };
+
+/// Where a configuration gives an error: [centrifuge.errors] (the machine's), or [record] (the acquisition's:
+/// the output's delay, docs/records.md). Its standard uncertainty is an [uncertainty] key either way.
+enum class MachineErrorSection { kCentrifugeErrors, kRecord };
 
 /// One field of CentrifugeErrors. Exactly one of scalar, series, vector is set, as kind says.
 struct MachineErrorField {
@@ -31,6 +36,18 @@ struct MachineErrorField {
   double CentrifugeErrors::*scalar = nullptr;
   HarmonicSeries CentrifugeErrors::*series = nullptr;
   Eigen::Vector3d CentrifugeErrors::*vector = nullptr;
+  /// The configuration's section of its key.
+  MachineErrorSection section = MachineErrorSection::kCentrifugeErrors;
+  /// The largest |value| a configuration may give it, SI (core/limits.hpp), with the limit's name and reason
+  /// for the refusal; and whether it must be >= 0 (a delay).
+  double limit_si = limits::kMachineErrorSi;
+  const char* limit_reason = "about 1 rad or 1 m, limits::kMachineErrorSi: no machine error is that large";
+  bool non_negative = false;
+  /// Whether the sensitivity study adds it at its typical magnitude where the configuration leaves it zero.
+  /// False for the errors added after the study's rows were set (the counter encoder's zero and the output's
+  /// delay, issue 28): they have their rows where a configuration gives them, and a default study's rows
+  /// stay what they were.
+  bool studied_when_zero = true;
 
   /// The configuration key: name_suffix for a constant or vector, name for a series.
   std::string key() const;
