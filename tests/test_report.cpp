@@ -853,8 +853,8 @@ TEST(ReportPages, AnAccelerometersResultsShowItsCoefficientsUnitsAndRadius) {
   // its own data, the positions' residuals in ug (the spinning dwells' harmonic content).
   const std::string cal = read_file(p.html.at("calibration"));
   for (const char* cell :
-       {"<td>K0</td>", "<td>K3</td>", "<td>delta_o</td>", "<td>ug/g^3</td>", "<td>urad</td>",
-        "<td>g/g</td>", "radius_error", "radius_stretch", "residual, \xC2\xB5g", "harmonic content"})
+       {"<td>K0</td>", "<td>K3</td>", "<td>delta_o</td>", "<td>ug/g^3</td>", "<td>urad</td>", "<td>g/g</td>",
+        "radius_error", "radius_stretch", "residual, \xC2\xB5g", "harmonic content"})
     EXPECT_NE(cal.find(cell), std::string::npos) << cell;
   EXPECT_EQ(cal.find("<td>dF</td>"), std::string::npos);
   EXPECT_EQ(cal.find("residual, deg/h"), std::string::npos);
