@@ -790,7 +790,9 @@ TEST(ReportPages, EachResultOfTheCommandLineRendersAsItsOwnPage) {
   EXPECT_NE(cal.find("<h1>gyrocal calibration report</h1>"), std::string::npos);
   const auto cal_headings = headings(cal);
   ASSERT_GE(cal_headings.size(), 2u);
-  EXPECT_EQ(cal_headings[0], "Provenance");
+  // The result first, where it came from last (issue 28, item 7).
+  EXPECT_EQ(cal_headings[0], "Drift coefficients");
+  EXPECT_EQ(cal_headings.back(), "Provenance");
   EXPECT_NE(std::find(cal_headings.begin(), cal_headings.end(), "Test plan"), cal_headings.end());
   const std::size_t provenance = cal.find("<section id=\"provenance\">");
   const std::string prov = cal.substr(provenance, cal.find("</section>", provenance) - provenance);
