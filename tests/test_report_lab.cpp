@@ -230,11 +230,12 @@ TEST(AccelerometerReport, LeadsWithItsResultAndFoldsTheLongTablesAtTheEnd) {
   }
   EXPECT_LT(index_of(drawn, "linearity"), index_of(drawn, "plan"));
   EXPECT_LT(index_of(drawn, "plan"), index_of(drawn, "data-quality"));
-  // The plan is a beta x rate grid, folded: one row per beta, not one per position (128 here).
+  // The plan is a beta x rate grid, folded: one row per beta, not one per position (4 beta x 8 gamma x 3
+  // rates here).
   const std::string plan = section_html(r.html, "plan");
   EXPECT_NE(plan.find("<details class=\"fold\">"), std::string::npos);
   const json& positions = r.result["plan"]["positions"];
-  ASSERT_EQ(positions.size(), 128u);
+  ASSERT_EQ(positions.size(), 4u * 8u * 3u);
   std::size_t grid_rows = 0;
   const std::size_t grid = plan.find("<th>\xCE\xB2, deg</th>");
   ASSERT_NE(grid, std::string::npos) << plan;
