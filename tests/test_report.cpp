@@ -320,10 +320,11 @@ TEST(Report, MachineErrorsShowEstimateConfiguredValueAndCorrelations) {
   const std::string html = gyrocal::render_html_report(r, options);
   EXPECT_TRUE(problems.empty()) << problems.front();
   EXPECT_NE(html.find("<h2>Estimated machine errors</h2>"), std::string::npos);
-  // counter_perpendicularity_x: configured 5, estimate 4.87 +- 0.35: change -0.13 = -0.37 sigma.
+  // counter_perpendicularity_x: configured 5, estimate 4.87 +- 0.35 (U = 2 sigma = 0.7 at k = 2): change
+  // -0.13 = -0.37 sigma.
   EXPECT_NE(html.find("<td>counter_perpendicularity_x</td><td>arcsec</td><td class=\"num\">5</td>"
-                      "<td class=\"num\">4.87</td><td class=\"num\">0.35</td><td class=\"num\">-0.13</td>"
-                      "<td class=\"num\">-0.37</td>"),
+                      "<td class=\"num\">4.87</td><td class=\"num\">0.35</td><td class=\"num\">0.7</td>"
+                      "<td class=\"num\">-0.13</td><td class=\"num\">-0.37</td>"),
             std::string::npos);
   // The cosine part of the second harmonic moved 1.93/0.5 = 3.86 sigma from its configured 0: shaded.
   EXPECT_NE(html.find("<td>counter_wobble_x h2 cos</td>"), std::string::npos);
@@ -790,7 +791,9 @@ TEST(ReportPages, EachResultOfTheCommandLineRendersAsItsOwnPage) {
   EXPECT_NE(cal.find("<h1>gyrocal calibration report</h1>"), std::string::npos);
   const auto cal_headings = headings(cal);
   ASSERT_GE(cal_headings.size(), 2u);
-  EXPECT_EQ(cal_headings[0], "Provenance");
+  // The result first, where it came from last (issue 28, item 7).
+  EXPECT_EQ(cal_headings[0], "Drift coefficients");
+  EXPECT_EQ(cal_headings.back(), "Provenance");
   EXPECT_NE(std::find(cal_headings.begin(), cal_headings.end(), "Test plan"), cal_headings.end());
   const std::size_t provenance = cal.find("<section id=\"provenance\">");
   const std::string prov = cal.substr(provenance, cal.find("</section>", provenance) - provenance);

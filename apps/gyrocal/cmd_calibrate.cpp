@@ -15,6 +15,7 @@
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/test_statement_json.hpp"
 #include "tables.hpp"
 
 namespace gyrocal::cli {
@@ -139,6 +140,12 @@ void register_calibrate(CLI::App& app) {
         j["config_sha256"] = config_sha256.empty() ? nlohmann::json(nullptr) : nlohmann::json(config_sha256);
       }
     }
+    // What the report states beyond the estimates (docs/report.md): the unit under test, the record's truth,
+    // the g-levels and sequence; its warnings (a [unit] serial the record contradicts) printed too.
+    nlohmann::ordered_json scratch;
+    const std::vector<std::string> statement_warnings = add_test_statement(
+        !opt->json.empty() || storing ? j : scratch, s, &reader.metadata(), r.positions, opt->record);
+    r.warnings.insert(r.warnings.end(), statement_warnings.begin(), statement_warnings.end());
     if (!opt->json.empty()) write_result(opt->json, j, "calibration", opt->force);
     if (opt->json != "-") print_out("{}", result_table(r));
     if (storing) {

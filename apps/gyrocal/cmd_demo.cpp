@@ -19,6 +19,7 @@
 #include "gyrocal/result/coefficient_order.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
+#include "gyrocal/result/test_statement_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "tables.hpp"
 
@@ -101,6 +102,8 @@ void accelerometer_demo(const std::string& out, bool force) {
     truth[std::string(kAccelerometerParameters[k].name)] = s.accelerometer.coefficients.values[k];
   j["truth"] = truth;
   j["plan"] = plan_to_json(s.test);
+  // The g-levels, sequence and the inputs of the linearity plot (docs/report.md); no unit under test.
+  add_test_statement(j, s, nullptr, main.positions, record);
   j["comparison"] = nlohmann::json::array();
   for (std::size_t i = 0; i < results.size(); ++i) {
     const nlohmann::ordered_json r = calibration_to_json(results[i]);

@@ -41,6 +41,43 @@ void refuse_long_list(const Reader& reader, const toml::node& node, const std::s
                                  " in all)");
 }
 
+/// [unit]: the unit under test (docs/report.md). Texts on one line (notes: line breaks allowed), within
+/// limits::kUnitTextBytes / kUnitNotesBytes; the temperature within the limits' range; any other key refused.
+void read_unit(const Reader& reader, Section& top, UnitUnderTest& unit) {
+  Section section(reader, top.table("unit"), "unit");
+  const auto text = [&](std::string_view key, std::size_t max_bytes, bool lines, std::string& target) {
+    const toml::node* node = section.find(key);
+    if (node == nullptr) return;
+    const std::string path = section.path(key);
+    std::string value = reader.string(*node, path);
+    if (value.size() > max_bytes)
+      reader.fail(node->source(), path + " is " + std::to_string(value.size()) + " bytes long; at most " +
+                                      std::to_string(max_bytes) +
+                                      " (limits::" + (lines ? "kUnitNotesBytes" : "kUnitTextBytes") + ")");
+    for (const char c : value) {
+      const auto byte = static_cast<unsigned char>(c);
+      if ((byte < 0x20 && !(lines && (c == '\n' || c == '\t'))) || byte == 0x7F)
+        reader.fail(node->source(),
+                    path + " holds a control character" +
+                        std::string(lines ? " other than a line break or a tab"
+                                          : " (a line break, a tab, ...); write it on one line"));
+    }
+    if (value.find_first_not_of(" \t\r\n") == std::string::npos)
+      reader.fail(node->source(), path + " is empty; leave the key out when it is not known");
+    target = std::move(value);
+  };
+  text("serial", limits::kUnitTextBytes, false, unit.serial);
+  text("model", limits::kUnitTextBytes, false, unit.model);
+  text("operator", limits::kUnitTextBytes, false, unit.operator_name);
+  text("notes", limits::kUnitNotesBytes, true, unit.notes);
+  if (const toml::node* node = section.find("temperature_c"))
+    unit.temperature_c =
+        reader.number(*node, section.path("temperature_c"),
+                      Range{limits::kUnitTemperatureMinC, limits::kUnitTemperatureMaxC, true,
+                            "limits::kUnitTemperatureMinC/MaxC: above absolute zero, at most 1000 deg C"});
+  section.reject_unknown();
+}
+
 void read_test(const Reader& reader, Section& section, TestSpec& test) {
   section.number("sample_rate_hz", 1.0, kSampleRate, test.sample_rate_hz);
   if (const toml::node* node = section.find("revolutions")) {
@@ -341,6 +378,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
       reader.fail(node->source(), "history.database must not hold a NUL character");
   }
   history.reject_unknown();
+  read_unit(reader, top, s.unit);
   const toml::table* reduce_table = top.table("reduce");
   Section reduce(reader, reduce_table, "reduce");
   read_reduce(reader, reduce, reduce_table, s.reduce);

@@ -339,6 +339,30 @@ std::string scenario_to_toml(const Scenario& s) {
     w.section_commented("history", kHistoryNote, keys.text());
   }
 
+  constexpr std::string_view kUnitNote =
+      "The unit under test, as the calibration report states it (docs/report.md); every key optional.\n"
+      "A record's metadata ('# unit = SERIAL', '# date = YYYY-MM-DD') states what is left out here.";
+  {
+    TomlWriter keys;
+    const UnitUnderTest& u = s.unit;
+    const bool written = !u.empty();
+    TomlWriter& out = written ? w : keys;
+    if (written) w.section("unit", kUnitNote);
+    const auto text = [&](std::string_view key, const std::string& value, std::string_view example,
+                          std::string_view note) {
+      if (written && value.empty()) return;
+      out.key(key, toml_string(written ? value : std::string(example)), note);
+    };
+    text("serial", u.serial, "SN-0001", "the unit's serial number");
+    text("model", u.model, "QA-2000", "its model or part number");
+    text("operator", u.operator_name, "A. Operator", "who ran the test");
+    if (!written || u.temperature_c)
+      out.key("temperature_c", written ? toml_number(*u.temperature_c) : std::string("23.0"),
+              "the test's temperature, deg C");
+    text("notes", u.notes, "30 min warm-up; mounted on fixture F2", "conditions, warm-up, mounting");
+    if (!written) w.section_commented("unit", kUnitNote, keys.text());
+  }
+
   constexpr std::string_view kRecordNote =
       "How to read a rig's own record (docs/contract.md, \"Records\"; docs/records.md). Without a [record]\n"
       "section a record is gyrocal's own format, whose first line is \"# gyrocal-record 1\"; with one (even\n"

@@ -20,6 +20,11 @@ namespace gyrocal::report::section {
 
 namespace {
 
+std::optional<double> times_million(std::optional<double> v) {
+  if (!v) return v;
+  return *v * 1e6;
+}
+
 /// The dwells' table of data_quality.dwells (calibration_to_json): one row per dwell in time order, its
 /// columns in the order a reader follows a dwell (what was planned, what was measured, what was dropped and
 /// why it ended), the `dropped` object spread into one column per reason; any field a later gyrocal adds
@@ -114,10 +119,10 @@ void dwell_table(const json& dwells, std::string& out) {
     for (const auto& key : others) row.push_back(value_cell(find(d, key)));
     rows.push_back(std::move(row));
   }
-  out +=
-      "<p class=\"note\">Each dwell the calibration used, in time order: the steady run the record held, the "
-      "rows that entered the estimate and the rows dropped from it, by reason.</p>\n";
-  out += table(header, rows, "wrap dense");
+  out += folded(fmt::format("The {} dwells in time order", dwells.size()),
+                "<p class=\"note\">Each dwell the calibration used, in time order: the steady run the record "
+                "held, the rows that entered the estimate and the rows dropped from it, by reason.</p>\n" +
+                    table(header, rows, "wrap dense dwells"));
 }
 
 }  // namespace
@@ -150,10 +155,11 @@ void data_quality(const json& result, Page&, std::string& out) {
   if (const json* rejected = find(q, "rejected")) {
     expect(*rejected, json::value_t::array, "data_quality.rejected");
     if (!rejected->empty()) {
-      out +=
-          "<h3>Steady runs that gave no dwell</h3>\n<p class=\"note\">Parts of the record where the machine "
-          "held a steady rate that no planned dwell could use, and why.</p>\n";
-      out += generic_table(*rejected, {"start_s", "end_s", "reason"}, "data_quality.rejected");
+      out += "<h3>Steady runs that gave no dwell</h3>\n";
+      out += folded(fmt::format("{} steady runs that no planned dwell could use, and why", rejected->size()),
+                    "<p class=\"note\">Parts of the record where the machine held a steady rate that no "
+                    "planned dwell could use, and why (a static set's indexing moves among them).</p>\n" +
+                        generic_table(*rejected, {"start_s", "end_s", "reason"}, "data_quality.rejected"));
     }
   }
 }
@@ -200,10 +206,15 @@ void positions(const json& result, Page& page, std::string& out) {
     tips.push_back(fmt::format("position {}: residual {} \xC2\xB1 {} {}", num(index), fixed(residual, d),
                                num(std_err, 2), unit));
   }
-  out += table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, " + unit,
-                "standard error, " + unit, "samples", "residual, " + unit},
-               rows);
+  const std::string positions_table =
+      table({"position", "\xCE\xB2, deg", "\xCE\xB3, deg", "rate, rad/s", "mean output, " + unit,
+             "standard error, " + unit, "samples", "residual, " + unit},
+            rows);
+  const std::string table_folded = folded(
+      fmt::format("The {} reduced positions: mean output, standard error, samples, residual", p.size()),
+      positions_table);
   if (!any_residual) {
+    out += table_folded;
     out += "<p class=\"note\">The result gives no residuals, so none are plotted.</p>\n";
     return;
   }
@@ -226,6 +237,74 @@ void positions(const json& result, Page& page, std::string& out) {
         "<p class=\"note\">An accelerometer's spinning dwell is reduced to its whole harmonic content up to "
         "order 3: its positions are the values at seven evenly spaced \xCE\xB3, so the residuals of one "
         "dwell are its harmonic residuals (docs/accelerometer.md).</p>\n";
+  out += table_folded;
+}
+
+void linearity(const json& result, Page& page, std::string& out) {
+  const json& p = member(result, "positions", "the result");
+  expect(p, json::value_t::array, "positions");
+  const json& inputs = member(result, "position_inputs", "the result");
+  expect(inputs, json::value_t::array, "position_inputs");
+  // a_i of each position, by its index.
+  std::unordered_map<double, double> a_i;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const std::string where = fmt::format("position_inputs[{}]", k);
+    expect(inputs[k], json::value_t::object, where);
+    const auto index = number(inputs[k], "index", where), a = number(inputs[k], "a_i_g", where);
+    if (index && a) a_i[*index] = *a;
+  }
+  // One series per beta, in the order the betas first occur; residuals in ug (the output in g).
+  std::vector<double> betas;
+  std::unordered_map<double, std::size_t> beta_index;
+  json series = json::array();
+  std::size_t points_drawn = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const std::string where = fmt::format("positions[{}]", k);
+    expect(p[k], json::value_t::object, where);
+    const auto index = number(p[k], "index", where), beta = number(p[k], "beta_deg", where);
+    const auto residual = number(p[k], "residual_deg_h", where),
+               std_err = number(p[k], "std_err_deg_h", where);
+    if (!index || !beta || !residual) continue;
+    const auto a = a_i.find(*index);
+    if (a == a_i.end()) continue;
+    const auto [it, added] = beta_index.try_emplace(*beta, betas.size());
+    if (added) {
+      betas.push_back(*beta);
+      series.push_back({{"name", fmt::format("\xCE\xB2 = {}\xC2\xB0", num(*beta))},
+                        {"colour", palette(series.size())},
+                        {"points", json::array()},
+                        {"tips", json::array()}});
+    }
+    json& s = series[it->second];
+    const double r_ug = *residual * 1e6;
+    s["points"].push_back({{"x", a->second}, {"y", r_ug}});
+    s["tips"].push_back(fmt::format("position {}: a_i = {} g, residual {} \xC2\xB1 {} \xC2\xB5g", num(index),
+                                    num(a->second, 5), num(r_ug, 3), num(times_million(std_err), 2)));
+    ++points_drawn;
+  }
+  if (points_drawn == 0) {
+    out +=
+        "<p class=\"note\">The result gives no residuals at positions of known input, so none are "
+        "plotted.</p>\n";
+    return;
+  }
+  const ScatterChart chart{.series = series,
+                           .xlabel = "input a_i, g (the specific force along the input axis)",
+                           .ylabel = "residual, \xC2\xB5g",
+                           .xmin = nullptr,
+                           .xmax = nullptr,
+                           .ymin = nullptr,
+                           .ymax = nullptr,
+                           .xticks = nullptr,
+                           .yticks = nullptr};
+  out +=
+      page.plot(chart.to_json(), 360, "residual of every reduced position against its input a_i, per beta");
+  out += fmt::format(
+      "<p class=\"note\">The linearity error: each reduced position's output minus the fitted IEEE Std 1293 "
+      "model, against the nominal specific force along the input axis at that position, one colour per "
+      "\xCE\xB2 ({} points). What the model describes (K2, K3, the cross terms) is fitted out; a trend or a "
+      "curve left here is an effect the model lacks. Hover over a point for its standard error.</p>\n",
+      points_drawn);
 }
 
 }  // namespace gyrocal::report::section

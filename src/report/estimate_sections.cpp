@@ -18,6 +18,35 @@
 
 namespace gyrocal::report::section {
 
+namespace {
+
+/// The expanded uncertainty U = k·σ with coverage factor k = 2 (GUM; about 95 % for a normal
+/// distribution), as IEEE Std 836 and 1293 practice reports it beside the standard uncertainty.
+constexpr double kCoverage = 2.0;
+std::optional<double> expanded(std::optional<double> std_dev) {
+  if (!std_dev) return std_dev;
+  return kCoverage * *std_dev;
+}
+const char* const kExpandedHeader = "expanded uncertainty U (k = 2)";
+const char* const kExpandedNote =
+    "<p class=\"note\">U = 2\xCF\x83, the expanded uncertainty with coverage factor k = 2 (about 95 % "
+    "for a normal distribution); \xCF\x83 is the standard uncertainty.</p>\n";
+
+/// A length in m shown in \xC2\xB5m (the radius error, a runout, a lever arm: a centrifuge's arm is measured
+/// to a micron): the factor and the unit to show for `unit`, which is kept as it is otherwise.
+std::pair<double, std::string> shown_unit(const std::string& unit) {
+  if (unit == "m") return {1e6, "\xC2\xB5m"};
+  if (unit.rfind("m/", 0) == 0) return {1e6, "\xC2\xB5" + unit};
+  return {1.0, unit};
+}
+
+std::optional<double> times(std::optional<double> v, double factor) {
+  if (!v) return v;
+  return *v * factor;
+}
+
+}  // namespace
+
 void coefficients(const json& result, Page& page, std::string& out) {
   const json& c = member(result, "coefficients", "the result");
   expect(c, json::value_t::object, "coefficients");
@@ -38,8 +67,8 @@ void coefficients(const json& result, Page& page, std::string& out) {
       if (field != "value" && field != "std" && field != "unit" && field != "identifiable")
         extra_fields.insert(field);
   }
-  // name, unit, truth, estimate, sigma, error, error/sigma, identifiable, then the fields.
-  check_table_cells(c.size(), 8 + extra_fields.size(), "coefficients");
+  // name, unit, truth, estimate, sigma, U (k = 2), error, error/sigma, identifiable, then the fields.
+  check_table_cells(c.size(), 9 + extra_fields.size(), "coefficients");
   for (const auto& name : ordered_keys(c)) {
     const json& e = c[name];
     const std::string where = "coefficients." + name;
@@ -58,6 +87,7 @@ void coefficients(const json& result, Page& page, std::string& out) {
     if (have_truth) row.push_back(num_cell(num(truth)));
     row.push_back(num_cell(fixed(value, d)));
     row.push_back(num_cell(num(std_dev, 2)));
+    row.push_back(num_cell(num(expanded(std_dev), 2)));
     if (have_truth) {
       row.push_back(num_cell(fixed(error, d)));
       row.push_back(num_cell(z ? fmt::format("{:+.2f}", *z) : kDash, z && std::fabs(*z) > 3 ? "far" : ""));
@@ -83,16 +113,45 @@ void coefficients(const json& result, Page& page, std::string& out) {
   }
   std::vector<std::string> header = {"coefficient", "unit"};
   if (have_truth) header.push_back("truth");
-  header.insert(header.end(), {"estimate", "standard uncertainty \xCF\x83"});
+  header.insert(header.end(), {"estimate", "standard uncertainty \xCF\x83", kExpandedHeader});
   if (have_truth)
     header.insert(header.end(), {"estimate \xE2\x88\x92 truth", "(estimate \xE2\x88\x92 truth)/\xCF\x83"});
   header.push_back("identifiable");
   header.insert(header.end(), extra_fields.begin(), extra_fields.end());
   out += table(header, rows);
+  out += kExpandedNote;
+  const bool accelerometer = is_accelerometer(result);
+  if (accelerometer)
+    out +=
+        "<p class=\"note\">The IEEE Std 1293 model: E = K1\xC2\xB7(K0 + a_i + K2\xC2\xB7"
+        "a_i\xC2\xB2 + "
+        "K3\xC2\xB7"
+        "a_i\xC2\xB3 + Kip\xC2\xB7"
+        "a_i\xC2\xB7"
+        "a_p + Kio\xC2\xB7"
+        "a_i\xC2\xB7"
+        "a_o + "
+        "Kpo\xC2\xB7"
+        "a_p\xC2\xB7"
+        "a_o + Kpp\xC2\xB7"
+        "a_p\xC2\xB2 + Koo\xC2\xB7"
+        "a_o\xC2\xB2 + "
+        "delta_p\xC2\xB7"
+        "a_p + delta_o\xC2\xB7"
+        "a_o), a in g. delta_p and delta_o are named for the axis the "
+        "input axis tilts <em>toward</em>; IEEE Std 1293 names a misalignment for the axis it is rotated "
+        "<em>about</em> and writes \xCE\xB4o\xC2\xB7"
+        "a_p \xE2\x88\x92 \xCE\xB4p\xC2\xB7"
+        "a_o: delta_p here is "
+        "IEEE's \xCE\xB4o, delta_o here is \xE2\x88\x92 IEEE's \xCE\xB4p (docs/accelerometer.md).</p>\n";
   if (!have_truth) {
-    out += "<p class=\"note\">The result gives no truth, so no errors are shown.</p>\n";
+    // A real unit has no truth: only a gyro's page, whose results are often simulated, says so.
+    if (!accelerometer) out += "<p class=\"note\">The result gives no truth, so no errors are shown.</p>\n";
     return;
   }
+  out +=
+      "<p class=\"note\">The truth is the values the record was simulated with (its truth_* metadata, or the "
+      "demo's scenario).</p>\n";
   if (!labels.empty()) {
     const ErrorBarChart chart{.labels = labels,
                               .center = center,
@@ -240,30 +299,35 @@ void machine_errors(const json& result, Page&, std::string& out) {
           field != "unit" && field != "configured" && field != "correlations")
         extra_fields.insert(field);
   }
-  // label, unit, configured, estimate, sigma, change, change/sigma, then the fields.
-  check_table_cells(m.size(), 7 + extra_fields.size(), "machine_errors");
+  // label, unit, configured, estimate, sigma, U (k = 2), change, change/sigma, then the fields.
+  check_table_cells(m.size(), 8 + extra_fields.size(), "machine_errors");
   std::vector<std::vector<Cell>> rows;
   std::vector<std::vector<Cell>> correlation_rows;
   for (std::size_t k = 0; k < m.size(); ++k) {
     const std::string where = fmt::format("machine_errors[{}]", k);
     const json& e = m[k];
-    const auto value = number(e, "value", where), std_dev = number(e, "std", where);
+    // A length in um (the radius error to a micron), else in the result's unit.
+    const auto [factor, unit] = shown_unit(string_or(e, "unit"));
+    const auto value = times(number(e, "value", where), factor),
+               std_dev = times(number(e, "std", where), factor);
     const int d = decimals_for(std_dev);
     const std::string label = machine_error_label(e, where);
-    std::vector<Cell> row = {text_cell(label), text_cell(string_or(e, "unit"))};
+    std::vector<Cell> row = {text_cell(label), text_cell(unit)};
     if (any_configured) {
-      const auto configured = number(e, "configured", where);
+      const auto configured = times(number(e, "configured", where), factor);
       std::optional<double> change, z;
       if (configured && value) change = *value - *configured;
       if (change && std_dev && *std_dev > 0) z = *change / *std_dev;
       row.push_back(num_cell(num(configured)));
       row.push_back(num_cell(fixed(value, d)));
       row.push_back(num_cell(num(std_dev, 2)));
+      row.push_back(num_cell(num(expanded(std_dev), 2)));
       row.push_back(num_cell(fixed(change, d)));
       row.push_back(num_cell(z ? fmt::format("{:+.2f}", *z) : kDash, z && std::fabs(*z) > 3 ? "far" : ""));
     } else {
       row.push_back(num_cell(fixed(value, d)));
       row.push_back(num_cell(num(std_dev, 2)));
+      row.push_back(num_cell(num(expanded(std_dev), 2)));
     }
     for (const auto& field : extra_fields) {
       const json* v = find(e, field);
@@ -293,18 +357,27 @@ void machine_errors(const json& result, Page&, std::string& out) {
   std::vector<std::string> header = {"machine error", "unit"};
   if (any_configured)
     header.insert(header.end(),
-                  {"configured", "estimate", "standard uncertainty \xCF\x83",
+                  {"configured", "estimate", "standard uncertainty \xCF\x83", kExpandedHeader,
                    "estimate \xE2\x88\x92 configured", "(estimate \xE2\x88\x92 configured)/\xCF\x83"});
   else
-    header.insert(header.end(), {"estimate", "standard uncertainty \xCF\x83"});
+    header.insert(header.end(), {"estimate", "standard uncertainty \xCF\x83", kExpandedHeader});
   header.insert(header.end(), extra_fields.begin(), extra_fields.end());
+  const bool accelerometer = is_accelerometer(result);
+  out += accelerometer
+             ? "<p class=\"note\">Machine errors estimated from the accelerometer's data together with the "
+               "coefficients (--estimate, docs/self_calibration.md); lengths in \xC2\xB5m. The radius is "
+               "measured as \xCF\x89\xC2\xB2R/g: it is as right as the local gravity (1 ppm of g is "
+               "1 \xC2\xB5m a metre of arm)."
+             : "<p class=\"note\">Machine errors estimated from the gyro data together with the coefficients "
+               "(--estimate, docs/physics.md section 12)";
+  out += accelerometer ? " A" : "; a";
   out +=
-      "<p class=\"note\">Machine errors estimated from the gyro data together with the coefficients "
-      "(--estimate, docs/physics.md section 12); a harmonic's parts are a\xC2\xB7"
+      " harmonic's parts are a\xC2\xB7"
       "cos \xCF\x86 (cos) and a\xC2\xB7sin \xCF\x86 (sin).";
   if (any_configured) out += " A change of more than 3\xCF\x83 from the configured value is shaded.";
   out += "</p>\n";
   out += table(header, rows);
+  out += kExpandedNote;
   if (!correlation_rows.empty()) {
     out += "<h3>Correlations</h3>\n";
     out += table({"machine error", "correlation with the other estimates"}, correlation_rows, "wrap");

@@ -13,6 +13,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "page.hpp"
+#include "section_renderers.hpp"
 #include "sections.hpp"
 
 #ifndef GYROCAL_VERSION
@@ -268,8 +269,17 @@ const PageKind kPages[] = {
     {"noise", "gyrocal noise report", report::noise_sections},
 };
 
+/// An accelerometer's calibration or plan: its own table of sections.
+const PageKind kAccelerometerPages[] = {
+    {"calibration", "gyrocal calibration report", report::accelerometer_result_sections},
+    {"plan", "gyrocal plan report: the predicted calibration", report::accelerometer_result_sections},
+};
+
 const PageKind* page_of(const nlohmann::json& result) {
   const std::string kind = result_kind(result);
+  if (report::section::is_accelerometer(result))
+    for (const PageKind& p : kAccelerometerPages)
+      if (p.kind == kind) return &p;
   for (const PageKind& p : kPages)
     if (p.kind == kind) return &p;
   return nullptr;

@@ -142,26 +142,12 @@ std::string value_text(const json& j) {
 }
 
 std::vector<std::string> ordered_names(const std::set<std::string>& names) {
-  static const std::vector<std::string> canonical = {"dF",
-                                                     "dI",
-                                                     "dO",
-                                                     "dS",
-                                                     "dII",
-                                                     "dOO",
-                                                     "dSS",
-                                                     "dIO",
-                                                     "dIS",
-                                                     "dOS",
-                                                     "scale_factor_error_ppm",
-                                                     "input_axis_misalignment_O_arcsec",
-                                                     "input_axis_misalignment_S_arcsec",
-                                                     "dI_1g",
-                                                     "dO_1g",
-                                                     "dS_1g",
-                                                     "dIS_b",
-                                                     "dII-dSS",
-                                                     "dOO-dSS",
-                                                     "dF+(1+Ar^2)dSS"};
+  static const std::vector<std::string> canonical = {
+      "dF", "dI", "dO", "dS", "dII", "dOO", "dSS", "dIO", "dIS", "dOS", "scale_factor_error_ppm",
+      "input_axis_misalignment_O_arcsec", "input_axis_misalignment_S_arcsec", "dI_1g", "dO_1g", "dS_1g",
+      "dIS_b", "dII-dSS", "dOO-dSS", "dF+(1+Ar^2)dSS",
+      // The accelerometer's, in IEEE Std 1293's table order.
+      "K0", "K1", "K2", "K3", "Kip", "Kio", "Kpo", "Kpp", "Koo", "delta_p", "delta_o"};
   std::vector<std::string> out;
   for (const auto& n : canonical)
     if (names.count(n)) out.push_back(n);

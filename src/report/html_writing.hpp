@@ -52,7 +52,8 @@ std::string scalar_text(const json& j);
 std::string value_text(const json& j);
 
 /// Names in the order of docs/physics.md (the coefficients, the gyro model's scale factor and misalignments,
-/// the closed form's alternatives, the combinations of section 8), then any other names alphabetically.
+/// the closed form's alternatives, the combinations of section 8), then the accelerometer's in IEEE Std
+/// 1293's table order (K0 K1 K2 K3 Kip Kio Kpo Kpp Koo delta_p delta_o), then any other names alphabetically.
 /// nlohmann::json objects are sorted, so the order must be imposed here.
 std::vector<std::string> ordered_names(const std::set<std::string>& names);
 std::vector<std::string> ordered_keys(const json& object);

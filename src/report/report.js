@@ -252,6 +252,13 @@
     return false;
   }
 
+  // Folded parts (<details class="fold">) are opened while the plots are drawn and the tables measured, so
+  // that a plot inside one gets its size and a table inside one is measured as it shows when opened; the
+  // folds closed before are closed again afterwards, and every fold is open on paper.
+  var folds = Array.prototype.slice.call(document.querySelectorAll('details.fold'));
+  var closed = folds.filter(function (d) { return !d.open; });
+  folds.forEach(function (d) { d.open = true; });
+
   var charts = [], rendered = 0;
   specs.forEach(function (s) {
     try {
@@ -278,7 +285,17 @@
   });
   body.setAttribute('data-wide-tables', String(wide));
   body.setAttribute('data-page-overflow', String(document.documentElement.scrollWidth > window.innerWidth));
-  // Charts size themselves to their boxes; the printed page has other boxes.
-  window.addEventListener('beforeprint', function () { charts.forEach(function (c) { c.resize(); }); });
-  window.addEventListener('afterprint', function () { charts.forEach(function (c) { c.resize(); }); });
+  closed.forEach(function (d) { d.open = false; });
+  body.setAttribute('data-folds', String(folds.length));
+  // Charts size themselves to their boxes; the printed page has other boxes, and shows every fold open.
+  var closedForPrint = [];
+  window.addEventListener('beforeprint', function () {
+    closedForPrint = folds.filter(function (d) { return !d.open; });
+    closedForPrint.forEach(function (d) { d.open = true; });
+    charts.forEach(function (c) { c.resize(); });
+  });
+  window.addEventListener('afterprint', function () {
+    closedForPrint.forEach(function (d) { d.open = false; });
+    charts.forEach(function (c) { c.resize(); });
+  });
 })();

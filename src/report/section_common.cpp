@@ -57,6 +57,66 @@ bool has(const json& result, std::string_view key) {
   return find(result, key) != nullptr;
 }
 
+bool is_accelerometer(const json& result) {
+  const json* sensor = find(result, "sensor");
+  return sensor && sensor->is_string() && sensor->get<std::string>() == "accelerometer";
+}
+
+std::string folded(std::string_view summary, const std::string& body) {
+  return "<details class=\"fold\"><summary>" + esc(summary) + "</summary>\n" + body + "</details>\n";
+}
+
+void unit_under_test(const json& result, Page&, std::string& out) {
+  const json* u = find(result, "unit_under_test");
+  if (u) expect(*u, json::value_t::object, "unit_under_test");
+  const json* from = u ? find(*u, "from") : nullptr;
+  if (from) expect(*from, json::value_t::object, "unit_under_test.from");
+  std::string dl;
+  const auto item = [&](std::string_view label, std::string_view value_html, std::string_view key) {
+    std::string where;
+    if (from && !key.empty())
+      if (const std::string f = string_or(*from, key); !f.empty())
+        where = " <span class=\"note\">(" + esc(short_text(f)) + ")</span>";
+    dl += fmt::format("<dt>{}</dt><dd>{}{}</dd>", esc(label), value_html, where);
+  };
+  const auto text = [&](std::string_view key, std::string_view label) {
+    if (u == nullptr) return;
+    if (const json* v = find(*u, key); v && !v->is_null())
+      item(label, esc(short_text(scalar_text(*v), 4096)), key);
+  };
+  text("serial", "Serial number");
+  text("model", "Model");
+  if (const json* sensor = find(result, "sensor"); sensor && sensor->is_string())
+    item("Sensor",
+         esc(sensor->get<std::string>() == "accelerometer" ? "pendulous accelerometer (IEEE Std 1293 model)"
+                                                           : sensor->get<std::string>()),
+         "");
+  text("date", "Date of the test");
+  if (u)
+    if (const json* t = find(*u, "temperature_c"); t && !t->is_null())
+      item("Temperature",
+           esc(num(number(*t, "unit_under_test.temperature_c")) + " \xC2\xB0"
+                                                                  "C"),
+           "temperature_c");
+  text("operator", "Operator");
+  text("notes", "Conditions and notes");
+  if (const json* r = find(result, "record"))
+    item("Record", "<code>" + esc(short_text(scalar_text(*r), 1024)) + "</code>", "");
+  if (const json* m = find(result, kResultMarkerKey); m && m->is_object())
+    item("Calibrated with", esc("gyrocal " + string_or(*m, "version", kDash)), "");
+  out += "<dl class=\"facts\">" + dl + "</dl>\n";
+  const bool stated = u && (find(*u, "serial") || find(*u, "date"));
+  if (!stated)
+    out +=
+        "<p class=\"note\">The unit's serial number or the test's date is not stated: give them in the "
+        "configuration's [unit] section (serial, model, operator, temperature_c, notes) or in the record's "
+        "metadata (<code># unit = SERIAL</code>, <code># date = YYYY-MM-DD</code>; docs/report.md).</p>\n";
+}
+
+bool has_unit_under_test(const json& r) {
+  return has(r, "unit_under_test") || (is_accelerometer(r) && has(r, "coefficients"));
+}
+
 /// Where the result came from: the record, the configuration, the gyrocal that wrote it (its marker,
 /// docs/interface.md) and what it is. The plan has its own section.
 void provenance(const json& result, Page&, std::string& out) {

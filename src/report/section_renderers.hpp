@@ -30,6 +30,20 @@ std::string not_identifiable_notes(const json* not_identifiable, std::string_vie
 /// True when the result holds `key`.
 bool has(const json& result, std::string_view key);
 
+/// True when the result is an accelerometer's (its `sensor` is "accelerometer").
+bool is_accelerometer(const json& result);
+
+/// `body` folded under a line that says what it holds (`summary`, escaped here): a <details> element, closed
+/// on the screen; the page opens every fold to draw its plots, to measure its tables and to print.
+std::string folded(std::string_view summary, const std::string& body);
+
+/// The unit under test (`unit_under_test`: serial, model, operator, date, temperature, notes), the sensor,
+/// the record and the gyrocal that calibrated; for an accelerometer's result without it, what would state it.
+void unit_under_test(const json& result, Page&, std::string& out);
+
+/// True when the result states its unit under test, or is an accelerometer's calibration.
+bool has_unit_under_test(const json& r);
+
 /// Where the result came from: the record, the configuration, the gyrocal that wrote it and what it is.
 void provenance(const json& result, Page&, std::string& out);
 
@@ -40,6 +54,9 @@ bool has_provenance(const json& r);
 
 void summary(const json& result, Page&, std::string& out);
 void test_plan(const json& result, Page& page, std::string& out);
+/// The g-levels, the planned duration and the test's sequence (`test_sequence`), with the measured span of
+/// the dwells when the result has them.
+void test_sequence(const json& result, Page&, std::string& out);
 
 // --- the estimates (estimate_sections.cpp) ---
 
@@ -53,6 +70,9 @@ void machine_errors(const json& result, Page&, std::string& out);
 
 void data_quality(const json& result, Page&, std::string& out);
 void positions(const json& result, Page& page, std::string& out);
+/// An accelerometer's linearity: the residual of each reduced position against its input a_i (g), one series
+/// per beta (`positions` joined with `position_inputs` by index).
+void linearity(const json& result, Page& page, std::string& out);
 
 // --- the studies beyond one calibration (sensitivity_sections.cpp, montecarlo_sections.cpp) ---
 

@@ -32,9 +32,10 @@ seed = 3
 
 def cli_result(text):
     """A result file of the command line as Python returns it: without gyrocal's marker and the command's own
-    provenance (`gyrocal`, `config`, `plan`), which only a file carries (docs/interface.md)."""
+    provenance (`gyrocal`, `config`, `plan`, and what the report states beyond the estimates: `unit_under_test`,
+    `truth`, `test_sequence`, `position_inputs`), which only a file carries (docs/interface.md)."""
     result = json.loads(text)
-    for key in ("gyrocal", "config", "plan"):
+    for key in ("gyrocal", "config", "plan", "unit_under_test", "truth", "test_sequence", "position_inputs"):
         result.pop(key, None)
     return result
 

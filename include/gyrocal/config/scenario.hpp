@@ -16,6 +16,21 @@
 
 namespace gyrocal {
 
+/// [unit]: the unit under test, as a calibration report states it (docs/report.md). Every key optional; an
+/// empty string (or no temperature) = not stated, and the record's metadata (`# unit = ...`) may state it.
+struct UnitUnderTest {
+  std::string serial;                   ///< the unit's serial number
+  std::string model;                    ///< its model or part number
+  std::string operator_name;            ///< [unit] operator: who ran the test
+  std::optional<double> temperature_c;  ///< the test's temperature, deg C
+  std::string notes;                    ///< conditions, warm-up, mounting: a short paragraph
+
+  /// True when no key is stated.
+  bool empty() const {
+    return serial.empty() && model.empty() && operator_name.empty() && !temperature_c && notes.empty();
+  }
+};
+
 struct Scenario {
   Site site;
   CentrifugeGeometry centrifuge;
@@ -50,6 +65,8 @@ struct Scenario {
   /// `calibrate --history` use when the command line names none; empty = gyrocal-history.sqlite in the
   /// current folder. A relative path is taken from the configuration file's folder.
   std::string history_database;
+  /// [unit]: the unit under test (serial, model, operator, temperature, notes), for the report.
+  UnitUnderTest unit;
 
   /// The sensor this scenario describes: the gyro of [gyro], [gyro.noise] and calibration.gyro_model, or the
   /// accelerometer.

@@ -126,6 +126,19 @@ inline constexpr double kGravityUncertaintyMS2 = 1.0;
 /// The Earth rate ([site] earth_rate_rad_s), rad/s: 1.4e4 times the Earth's.
 inline constexpr double kEarthRateRadS = 1.0;
 
+// ---- The unit under test ([unit]; docs/report.md) ----
+
+/// The longest [unit] serial, model and operator, bytes: the same bound as a history serial
+/// (kHistoryUnitBytes): a name or a part number of a few dozen characters, printed on one line of the report.
+inline constexpr std::size_t kUnitTextBytes = 128;
+/// The longest [unit] notes, bytes: a short paragraph (warm-up, mounting, conditions), as a run's note
+/// (kHistoryNoteBytes).
+inline constexpr std::size_t kUnitNotesBytes = 4096;
+/// [unit] temperature_c, deg C: from absolute zero (-273.15, excluded) to 1000; a test chamber holds
+/// -55 to +125, so anything beyond is a typing error (a temperature in K, a value in deg F would still pass).
+inline constexpr double kUnitTemperatureMinC = -273.15;
+inline constexpr double kUnitTemperatureMaxC = 1000.0;
+
 // ---- What a calibration holds of a record ----
 
 /// The most revolutions of gamma a calibration holds, over all the spinning dwells of its test together
