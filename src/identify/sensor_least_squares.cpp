@@ -10,8 +10,6 @@
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
-#include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
@@ -33,7 +31,7 @@ struct SensorCombination {
 
 /// The accelerometer's named degeneracy: at one speed a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position, so
 /// adding c to K2, Kpp, Koo and -(1 + Ar^2) c to K0 changes no output. What remains estimable: K2 - Kpp,
-/// K2 - Koo and K0 + (1 + Ar^2) K2. Used under these names only where they are the estimable ones.
+/// K2 - Koo and K0 + (1 + Ar^2) K2.
 std::vector<SensorCombination> accelerometer_combinations(double ar) {
   const auto at = [](AccelCoefficient c) { return static_cast<std::size_t>(c); };
   std::vector<SensorCombination> out;
@@ -47,187 +45,6 @@ std::vector<SensorCombination> accelerometer_combinations(double ar) {
   add(fmt::format("K0 + {:.6g} K2", 1.0 + ar * ar),
       {{AccelCoefficient::K0, 1.0}, {AccelCoefficient::K2, 1.0 + ar * ar}});
   out.back().unit = "ug";
-  return out;
-}
-
-/// The fit of the whole column space of a (whitened) design: its residuals leave nothing of the data that any
-/// combination of the columns explains, and its degrees of freedom are the rows less that space's rank,
-/// judged on equilibrated columns with the solver's own rounding-level tolerance.
-struct ColumnSpaceFit {
-  Eigen::VectorXd x;  ///< a solution, in the columns' units
-  double chi2 = 0.0;  ///< sum of the squared residuals
-  int dof = 0;        ///< rows - rank
-};
-
-ColumnSpaceFit column_space_fit(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
-  Eigen::VectorXd scale = Eigen::VectorXd::Ones(a.cols());
-  Eigen::MatrixXd s = a;
-  for (Eigen::Index j = 0; j < a.cols(); ++j) {
-    const double norm = a.col(j).norm();
-    if (norm > 0.0) scale[j] = 1.0 / norm;
-    s.col(j) *= scale[j];
-  }
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s);
-  qr.setThreshold(LeastSquaresOptions{}.rank_tolerance);
-  const Eigen::VectorXd xs = qr.solve(b);
-  ColumnSpaceFit out;
-  out.x = scale.cwiseProduct(xs);
-  out.chi2 = (b - s * xs).squaredNorm();
-  out.dof = static_cast<int>(a.rows() - qr.rank());
-  return out;
-}
-
-/// An accelerometer's unidentifiable direction (its products' units) in the coefficients' own: the others in
-/// ug, ug/g^n or urad (a product K1*Kx moves as Kx at K1 fixed), K1 in ppm of itself, so that "+1 K0 +1 Kio
-/// -1 delta_o -1 ppm of K1" reads as what it is: adding 1 ug to K0 and Kio, taking 1 urad from delta_o and 1
-/// ppm from K1 changes no output. Parts below 1e-3 of the largest are left out.
-std::string describe_accelerometer_direction(const Eigen::VectorXd& dir, double k1,
-                                             const std::vector<std::string>& names) {
-  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
-  const auto nc = static_cast<Eigen::Index>(kNumAccelCoefficients);
-  Eigen::VectorXd w = dir;
-  for (Eigen::Index j = 0; j < std::min(nc, w.size()); ++j)
-    w[j] = j == scale_at ? dir[j] / k1 * 1e6 : dir[j] / k1;
-  const double largest = w.cwiseAbs().maxCoeff();
-  if (largest > 0.0) w /= largest;
-  std::string out;
-  const auto K = [](AccelCoefficient c) { return static_cast<Eigen::Index>(c); };
-  std::vector<Eigen::Index> order;
-  for (Eigen::Index j = 0; j < w.size(); ++j)
-    if (j != scale_at) order.push_back(j);
-  order.push_back(scale_at);
-  for (Eigen::Index j : order) {
-    if (!(std::abs(w[j]) >= 1e-3)) continue;
-    out += fmt::format("{}{}{:.4g} {}{}", out.empty() ? "" : " ", w[j] < 0 ? '-' : '+', std::abs(w[j]),
-                       j == scale_at ? "ppm of " : "", names[static_cast<std::size_t>(j)]);
-  }
-  // The one-speed direction, as docs/accelerometer.md writes it.
-  if (w.size() >= nc && std::abs(w[K(AccelCoefficient::K2)]) >= 1e-3 &&
-      std::abs(w[K(AccelCoefficient::Kpp)]) >= 1e-3 && std::abs(w[K(AccelCoefficient::Koo)]) >= 1e-3 &&
-      std::abs(w[K(AccelCoefficient::K0)]) >= 1e-3)
-    return fmt::format(
-        "K0, K2, Kpp, Koo: adding c to K2, Kpp and Koo and {:.6g} c to K0 changes no output (at one speed "
-        "a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position; direction {})",
-        w[K(AccelCoefficient::K0)] / w[K(AccelCoefficient::K2)], out);
-  return out;
-}
-
-/// An estimable combination of an accelerometer's products: weights c on the products u (c'u, in output
-/// units per g when it holds K1; otherwise read as c'u / K1 in the unit of its first coefficient).
-struct EstimableCombination {
-  std::string name, unit;
-  Eigen::VectorXd weights;
-};
-
-/// The name of a combination: "K0 + delta_o", "K2 - 0.5 Kpp", or with K1 "K1 (1 - 1e-6 delta_o)" (weights
-/// below 1e-4 of the largest left out of the name, and a weight within 1e-4 of 1 written as 1: the exact
-/// chain's tilt of the null direction, ~1e-5, is in the value and the weights, not in the name).
-std::string combination_name(const Eigen::VectorXd& c, const std::vector<std::string>& names) {
-  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
-  const bool with_scale = c[scale_at] != 0.0;
-  Eigen::VectorXd w = c;
-  if (with_scale) {
-    w /= c[scale_at];
-    w *= 1e6;
-    w[scale_at] = 0.0;
-  }
-  const double largest = std::max(with_scale ? 1.0 : 0.0, w.cwiseAbs().maxCoeff());
-  std::string terms;
-  for (Eigen::Index j = 0; j < w.size(); ++j) {
-    if (!(std::abs(w[j]) >= 1e-4 * largest)) continue;
-    const double a = std::abs(w[j]);
-    const std::string weight = with_scale                 ? fmt::format("{:.4g}e-6 ", a)
-                               : std::abs(a - 1.0) < 1e-4 ? ""
-                                                          : fmt::format("{:.6g} ", a);
-    if (terms.empty() && !with_scale)
-      terms = fmt::format("{}{}{}", w[j] < 0 ? "-" : "", weight, names[static_cast<std::size_t>(j)]);
-    else
-      terms += fmt::format(" {} {}{}", w[j] < 0 ? '-' : '+', weight, names[static_cast<std::size_t>(j)]);
-  }
-  return with_scale ? fmt::format("{} (1{})", names[static_cast<std::size_t>(scale_at)], terms) : terms;
-}
-
-/// The estimable combinations of the accelerometer's products that are not identifiable on their own
-/// (the first nc unknowns), computed from the null space for any plan: docs/accelerometer.md's one-speed
-/// names where the estimable combination IS the named one, the rest of the estimable space in reduced row
-/// echelon form with K1 first (so that it appears in one combination at most), then the table's order.
-std::vector<EstimableCombination> estimable_combinations(const LeastSquaresSolution& sol,
-                                                         const LeastSquaresOptions& lso, double ar,
-                                                         Eigen::Index nc) {
-  std::vector<EstimableCombination> out;
-  const Eigen::Index n = sol.null_space.rows();
-  const Eigen::MatrixXd& ns = sol.scaled_null_space;
-  const Eigen::VectorXd& d = sol.column_scales;
-  std::vector<Eigen::Index> unidentified;
-  for (Eigen::Index j = 0; j < nc; ++j)
-    if (!sol.identifiable[static_cast<std::size_t>(j)]) unidentified.push_back(j);
-  const auto nj = static_cast<Eigen::Index>(unidentified.size());
-  if (nj == 0) return out;
-  Eigen::MatrixXd null_j(nj, ns.cols());
-  for (Eigen::Index a = 0; a < nj; ++a) null_j.row(a) = ns.row(unidentified[static_cast<std::size_t>(a)]);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd_j(null_j, Eigen::ComputeFullU);
-  Eigen::Index rank_j = 0;
-  for (Eigen::Index k = 0; k < svd_j.singularValues().size(); ++k)
-    if (svd_j.singularValues()[k] > 1e-6) ++rank_j;
-  const Eigen::Index estimable_dim = nj - rank_j;
-  if (estimable_dim <= 0) return out;
-  std::vector<std::string> names;
-  for (Eigen::Index j = 0; j < n; ++j)
-    names.push_back(j < nc ? std::string(kAccelerometerParameters[static_cast<std::size_t>(j)].name)
-                           : sol.names[static_cast<std::size_t>(j)]);
-
-  std::vector<Eigen::VectorXd> chosen;  // accepted combinations, equilibrated coordinates
-  const auto in_span = [&chosen](const Eigen::VectorXd& z) {
-    if (chosen.empty()) return false;
-    Eigen::MatrixXd basis(z.size(), static_cast<Eigen::Index>(chosen.size()));
-    for (std::size_t k = 0; k < chosen.size(); ++k) basis.col(static_cast<Eigen::Index>(k)) = chosen[k];
-    const Eigen::VectorXd fit = basis * basis.colPivHouseholderQr().solve(z);
-    return (z - fit).norm() <= 1e-3 * z.norm();
-  };
-  LeastSquaresOptions loose = lso;
-  loose.estimable_tolerance = std::max(loose.estimable_tolerance, 1e-6);
-  const auto add = [&](std::string name, std::string unit, const Eigen::VectorXd& scaled) {
-    // Exactly estimable: its (tiny) part along the unidentifiable directions removed.
-    const Eigen::VectorXd kept = scaled - ns * (ns.transpose() * scaled);
-    const Eigen::VectorXd c = kept.cwiseQuotient(d);
-    if (!evaluate_combination(sol, c, loose).identifiable) return;
-    if (name.empty()) name = combination_name(c, names);
-    out.push_back({std::move(name), std::move(unit), c});
-    chosen.push_back(kept);
-  };
-  for (const SensorCombination& named : accelerometer_combinations(ar)) {
-    Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
-    bool touches_unidentified = false;
-    for (Eigen::Index j = 0; j < nc; ++j) {
-      c[j] = named.weights[static_cast<std::size_t>(j)];
-      touches_unidentified |= c[j] != 0.0 && !sol.identifiable[static_cast<std::size_t>(j)];
-    }
-    if (!touches_unidentified) continue;
-    const Eigen::VectorXd scaled = c.cwiseProduct(d);
-    if ((ns.transpose() * scaled).norm() <= 1e-4 * scaled.norm() && !in_span(scaled))
-      add(named.name, named.unit, scaled);
-  }
-  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(estimable_dim, n);
-  for (Eigen::Index k = 0; k < estimable_dim; ++k)
-    for (Eigen::Index a = 0; a < nj; ++a)
-      basis(k, unidentified[static_cast<std::size_t>(a)]) = svd_j.matrixU()(a, rank_j + k);
-  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
-  std::vector<Eigen::Index> order = {scale_at};
-  for (Eigen::Index j = 0; j < n; ++j)
-    if (j != scale_at) order.push_back(j);
-  const Eigen::MatrixXd rows = reduced_row_echelon(basis, order, 1e-4);
-  for (Eigen::Index k = 0; k < rows.rows() && static_cast<Eigen::Index>(chosen.size()) < estimable_dim; ++k) {
-    const Eigen::VectorXd z = rows.row(k).transpose();
-    if (in_span(z)) continue;
-    Eigen::Index pivot = 0;
-    for (Eigen::Index j : order)
-      if (std::abs(z[j]) >= 0.5) {
-        pivot = j;
-        break;
-      }
-    // In parameter units with the pivot's weight 1: c = z / D, scaled back so that c[pivot] = 1.
-    add({}, std::string(kAccelerometerParameters[static_cast<std::size_t>(pivot)].unit), z * d[pivot]);
-  }
   return out;
 }
 
@@ -252,7 +69,7 @@ Sensor sensor_of(SensorKind kind) {
 /// products.
 void sensor_least_squares(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                           const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
-                          ErrorColumnsSolution* extra_solution, const CentrifugeModel* model) {
+                          ErrorColumnsSolution* extra_solution) {
   const Sensor sensor = sensor_of(options.sensor);
   const std::vector<std::string_view> unknown_names =
       std::visit([](const auto& s) { return s.unknown_names(); }, sensor);
@@ -402,82 +219,71 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
                  student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
     }
   }
-  // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
-  // data's part along it (the truth's component there times the design's small singular value, or any part
-  // a near-dependency of the exact chain still carries) would stay in the residuals and read as a misfit of
-  // a correct record. The residuals are those of the whole column space instead, and chi2 has as many
-  // degrees of freedom as the positions less that space's rank.
-  Eigen::VectorXd fitted = sol.estimate;
-  if (sol.null_space.cols() > 0) {
-    const ColumnSpaceFit full = column_space_fit(problem.design, problem.observations);
-    fitted = full.x;
-    r.chi2 = full.chi2;
-    r.dof = full.dof;
-  }
-  const Eigen::VectorXd residuals = observations - design * fitted;
+  const Eigen::VectorXd residuals = observations - design * sol.estimate;
   r.residuals_deg_h.assign(residuals.data(), residuals.data() + residuals.size());
   for (const std::string& w : sol.warnings) {
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
       continue;
-    if (sol.null_space.cols() > 0 && w.rfind("chi2 = ", 0) == 0) continue;  // the truncated fit's
     r.warnings.push_back("least squares: " + w);
   }
   if (sol.null_space.cols() == 0) return;
+  // The unidentifiable directions in the coefficients' names (a product K1*Kx moves as Kx at K1 fixed).
   std::vector<std::string> coefficient_names;
   for (Eigen::Index j = 0; j < nc; ++j)
     coefficient_names.emplace_back(table[static_cast<std::size_t>(j)].name);
   coefficient_names.insert(coefficient_names.end(), extra.names.begin(), extra.names.end());
-  const bool accelerometer = options.sensor == SensorKind::kAccelerometer;
-  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
-  const double k1v = accelerometer ? u[scale_at] : 1.0;
   std::string listed;
   for (Eigen::Index d = 0; d < sol.null_space.cols(); ++d) {
-    const std::string text =
-        accelerometer ? describe_accelerometer_direction(sol.null_space.col(d), k1v, coefficient_names)
-                      : describe_combination(sol.null_space.col(d), coefficient_names);
+    Eigen::VectorXd dir = sol.null_space.col(d);
+    const double largest = dir.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < dir.size(); ++i)
+      if (std::abs(dir[i]) < 1e-3 * largest) dir[i] = 0.0;
+    // The accelerometer's one-speed direction, written as docs/accelerometer.md writes it.
+    const auto K = [](AccelCoefficient c) { return static_cast<Eigen::Index>(c); };
+    std::string text;
+    if (options.sensor == SensorKind::kAccelerometer && dir[K(AccelCoefficient::K2)] != 0.0 &&
+        dir[K(AccelCoefficient::Kpp)] != 0.0 && dir[K(AccelCoefficient::Koo)] != 0.0 &&
+        dir[K(AccelCoefficient::K0)] != 0.0) {
+      const double s = 1.0 / dir[K(AccelCoefficient::K2)];
+      text = fmt::format(
+          "K0, K2, Kpp, Koo: adding c to K2, Kpp and Koo and {:.6g} c to K0 changes no output (at one speed "
+          "a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position; direction {})",
+          dir[K(AccelCoefficient::K0)] * s, describe_combination(dir, coefficient_names));
+    } else {
+      text = describe_combination(dir, coefficient_names);
+    }
     r.unidentifiable.push_back(text);
     listed += fmt::format("{}({}) {}", d ? "; " : "", d + 1, text);
   }
-  // What remains estimable of the coefficients that are not identifiable on their own, by name, with its
-  // value and std (delta method as the coefficients').
-  if (accelerometer) {
-    for (const EstimableCombination& c : estimable_combinations(sol, lso, r.g_level, nc)) {
-      const IdentifiableCombination ic = evaluate_combination(sol, c.weights, lso, c.name);
-      if (!ic.identifiable) continue;
+  // What remains estimable, by name, with its value and std (delta method as the coefficients').
+  if (options.sensor == SensorKind::kAccelerometer) {
+    const Eigen::Index k1 = static_cast<Eigen::Index>(AccelCoefficient::K1);
+    for (const SensorCombination& c : accelerometer_combinations(r.g_level)) {
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+      for (Eigen::Index j = 0; j < nc; ++j) g[j] = c.weights[static_cast<std::size_t>(j)];
+      const IdentifiableCombination ic = evaluate_combination(sol, g, lso, c.name);
+      if (!ic.identifiable || !sol.identifiable[static_cast<std::size_t>(k1)]) continue;
+      // c'K = (g'u) / K1: J = g / K1 - (g'u) / K1^2 e_K1.
+      const double k1v = u[k1];
+      Eigen::VectorXd jrow = g / k1v;
+      jrow[k1] -= ic.value / (k1v * k1v);
       NamedEstimate ne;
       ne.name = c.name;
       ne.unit = c.unit;
-      Eigen::VectorXd jrow = c.weights;
-      if (c.weights[scale_at] != 0.0) {
-        ne.value = ic.value;  // K1 (1 + ...): a scale, in output units per g
-      } else {
-        // c'K = (c'u) / K1: J = c / K1 - (c'u) / K1^2 e_K1 (K1 the estimate's, an estimable scale).
-        jrow = c.weights / k1v;
-        jrow[scale_at] -= ic.value / (k1v * k1v);
-        ne.value = ic.value / k1v;
-      }
+      ne.value = ic.value / k1v;
       ne.std = std::sqrt(jrow.dot(sandwich * jrow)) * student(jrow, c.name);
-      ne.coefficients.assign(c.weights.data(), c.weights.data() + nc);
+      ne.coefficients = c.weights;
       r.combinations.push_back(std::move(ne));
     }
-  }
-  std::string advice;
-  if (model != nullptr) {
-    const Sensor regressor_sensor = sensor;
-    advice = sensor_identifiability_advice(
-        sol.null_space.topRows(nc), reduction.positions, *model, [&](const Eigen::Vector3d& f) {
-          GyroInputs in;
-          in.specific_force_g = f;
-          const DesignRow row = std::visit([&](const auto& s) { return s.design_row(in); }, regressor_sensor);
-          Eigen::VectorXd x(nc);
-          for (Eigen::Index j = 0; j < nc; ++j) x[j] = row.regressors[static_cast<std::size_t>(j)];
-          return x;
-        });
   }
   const auto k = sol.null_space.cols();
   r.warnings.push_back(fmt::format(
       "{} direction{} of the coefficients cannot be identified from this plan: {}.{}", k, k > 1 ? "s" : "",
-      listed, advice.empty() ? "" : " " + advice + " (docs/calibration.md, \"Identifiability\")"));
+      listed,
+      options.sensor == SensorKind::kAccelerometer
+          ? " A second non-zero speed or a static set (the main axis stopped, the platform indexed to each "
+            "gamma) separates them (docs/accelerometer.md)."
+          : ""));
 }
 
 }  // namespace gyrocal::identify_detail

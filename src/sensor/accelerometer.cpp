@@ -108,10 +108,7 @@ ParameterEstimates Accelerometer::from_products(const Eigen::VectorXd& u, const 
     values(k) = u(k) / k1;
     jacobian(k, k) = 1.0 / k1;
     jacobian(k, s) = -values(k) / k1;
-    // A ratio is identifiable with its product: when K1 is not (a plan without a beta reversal), the
-    // estimate's K1 is the minimum-norm one, itself an estimable scale that differs from K1 by ppm per ug of
-    // the unidentifiable direction, so Kx is stated to that (second-order) relative precision.
-    ok[k] = identifiable[k];
+    ok[k] = identifiable[k] && identifiable[kScale];
   }
   return propagate(std::move(values), jacobian, covariance, std::move(ok));
 }

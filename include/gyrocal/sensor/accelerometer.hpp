@@ -107,9 +107,7 @@ struct Accelerometer {
   double output(const GyroInputs& inputs) const;
   /// known 0; regressors accelerometer_regressors(f): E = sum_j r_j u_j with u = (K1 K0, K1, K1 K2, ...).
   DesignRow design_row(const GyroInputs& inputs) const;
-  /// K1 = u_1, Kx = u_x / u_1; J: dKx/du_x = 1/K1, dKx/dK1 = -Kx/K1. Kx is identifiable when u_x is
-  /// (docs/calibration.md, "Identifiability": divided by the estimate's K1, an estimable scale, when K1
-  /// itself is not).
+  /// K1 = u_1, Kx = u_x / u_1; J: dKx/du_x = 1/K1, dKx/dK1 = -Kx/K1. Kx is identifiable when u_x and K1 are.
   ParameterEstimates from_products(const Eigen::VectorXd& products, const Eigen::MatrixXd& covariance,
                                    const std::vector<bool>& identifiable) const;
   /// The products of these coefficients (K1 K0, K1, K1 K2, ...): what a noise-free calibration recovers.

@@ -1,0 +1,137 @@
+// The local gravity: an accelerometer's specific force is read in the local g, so the radius it measures is
+// omega^2 R / g (docs/calibration.md, "The radius is measured against gravity"; docs/montecarlo.md,
+// "Gravity"): [uncertainty] gravity_m_s2 is read and bounded, its Monte Carlo effect is the hand formula
+// R0 u_g / g0 on the radius and none on K1, and a calibration that estimates the radius states the gravity
+// it assumed.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "gyrocal/analysis/montecarlo.hpp"
+#include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/config/config_io.hpp"
+#include "gyrocal/config/scenario.hpp"
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/model/machine_errors.hpp"
+#include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/simulate/simulator.hpp"
+
+namespace gyrocal {
+namespace {
+
+/// A small accelerometer test on the given beta: static holds, 6 and 12 rad/s, the default truth and machine
+/// errors of [accelerometer] and [centrifuge.errors] (the exact chain tilts each null direction slightly),
+/// few revolutions at 50 Hz so that a record is simulated, reduced and identified in well under a second.
+Scenario small_test(double beta0, double beta1) {
+  Scenario s = default_scenario();
+  s.sensor_kind = SensorKind::kAccelerometer;
+  s.accelerometer = Accelerometer{};
+  s.test.rates_rad_s = {0.0, 6.0, 12.0};
+  s.centrifuge.rate_rad_s = 6.0;
+  s.test.beta_deg = {beta0, beta1};
+  s.test.revolutions = 8;
+  s.test.sample_rate_hz = 50.0;
+  s.test.settle_s = 2.0;
+  s.test.static_hold_s = 2.0;
+  return s;
+}
+
+Reduction simulate_and_reduce(const Scenario& truth, std::uint64_t seed) {
+  const ReduceOptions ro;
+  Reducer reducer(reduction_plan(truth.test, SensorKind::kAccelerometer, ro), ro, "simulated",
+                  truth.centrifuge.rate_rad_s);
+  SimulationOptions so;
+  so.seed = seed;
+  simulate(truth, so, [&](const RecordSample& sample) { reducer.push(sample); });
+  return reducer.finish();
+}
+
+CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
+                            CalibrationOptions o = CalibrationOptions{}) {
+  o.sensor = SensorKind::kAccelerometer;
+  const CentrifugeModel model = config.model();
+  return identify(reduction, reduce_sensor_channels(reduction, model, o.reduce, config.sensor()), model, o);
+}
+
+std::string all_warnings(const CalibrationResult& r) {
+  std::string out;
+  for (const std::string& w : r.warnings) out += w + "\n";
+  return out;
+}
+
+TEST(AccelerometerGravity, UncertaintyKeyIsReadWrittenAndBounded) {
+  Scenario s = small_test(0.0, 90.0);
+  s.gravity_uncertainty_m_s2 = 2.5e-5;
+  const Scenario back = parse_scenario(scenario_to_toml(s), "round trip");
+  EXPECT_EQ(back.gravity_uncertainty_m_s2, 2.5e-5);
+  for (const char* bad : {"-1e-5", "2.0"}) {
+    try {
+      (void)parse_scenario(std::string("[uncertainty]\ngravity_m_s2 = ") + bad + "\n", "g.toml");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("uncertainty.gravity_m_s2"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("g.toml"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(AccelerometerGravity, ItsUncertaintyMovesTheRadiusByR0UgOverGAndNotK1) {
+  // The specific force is in the local g: the centripetal level is omega^2 R / g, so a true gravity g0 + u
+  // reads as a radius R0 g0 / (g0 + u): a radius error of -R0 u / g0 to first order, while K1 (fixed by the
+  // +-1 g of gravity itself) does not move. Hand formula: sigma(dR) = R0 u_g / g0 (1 um at 1 m per ppm).
+  Scenario s = small_test(0.0, 90.0);
+  s.test.beta_deg = {0.0, 90.0, 180.0, 270.0};
+  const double g0 = s.site.gravity_m_s2;
+  const double r0 = s.centrifuge.radius_m;
+  s.gravity_uncertainty_m_s2 = 3e-6 * g0;  // 3 ppm
+  MonteCarloOptions mo;
+  mo.threads = 1;
+  mo.calibration.sensor = SensorKind::kAccelerometer;
+  mo.calibration.estimate = parse_machine_error_names({"radius_error"}, "test");
+  const MonteCarloModel m = prepare_monte_carlo(s, mo);
+  ASSERT_EQ(m.sources.size(), 1u);
+  EXPECT_TRUE(m.sources[0].gravity);
+  EXPECT_EQ(m.sources[0].term.label(), "gravity");
+  const std::size_t nc = m.columns();
+  double radius = std::nan(""), k1 = std::nan(""), k1_noise = 0.0;
+  for (std::size_t i = 0; i < m.names.size(); ++i) {
+    const double effect = m.gain[i * nc];  // the gravity source's column: its effect at one std
+    if (m.names[i].rfind("radius_error", 0) == 0) radius = effect;
+    if (m.names[i] == "K1") {
+      k1 = effect;
+      for (std::size_t c = 1; c < nc; ++c) k1_noise += m.gain[i * nc + c] * m.gain[i * nc + c];
+    }
+  }
+  const double expected = r0 * s.gravity_uncertainty_m_s2 / g0;  // 3e-6 R0
+  EXPECT_NEAR(std::abs(radius), expected, 0.01 * expected) << radius;
+  EXPECT_LT(radius, 0.0);  // a larger g reads as a shorter arm
+  ASSERT_TRUE(std::isfinite(k1));
+  EXPECT_LT(std::abs(k1), 0.01 * std::sqrt(k1_noise)) << k1 << " against the noise's " << std::sqrt(k1_noise);
+}
+
+TEST(AccelerometerGravity, EstimatingTheRadiusStatesTheGravityAssumed) {
+  Scenario s = small_test(0.0, 90.0);
+  s.test.beta_deg = {0.0, 90.0, 180.0, 270.0};
+  s.site.gravity_m_s2 = 9.8012;
+  CalibrationOptions o;
+  o.estimate = parse_machine_error_names({"radius_error"}, "test");
+  const CalibrationResult r = calibrate(s, simulate_and_reduce(s, 3), o);
+  const std::string w = all_warnings(r);
+  EXPECT_NE(w.find("omega^2 R / g"), std::string::npos) << w;
+  EXPECT_NE(w.find("g = 9.8012 m/s^2"), std::string::npos) << w;
+  // 1 ppm of g is 1 ppm of R0: at the default R0 of 1 m, 1 um.
+  EXPECT_NE(w.find(fmt::format("{:.3g} um at R0 = {:g} m", s.centrifuge.radius_m, s.centrifuge.radius_m)),
+            std::string::npos)
+      << w;
+  const CalibrationResult plain = calibrate(s, simulate_and_reduce(s, 3));
+  EXPECT_EQ(all_warnings(plain).find("omega^2 R / g"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gyrocal
