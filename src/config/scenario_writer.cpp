@@ -174,8 +174,8 @@ void write_numbers(TomlWriter& writer, const NumberKey<S> (&keys)[N], const S& s
   }
 }
 
-/// The keys of the machine-error table that `keys` holds, with their values in `errors` and the comments in the
-/// sensor's words.
+/// The keys of the machine-error table that `keys` holds, with their values in `errors` and the comments in
+/// the sensor's words.
 void write_errors(TomlWriter& writer, const CentrifugeErrors& errors, ErrorKeys keys, SensorKind kind) {
   for (const ErrorKey& key : error_keys()) {
     if (!holds(keys, *key.field)) continue;
