@@ -48,7 +48,9 @@ class Messages : public ::testing::Test {
     for (const auto& [key, value] : set) {
       const std::regex line("(^|\n)" + key + " = [^\n]*");
       EXPECT_TRUE(std::regex_search(text, line)) << key;
-      text = std::regex_replace(text, line, "$1" + key + " = " + value);
+      // The first line of the key: the section it is read from ([site] gravity_m_s2, not [uncertainty]'s).
+      text =
+          std::regex_replace(text, line, "$1" + key + " = " + value, std::regex_constants::format_first_only);
     }
     std::ofstream(path(name)) << text;
     return path(name).string();

@@ -385,11 +385,12 @@ TEST(ReportBounds, EveryTableOfTheReportIsBounded) {
     json r = result_with_coefficients(1000);
     std::size_t i = 0;
     for (auto& [name, e] : r["coefficients"].items()) e["f" + std::to_string(i++)] = 1;
-    expect_table_refused(r, "coefficients would be a table of 1000 rows \xC3\x97 1008 columns");
+    // 1000 extra keys beside the table's nine columns (the expanded uncertainty U, k = 2, among them).
+    expect_table_refused(r, "coefficients would be a table of 1000 rows \xC3\x97 1009 columns");
   }
   {
     json r = {{"machine_errors", cycling_entries(1000, 1000, "f", {{"error", "x"}, {"value", 1}})}};
-    expect_table_refused(r, "machine_errors would be a table of 1000 rows \xC3\x97 1007 columns");
+    expect_table_refused(r, "machine_errors would be a table of 1000 rows \xC3\x97 1008 columns");
   }
   {
     json r = {{"comparison", json::array()}};

@@ -108,8 +108,8 @@ void register_plan(CLI::App& app) {
       "NAME:N for a harmonic; docs/self_calibration.md); overrides [calibration] estimate");
   sub->add_option(
          "--reduction", opt->reduction,
-         "harmonic (harmonic fit in gamma with drift) or window (mean around each gamma), as calibrate "
-         "reduces the record; default: [calibration] reduction, else harmonic")
+         "harmonic (harmonic fit in gamma with a linear trend in time) or window (mean around each gamma), "
+         "as calibrate reduces the record; default: [calibration] reduction, else harmonic")
       ->check(CLI::IsMember({"harmonic", "window"}));
   add_gyro_model_option(sub, opt->gyro_model);
   sub->add_option("--json", opt->json, "Write the prediction as JSON to FILE ('-' = standard output)");

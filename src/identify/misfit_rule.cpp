@@ -83,7 +83,8 @@ std::string accelerometer_scale_key(const OutputConfiguration& output) {
 
 /// An accelerometer's radius (and so the local gravity: the centrifuge's input is omega^2 R / g) refitted:
 /// the radius error estimated with the coefficients. Refuses the calibration naming both when that fit is
-/// consistent. Not tried when --estimate already holds radius_error.
+/// consistent and the radius it finds is off the configured one by more than 3 sigma. Not tried when
+/// --estimate already holds radius_error.
 void refuse_radius_or_gravity(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                               const CentrifugeModel& model, const CalibrationOptions& options, double g_level,
                               double noise_free, const std::string& stated) {
@@ -108,6 +109,9 @@ void refuse_radius_or_gravity(const Reduction& reduction, const std::vector<Posi
     if (e.error != "radius_error" || !e.identifiable) continue;
     const double r0 = model.geometry().radius_m + model.errors().radius_error_m;  // as configured
     const double dr = e.value - e.configured;                                     // m
+    // A radius within 3 sigma of the configured one is not what the misfit was: the refit was consistent
+    // through the errors --estimate already holds (tried before they are estimated, e.g. an output delay).
+    if (!(std::abs(dr) > 3.0 * e.std)) return;
     const double g0 = model.site().gravity_m_s2;
     throw Error(fmt::format(
         "calibration refused: {}. The data fit a radius error: estimated with the coefficients, the arm is "

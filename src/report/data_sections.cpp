@@ -25,6 +25,12 @@ std::optional<double> times_million(std::optional<double> v) {
   return *v * 1e6;
 }
 
+/// A reduced position's `key` (mean, std_err, residual: any sensor's, in its output unit), else the gyro's
+/// `key_deg_h` of a result written before those keys existed.
+std::optional<double> position_value(const json& q, const std::string& key, const std::string& where) {
+  return find(q, key) != nullptr ? number(q, key, where) : number(q, key + "_deg_h", where);
+}
+
 /// The dwells' table of data_quality.dwells (calibration_to_json): one row per dwell in time order, its
 /// columns in the order a reader follows a dwell (what was planned, what was measured, what was dropped and
 /// why it ended), the `dropped` object spread into one column per reason; any field a later gyrocal adds
@@ -185,13 +191,9 @@ void positions(const json& result, Page& page, std::string& out) {
     const std::string where = fmt::format("positions[{}]", k);
     expect(p[k], json::value_t::object, where);
     const json& q = p[k];
-    // The keys of any sensor (mean, std_err, residual), else a gyro's result of an earlier version's.
-    const auto either = [&](const char* key, const char* earlier) {
-      return find(q, key) != nullptr ? number(q, key, where) : number(q, earlier, where);
-    };
-    const auto index = number(q, "index", where), residual = scaled(either("residual", "residual_deg_h")),
-               std_err = scaled(either("std_err", "std_err_deg_h")),
-               mean = scaled(either("mean", "mean_deg_h"));
+    const auto index = number(q, "index", where), residual = scaled(position_value(q, "residual", where)),
+               std_err = scaled(position_value(q, "std_err", where)),
+               mean = scaled(position_value(q, "mean", where));
     const int d = decimals_for(std_err);
     rows.push_back({num_cell(num(index)), num_cell(num(number(q, "beta_deg", where))),
                     num_cell(num(number(q, "gamma_deg", where))),
@@ -262,8 +264,8 @@ void linearity(const json& result, Page& page, std::string& out) {
     const std::string where = fmt::format("positions[{}]", k);
     expect(p[k], json::value_t::object, where);
     const auto index = number(p[k], "index", where), beta = number(p[k], "beta_deg", where);
-    const auto residual = number(p[k], "residual_deg_h", where),
-               std_err = number(p[k], "std_err_deg_h", where);
+    const auto residual = position_value(p[k], "residual", where),
+               std_err = position_value(p[k], "std_err", where);
     if (!index || !beta || !residual) continue;
     const auto a = a_i.find(*index);
     if (a == a_i.end()) continue;
