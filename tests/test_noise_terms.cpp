@@ -145,7 +145,9 @@ TEST(NoiseCharacterisation, RecoversWhiteNoiseAndRateRandomWalk) {
   noise.angle_random_walk_deg_rt_h = 0.01;  // sigma = 0.6 deg/h at 1 s
   noise.rate_random_walk_deg_h_rt_h = 1.0;  // crosses the white noise at tau = 3 * 3600 * N / K = 108 s
   const double fs = 20.0;
-  const int runs = sanitized() ? 10 : 40;
+  // 40 runs under the sanitizers too (0.2 s for 10 there): the rms of 10 z-scores spreads by 1/sqrt(20) =
+  // 0.22, too much for the band below (0.44 with the noise fit's quantization rule of issue 28).
+  const int runs = 40;
   std::vector<double> z_n, z_k;
   for (int run = 0; run < runs; ++run) {
     const NoiseCharacterisation c = characterise_noise(
