@@ -133,7 +133,7 @@ py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double
   {
     py::gil_scoped_release release;
     for (py::ssize_t i = 0; i < n; ++i) {
-      const GyroInputs in = exact_inputs(model, spinning_joint_state(model, rate, beta, t[i]));
+      const SensorInputs in = exact_inputs(model, spinning_joint_state(model, rate, beta, t[i]));
       for (int k = 0; k < 3; ++k) {
         w[3 * i + k] = in.rate_rad_s[k];
         f[3 * i + k] = in.specific_force_g[k];

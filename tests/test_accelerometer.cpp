@@ -131,7 +131,7 @@ Rows plan_rows(const Scenario& s, const Accelerometer& sensor, const std::vector
     rows.observed.push_back(evaluate(m, -1));
   };
   // column -1: the sensor's output; column j: the j-th regressor of its design row.
-  auto channel = [&sensor](const GyroInputs& in, int column) {
+  auto channel = [&sensor](const SensorInputs& in, int column) {
     return column < 0 ? sensor.output(in)
                       : sensor.design_row(in).regressors[static_cast<std::size_t>(column)];
   };
@@ -152,7 +152,7 @@ Rows plan_rows(const Scenario& s, const Accelerometer& sensor, const std::vector
       }
       for (int h = 0; h < kHarmonicRows; ++h) {
         add([&](const CentrifugeModel& mm, int column) {
-          return harmonic_content(mm, rate, beta, 64, [&](const GyroInputs& in) {
+          return harmonic_content(mm, rate, beta, 64, [&](const SensorInputs& in) {
             return channel(in, column);
           })[static_cast<std::size_t>(h)];
         });
@@ -181,7 +181,7 @@ TEST(Accelerometer, OutputIsIeee1293EquationAndLinearInTheProducts) {
   const double expected =
       t.K1 * (t.K0 + ai + t.K2 * ai * ai + t.K3 * ai * ai * ai + t.Kip * ai * ap + t.Kio * ai * ao +
               t.Kpo * ap * ao + t.Kpp * ap * ap + t.Koo * ao * ao + t.dp * ap + t.d_o * ao);
-  GyroInputs in;
+  SensorInputs in;
   in.specific_force_g = f;
   EXPECT_NEAR(a.output(in), expected, 1e-15 * std::abs(expected));
   const DesignRow row = a.design_row(in);
@@ -209,7 +209,7 @@ void check_harmonic_content(double beta_deg, bool earth_rate) {
                    std::cos(m.site().latitude_rad) / m.site().gravity_m_s2;
   const std::array<double, kHarmonicRows> h =
       harmonic_content(m, rate, beta_deg * kDegToRad, 64,
-                       [&a](const GyroInputs& in) { return a.output(in) / a.coefficients.values[kK1]; });
+                       [&a](const SensorInputs& in) { return a.output(in) / a.coefficients.values[kK1]; });
   std::array<double, kHarmonicRows> expected{};
   const double ar2 = ar * ar, ar3 = ar2 * ar;
   if (beta_deg == 0.0) {  // a_i = -Ar cos g, a_p = -Ar sin g, a_o = 1 (+ c cos g)
@@ -477,7 +477,7 @@ TEST(GyroSensor, WrapsTheGyroModel) {
   g.rate.scale_factor_error_ppm = 200.0;
   g.rate.input_axis_misalignment_O_arcsec = 3.0;
   g.rate.input_axis_misalignment_S_arcsec = -2.0;
-  const GyroInputs in = exact_inputs(s.model(), spinning_joint_state(s.model(), 9.9, 0.3, 1.234));
+  const SensorInputs in = exact_inputs(s.model(), spinning_joint_state(s.model(), 9.9, 0.3, 1.234));
   EXPECT_EQ(g.output(in),
             sensed_rate_deg_h(g.rate, in.rate_rad_s) + drift_deg_h(g.drift, in.specific_force_g));
   EXPECT_EQ(g.num_unknowns(), kNumCoefficients);

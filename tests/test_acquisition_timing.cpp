@@ -108,8 +108,8 @@ TEST(AcquisitionTiming, SensedInputsAreTheMachinesInputsTheDelayEarlier) {
     delayed.output_delay_s = tau;
     const CentrifugeModel m(Site{}, CentrifugeGeometry{}, delayed);
     const double omega = 12 * u(rng), beta = kPi * u(rng), t = 30 * std::abs(u(rng)) + 1.0;
-    const GyroInputs sensed = sensed_inputs(m, spinning_joint_state(m, omega, beta, t));
-    const GyroInputs earlier = exact_inputs(m, spinning_joint_state(m, omega, beta, t - tau));
+    const SensorInputs sensed = sensed_inputs(m, spinning_joint_state(m, omega, beta, t));
+    const SensorInputs earlier = exact_inputs(m, spinning_joint_state(m, omega, beta, t - tau));
     // A spin-up at constant acceleration, the position platform turning: angles, rates of t - tau by hand.
     const double accel = 2 * u(rng), beta_rate = 0.3 * u(rng);
     const auto joints = [&](double at) {
@@ -126,8 +126,8 @@ TEST(AcquisitionTiming, SensedInputsAreTheMachinesInputsTheDelayEarlier) {
     };
     // A few seconds of spin-up (as tests/test_model.cpp's): the angles' rounding stays below 1e-14 rad.
     const double t_up = 3.0 * std::abs(u(rng)) + 0.5;
-    const GyroInputs sensed_up = sensed_inputs(m, joints(t_up));
-    const GyroInputs earlier_up = exact_inputs(m, joints(t_up - tau));
+    const SensorInputs sensed_up = sensed_inputs(m, joints(t_up));
+    const SensorInputs earlier_up = exact_inputs(m, joints(t_up - tau));
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(sensed.specific_force_g[k], earlier.specific_force_g[k], 1e-12) << trial;
       EXPECT_NEAR(sensed.rate_rad_s[k], earlier.rate_rad_s[k], 1e-12) << trial;
@@ -137,7 +137,7 @@ TEST(AcquisitionTiming, SensedInputsAreTheMachinesInputsTheDelayEarlier) {
     // Without a delay, the exact inputs bit for bit (the gyro's results unchanged).
     const CentrifugeModel plain(Site{}, CentrifugeGeometry{}, e);
     const JointState j = spinning_joint_state(plain, omega, beta, t);
-    const GyroInputs a = sensed_inputs(plain, j), b = exact_inputs(plain, j);
+    const SensorInputs a = sensed_inputs(plain, j), b = exact_inputs(plain, j);
     for (int k = 0; k < 3; ++k) {
       EXPECT_EQ(a.specific_force_g[k], b.specific_force_g[k]);
       EXPECT_EQ(a.rate_rad_s[k], b.rate_rad_s[k]);

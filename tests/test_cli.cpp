@@ -99,7 +99,7 @@ TEST_F(Cli, InputsJsonMatchesTheIndependentPoseForARandomConfiguration) {
       EXPECT_TRUE(j.contains(key)) << key;
     // The configuration as the program read it, and the independent route at the same instant.
     const Scenario read = load_scenario(path("c.toml"));
-    const GyroInputs fd = test_support::finite_difference_inputs(
+    const SensorInputs fd = test_support::finite_difference_inputs(
         read.model(), read.centrifuge.rate_rad_s, std::stod(std::to_string(beta_deg)) * kDegToRad,
         std::stod(std::to_string(t)));
     for (int k = 0; k < 3; ++k) {

@@ -87,8 +87,8 @@ TEST(ExactModel, AgreesWithFiniteDifferenceOfThePoseForRandomErrors) {
     const double omega = 10 * u(rng);  // both senses
     const double beta = kPi * u(rng);
     const double t = 50 * std::abs(u(rng));
-    const GyroInputs exact = exact_inputs(m, spinning_joint_state(m, omega, beta, t));
-    const GyroInputs fd = finite_difference_inputs(m, omega, beta, t);
+    const SensorInputs exact = exact_inputs(m, spinning_joint_state(m, omega, beta, t));
+    const SensorInputs fd = finite_difference_inputs(m, omega, beta, t);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(exact.rate_rad_s[k], fd.rate_rad_s[k], 1e-9) << "trial " << trial << " axis " << k;
       EXPECT_NEAR(exact.specific_force_g[k], fd.specific_force_g[k], 1e-9)
@@ -116,8 +116,8 @@ TEST(ExactModel, AgreesWithFiniteDifferenceWhileTheMainAxisAcceleratesAndThePlat
     j.counter_accel_rad_s2 = -accel;
     j.position_angle_rad = beta + beta_rate * t;
     j.position_rate_rad_s = beta_rate;
-    const GyroInputs exact = exact_inputs(m, j);
-    const GyroInputs fd = finite_difference_inputs(m, omega, beta, t, accel, beta_rate);
+    const SensorInputs exact = exact_inputs(m, j);
+    const SensorInputs fd = finite_difference_inputs(m, omega, beta, t, accel, beta_rate);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(exact.rate_rad_s[k], fd.rate_rad_s[k], 1e-9) << "trial " << trial << " axis " << k;
       EXPECT_NEAR(exact.specific_force_g[k], fd.specific_force_g[k], 1e-9)
@@ -146,7 +146,7 @@ TEST(ExactModel, PerfectMachineEqualsNominalPlusTheTermsTheSeedOmits) {
       for (double beta : {0.0, 0.4, kPi / 2, kPi, 4.0}) {
         for (double t : {0.0, 0.13, 1.7, 33.0}) {
           const JointState j = spinning_joint_state(m, omega, beta, t);
-          const GyroInputs ex = exact_inputs(m, j);
+          const SensorInputs ex = exact_inputs(m, j);
           const NominalInputs no = nominal_inputs(m, j, false);
           // Omitted by section 5: the vertical Coriolis term 2*omega*R0*we*cos(lat)*cos(theta)/g along Up,
           // and the Earth's centripetal term we x (we x p); both projected on the gyro axes here.
@@ -207,7 +207,7 @@ TEST(ExactModel, ReproducesTheSixteenPositionTable) {
   for (const TableRow& row : kTable) {
     const double beta = row.beta_deg * kDeg, gamma = row.gamma_deg * kDeg;
     const double t = time_at_gamma(m, omega, gamma, 3);
-    const GyroInputs in = exact_inputs(m, spinning_joint_state(m, omega, beta, t));
+    const SensorInputs in = exact_inputs(m, spinning_joint_state(m, omega, beta, t));
     // The table's specific force, plus the vertical Coriolis term along Up (cos gamma at these positions);
     // the platform's 3" tilt moves the components by up to 3" * Ar.
     const double vc = vertical_coriolis * std::cos(gamma);
@@ -301,8 +301,8 @@ TEST(ExactModel, MountMisalignmentRotatesBothVectorsRigidly) {
   std::uniform_real_distribution<double> u(0, 100);
   for (int k = 0; k < 20; ++k) {
     const double t = u(rng), beta = u(rng);
-    const GyroInputs a = exact_inputs(aligned, spinning_joint_state(aligned, 9.9, beta, t));
-    const GyroInputs b = exact_inputs(misaligned, spinning_joint_state(misaligned, 9.9, beta, t));
+    const SensorInputs a = exact_inputs(aligned, spinning_joint_state(aligned, 9.9, beta, t));
+    const SensorInputs b = exact_inputs(misaligned, spinning_joint_state(misaligned, 9.9, beta, t));
     EXPECT_NEAR((b.rate_rad_s - mount.transpose() * a.rate_rad_s).norm(), 0, 1e-15);
     EXPECT_NEAR((b.specific_force_g - mount.transpose() * a.specific_force_g).norm(), 0, 1e-13);
     EXPECT_NEAR(b.specific_force_g.norm(), a.specific_force_g.norm(), 1e-13);

@@ -71,8 +71,8 @@ TEST(RatePlatformModel, AnOffsetTurnsThePlatformAsARateMismatchOfTheSameSize) {
   const CentrifugeModel mismatched(s.site, s.centrifuge, with_mismatch);
   for (double t : {0.0, 0.37, 5.2, 31.9})
     for (double beta : {0.0, kPi / 2, 2.0}) {
-      const GyroInputs a = exact_inputs(commanded, spinning_joint_state(commanded, 9.9, beta, t, offset));
-      const GyroInputs b = exact_inputs(mismatched, spinning_joint_state(mismatched, 9.9, beta, t));
+      const SensorInputs a = exact_inputs(commanded, spinning_joint_state(commanded, 9.9, beta, t, offset));
+      const SensorInputs b = exact_inputs(mismatched, spinning_joint_state(mismatched, 9.9, beta, t));
       EXPECT_NEAR((a.rate_rad_s - b.rate_rad_s).norm(), 0.0, 1e-12) << t;
       EXPECT_NEAR((a.specific_force_g - b.specific_force_g).norm(), 0.0, 1e-9) << t;
     }
@@ -96,9 +96,9 @@ TEST(RatePlatformModel, ACounterRateIsTheFiniteDifferenceOfItsAngleAndARateTable
   const double up = s.site.earth_rate_rad_s * std::sin(s.site.latitude_rad);
   for (double offset : {0.5, -1.0})
     for (double t : {0.0, 2.0, 7.5}) {
-      const GyroInputs i_up = exact_inputs(perfect, spinning_joint_state(perfect, 0.0, kPi / 2, t, offset));
+      const SensorInputs i_up = exact_inputs(perfect, spinning_joint_state(perfect, 0.0, kPi / 2, t, offset));
       EXPECT_NEAR(i_up.rate_rad_s.x(), offset + up, 1e-12);
-      const GyroInputs s_up = exact_inputs(perfect, spinning_joint_state(perfect, 0.0, 0.0, t, offset));
+      const SensorInputs s_up = exact_inputs(perfect, spinning_joint_state(perfect, 0.0, 0.0, t, offset));
       EXPECT_NEAR(s_up.rate_rad_s.z(), offset + up, 1e-12);
       EXPECT_LT(std::abs(s_up.rate_rad_s.x()), s.site.earth_rate_rad_s * 1.0000001);
     }

@@ -171,10 +171,10 @@ TEST(ReductionExactness, WhereTheChannelsFollowTheMeasuredMotionTheDataAndTheMod
         testing::RigRow& x = rows[row];
         ASSERT_NEAR(x.time_s, record_first_s + static_cast<double>(i) * st.interval_s, 1e-6);
         // The rig's spike on this row, if any: its output minus the gyro at its true joints.
-        const GyroInputs truth = exact_inputs(model, x.truth);
+        const SensorInputs truth = exact_inputs(model, x.truth);
         const double spike =
             x.output - gyro_output_deg_h(s.gyro, truth.rate_rad_s.x(), truth.specific_force_g);
-        const GyroInputs in = exact_inputs(model, measured_joints(d, si, i));
+        const SensorInputs in = exact_inputs(model, measured_joints(d, si, i));
         x.output = gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) +
                    (std::abs(spike) > 1e3 ? spike : 0.0);
         ++replaced;

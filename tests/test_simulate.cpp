@@ -87,7 +87,7 @@ TEST(Simulate, NoiseFreeOutputIsTheModelAtTheRecordedAngles) {
     j.counter_angle_rad = row.counter_angle_deg * kDegToRad;
     j.counter_rate_rad_s = m->kind == SegmentKind::kDwell ? -m->rate_rad_s + delta_omega : 0.0;
     j.position_angle_rad = row.position_angle_deg * kDegToRad;
-    const GyroInputs in = exact_inputs(model, j);
+    const SensorInputs in = exact_inputs(model, j);
     ASSERT_NEAR(row.output, gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g), 1e-9)
         << "at t = " << row.time_s << " s";
     ++checked[m];

@@ -48,7 +48,7 @@ std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samp
 /// are a perfect machine's and acquisition's.
 void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState j, double* v) {
   j.position_angle_rad = d.beta_rad;
-  const GyroInputs exact = sensed_inputs(model, j);
+  const SensorInputs exact = sensed_inputs(model, j);
   const double offset = d.planned_counter_rate_offset_rad_s;
   const NominalInputs nominal = nominal_inputs(model, j, false, offset);
   v[0] = exact.rate_rad_s.x() * kRadPerSecToDegPerHour;

@@ -142,7 +142,7 @@ CentrifugeModel::CentrifugeModel(const Site& site, const CentrifugeGeometry& geo
   prepared_.counter_wobble_y = PreparedHarmonicSeries(errors.counter_wobble_y_rad);
 }
 
-GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
+SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   const CentrifugeErrors& e = model.errors();
   const CentrifugeModel::PreparedErrors& h = model.prepared();
   const Joint th(j.main_angle_rad, j.main_rate_rad_s, j.main_accel_rad_s2);
@@ -186,7 +186,7 @@ GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   const double g = model.site().gravity_m_s2;
   const Vector3d inertial_acceleration =
       f.acceleration + 2.0 * we.cross(f.velocity) + we.cross(we.cross(f.position)) + Vector3d(0.0, 0.0, g);
-  GyroInputs in;
+  SensorInputs in;
   in.rate_rad_s = f.rotation.transpose() * (we + f.angular_velocity);
   in.specific_force_g = f.rotation.transpose() * inertial_acceleration / g;
   return in;
@@ -204,7 +204,7 @@ JointState joints_before(const JointState& at_stamp, double delay_s) {
   return j;
 }
 
-GyroInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp) {
+SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp) {
   const double delay = model.errors().output_delay_s;
   return delay == 0.0 ? exact_inputs(model, at_stamp) : exact_inputs(model, joints_before(at_stamp, delay));
 }

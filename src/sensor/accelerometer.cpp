@@ -71,11 +71,11 @@ std::vector<std::string_view> Accelerometer::unknown_names() const {
   return {names.begin(), names.end()};
 }
 
-double Accelerometer::output(const GyroInputs& inputs) const {
+double Accelerometer::output(const SensorInputs& inputs) const {
   return accelerometer_output(coefficients, inputs.specific_force_g);
 }
 
-DesignRow Accelerometer::design_row(const GyroInputs& inputs) const {
+DesignRow Accelerometer::design_row(const SensorInputs& inputs) const {
   DesignRow row;
   const std::array<double, kNumAccelCoefficients> r = accelerometer_regressors(inputs.specific_force_g);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) row.regressors[k] = r[k];

@@ -41,11 +41,11 @@ std::vector<std::string_view> Gyro::unknown_names() const {
   return names;
 }
 
-double Gyro::output(const GyroInputs& inputs) const {
+double Gyro::output(const SensorInputs& inputs) const {
   return sensed_rate_deg_h(rate, inputs.rate_rad_s) + drift_deg_h(drift, inputs.specific_force_g);
 }
 
-DesignRow Gyro::design_row(const GyroInputs& inputs) const {
+DesignRow Gyro::design_row(const SensorInputs& inputs) const {
   DesignRow row;
   row.known = inputs.rate_rad_s.x() * kRadPerSecToDegPerHour;
   const std::array<double, kNumCoefficients> r = drift_regressors(inputs.specific_force_g);

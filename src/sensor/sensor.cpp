@@ -16,11 +16,11 @@ SensorKind kind_of(const Sensor& sensor) {
   return std::holds_alternative<Gyro>(sensor) ? SensorKind::kGyro : SensorKind::kAccelerometer;
 }
 
-double sensor_output(const Sensor& sensor, const GyroInputs& inputs) {
+double sensor_output(const Sensor& sensor, const SensorInputs& inputs) {
   return std::visit([&inputs](const auto& s) { return s.output(inputs); }, sensor);
 }
 
-DesignRow sensor_design_row(const Sensor& sensor, const GyroInputs& inputs) {
+DesignRow sensor_design_row(const Sensor& sensor, const SensorInputs& inputs) {
   return std::visit([&inputs](const auto& s) { return s.design_row(inputs); }, sensor);
 }
 

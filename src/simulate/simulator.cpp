@@ -57,8 +57,8 @@ void sample_at(const CentrifugeModel& model, const Sensor& sensor, const Timelin
   // The output stamped at t was sensed the acquisition's delay earlier ([record] output_delay_s): the
   // machine's own motion at that instant (the encoders are read at t).
   const double delay_s = model.errors().output_delay_s;
-  const GyroInputs inputs = delay_s == 0.0 ? exact_inputs(model, joints)
-                                           : exact_inputs(model, joint_state_at(timeline, t - delay_s));
+  const SensorInputs inputs = delay_s == 0.0 ? exact_inputs(model, joints)
+                                             : exact_inputs(model, joint_state_at(timeline, t - delay_s));
   sample.time_s = t;
   sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
   sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);

@@ -66,8 +66,8 @@ inline Pose pose_at(const CentrifugeModel& m, double omega, double beta, Real t,
 }
 
 // Inputs from the pose by 8th-order central differences (weights of f' and f'' at offsets 1..4).
-inline GyroInputs finite_difference_inputs(const CentrifugeModel& m, double omega, double beta, double t,
-                                           double accel = 0, double beta_rate = 0) {
+inline SensorInputs finite_difference_inputs(const CentrifugeModel& m, double omega, double beta, double t,
+                                             double accel = 0, double beta_rate = 0) {
   const Real h = 1e-3L;
   const Real d1[] = {4.0L / 5, -1.0L / 5, 4.0L / 105, -1.0L / 280};
   const Real d2[] = {8.0L / 5, -1.0L / 5, 8.0L / 315, -1.0L / 560};
@@ -86,7 +86,7 @@ inline GyroInputs finite_difference_inputs(const CentrifugeModel& m, double omeg
   const Vector3r body_rate(skew(2, 1), skew(0, 2), skew(1, 0));
   const Vector3r we = m.earth_rate_g().cast<Real>();
   const Real g = m.site().gravity_m_s2;
-  GyroInputs in;
+  SensorInputs in;
   in.rate_rad_s = (c.r.transpose() * we + body_rate).cast<double>();
   in.specific_force_g =
       (c.r.transpose() * (pddot + 2 * we.cross(pdot) + we.cross(we.cross(c.p)) + Vector3r(0, 0, g)) / g)

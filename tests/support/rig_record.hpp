@@ -258,7 +258,7 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
       // The platform really moves (and stays): the model sees it too.
       j.position_angle_rad += imp.beta_move_in_dwell_deg * kDegToRad;
     }
-    const GyroInputs in = exact_inputs(model, j);
+    const SensorInputs in = exact_inputs(model, j);
     double y = accelerometer ? accelerometer_noise.next(s.accelerometer.output(in))
                              : gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) + noise(rng);
     if (spike_every > 0 && k % spike_every == spike_every / 2 &&

@@ -84,8 +84,9 @@ struct JointState {
   double gamma_rad() const { return -counter_angle_rad; }
 };
 
-/// The exact inputs to the gyro at one instant, in gyro axes (I, O, S).
-struct GyroInputs {
+/// The exact inputs to the sensor at one instant, in the sensor's axes (a gyro's I, O, S; an accelerometer's
+/// i, p, o, docs/accelerometer.md): what any sensor's output is a function of (sensor/sensor_model.hpp).
+struct SensorInputs {
   Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();        ///< inertial angular rate, rad/s
   Eigen::Vector3d specific_force_g = Eigen::Vector3d::Zero();  ///< specific force, in the site's g
 };
@@ -142,9 +143,9 @@ class CentrifugeModel {
   PreparedErrors prepared_;
 };
 
-/// Exact inertial rate and specific force in gyro axes (docs/physics.md section 4), with analytic derivatives
-/// of the chain of section 3 (wobbles and runouts differentiated through their joint angle).
-GyroInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
+/// Exact inertial rate and specific force in the sensor's axes (docs/physics.md section 4), with analytic
+/// derivatives of the chain of section 3 (wobbles and runouts differentiated through their joint angle).
+SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
 
 /// The joints `delay_s` (s) before `at_stamp`, from its angles, rates and accelerations (second order in the
 /// delay: exact on a constant-rate line, whose acceleration is zero).
@@ -155,7 +156,7 @@ JointState joints_before(const JointState& at_stamp, double delay_s);
 /// (docs/calibration.md, "The acquisition's timing"). exact_inputs itself, bit for bit, when the delay is 0.
 /// The model's channels of a calibration are evaluated through it; the simulator takes the timeline's joints
 /// at the earlier instant instead (an independent route).
-GyroInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp);
+SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
 /// theta = theta0 + omega*t, psi_r = -theta + psi0 + (delta_omega + offset)*t (docs/physics.md sections 3

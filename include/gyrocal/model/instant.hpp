@@ -8,7 +8,7 @@ namespace gyrocal {
 struct InstantInputs {
   double time_s = 0.0;  ///< time since the start of the dwell, s
   JointState joints;    ///< theta, psi_r, beta and their rates
-  GyroInputs exact;     ///< docs/physics.md section 4
+  SensorInputs exact;   ///< docs/physics.md section 4
   NominalInputs
       nominal;  ///< docs/physics.md section 5, with the seed's k1, k2, delta omega of the configured errors
 };

@@ -104,9 +104,9 @@ struct Accelerometer {
   std::size_t num_unknowns() const { return kNumAccelCoefficients; }
   /// "K1*K0", "K1", "K1*K2", ...: the products in design-row order.
   std::vector<std::string_view> unknown_names() const;
-  double output(const GyroInputs& inputs) const;
+  double output(const SensorInputs& inputs) const;
   /// known 0; regressors accelerometer_regressors(f): E = sum_j r_j u_j with u = (K1 K0, K1, K1 K2, ...).
-  DesignRow design_row(const GyroInputs& inputs) const;
+  DesignRow design_row(const SensorInputs& inputs) const;
   /// K1 = u_1, Kx = u_x / u_1; J: dKx/du_x = 1/K1, dKx/dK1 = -Kx/K1. Kx is identifiable when u_x and K1 are.
   ParameterEstimates from_products(const Eigen::VectorXd& products, const Eigen::MatrixXd& covariance,
                                    const std::vector<bool>& identifiable) const;

@@ -54,10 +54,10 @@ struct Gyro {
   /// dF..dOS, then scale_factor_error_ppm, "(1+e)*dO", "(1+e)*dS" with drift+rate.
   std::vector<std::string_view> unknown_names() const;
   /// The sensed rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus eq. 6's drift, deg/h (the simulator's).
-  double output(const GyroInputs& inputs) const;
+  double output(const SensorInputs& inputs) const;
   /// known omega_I (deg/h); regressors: the ten drift regressors, then with drift+rate omega_I * 1e-6 (per
   /// ppm), omega_O and omega_S in deg/h times 1 arcsec in rad (per arcsec of (1+e) dO and (1+e) dS).
-  DesignRow design_row(const GyroInputs& inputs) const;
+  DesignRow design_row(const SensorInputs& inputs) const;
   /// Drift coefficients and e as solved; dO = u_O / (1 + e), dS = u_S / (1 + e), by the delta method with
   /// the correlation of e (the products exact, not dropped).
   ParameterEstimates from_products(const Eigen::VectorXd& products, const Eigen::MatrixXd& covariance,

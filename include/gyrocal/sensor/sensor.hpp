@@ -31,8 +31,8 @@ std::optional<SensorKind> parse_sensor_kind(std::string_view text);
 SensorKind kind_of(const Sensor& sensor);
 
 /// The noise-free output of any sensor at exact inputs, in its output unit.
-double sensor_output(const Sensor& sensor, const GyroInputs& inputs);
+double sensor_output(const Sensor& sensor, const SensorInputs& inputs);
 /// The design row of any sensor at exact inputs.
-DesignRow sensor_design_row(const Sensor& sensor, const GyroInputs& inputs);
+DesignRow sensor_design_row(const Sensor& sensor, const SensorInputs& inputs);
 
 }  // namespace gyrocal

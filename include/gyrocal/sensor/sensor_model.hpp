@@ -69,7 +69,7 @@ ParameterEstimates propagate(Eigen::VectorXd values, const Eigen::MatrixXd& jaco
 /// - from_products(u, C_u, identifiable): the coefficients of the identified parameters, in table order,
 ///   with their delta-method covariance (the products' identifiability carried over).
 template <class S>
-concept SensorModel = requires(const S& s, const GyroInputs& inputs, const Eigen::VectorXd& u,
+concept SensorModel = requires(const S& s, const SensorInputs& inputs, const Eigen::VectorXd& u,
                                const Eigen::MatrixXd& c, const std::vector<bool>& identifiable) {
   { S::kind } -> std::convertible_to<std::string_view>;
   { S::native_column } -> std::convertible_to<std::string_view>;
