@@ -247,8 +247,8 @@ TEST(AccelerometerMisfit, TheCounterPlatformCountedTheOtherWayIsNamed) {
       }
       for (ReducedPosition& p : r.positions)
         if (p.dwell == static_cast<int>(d)) {
-          p.mean_deg_h = w.gyro.value[static_cast<std::size_t>(p.gamma_slot)];
-          p.std_err_deg_h = w.gyro.std_err[static_cast<std::size_t>(p.gamma_slot)];
+          p.mean = w.gyro.value[static_cast<std::size_t>(p.gamma_slot)];
+          p.std_err = w.gyro.std_err[static_cast<std::size_t>(p.gamma_slot)];
         }
     }
   };

@@ -293,7 +293,7 @@ TEST(Predict, PlannedReductionMatchesAReducedNoiseFreeRecord) {
       // deg, docs/calibration.md), up to 0.1 s before the platform's move ends: the same duration of steady
       // spin, shifted, which moves only the harmonics above the fit's order (below 1e-5 deg/h on outputs of
       // tens of deg/h; 6e-6 measured).
-      EXPECT_NEAR(planned.positions[i].mean_deg_h, recorded.reduction.positions[i].mean_deg_h, 1e-5) << i;
+      EXPECT_NEAR(planned.positions[i].mean, recorded.reduction.positions[i].mean, 1e-5) << i;
     }
   }
 }
@@ -308,15 +308,14 @@ TEST(Predict, PredictedStandardErrorsMatchTheScatterOfANoisyRecord) {
   // over the 16 positions is 1 within a few per cent.
   double ratio = 0;
   for (std::size_t i = 0; i < planned.positions.size(); ++i)
-    ratio += noisy.reduction.positions[i].std_err_deg_h / planned.positions[i].std_err_deg_h;
+    ratio += noisy.reduction.positions[i].std_err / planned.positions[i].std_err;
   ratio /= static_cast<double>(planned.positions.size());
   EXPECT_NEAR(ratio, 1.0, sanitized() ? 0.08 : 0.04);
   // And the prediction itself against the closed form for a harmonic fit over whole revolutions: the value at
   // one gamma of a fit of orders 0..3 has variance (1 + 2*3) sigma^2 / n.
   const double sigma = 0.002 * 60 * std::sqrt(s.test.sample_rate_hz);
   const double n = static_cast<double>(planned.positions[0].samples);
-  EXPECT_NEAR(planned.positions[0].std_err_deg_h, sigma * std::sqrt(7.0 / n),
-              0.01 * sigma * std::sqrt(7.0 / n));
+  EXPECT_NEAR(planned.positions[0].std_err, sigma * std::sqrt(7.0 / n), 0.01 * sigma * std::sqrt(7.0 / n));
 }
 
 }  // namespace

@@ -302,7 +302,7 @@ TEST(Messages, APlanWithFewerPositionsThanCoefficientsSaysSoInItsTerms) {
 
 TEST(Messages, ANonFiniteReducedOutputIsNamedByItsPosition) {
   Planned p;
-  p.reduction.positions[7].mean_deg_h = std::numeric_limits<double>::infinity();
+  p.reduction.positions[7].mean = std::numeric_limits<double>::infinity();
   const std::string message =
       error_of([&] { identify(p.reduction, p.channels, p.s.model(), CalibrationOptions{}); });
   EXPECT_NE(message.find("position 8 (rate 9.9 rad/s, beta 180 deg, gamma 270 deg; record time"),

@@ -202,7 +202,7 @@ TEST(Misfit, TheCounterPlatformCountedTheOtherWayIsNamedOrFitsConsistently) {
   for (std::size_t d = 0; d < r.dwells.size(); ++d) {
     ReducedPosition& a = at(static_cast<int>(d), 90.0);
     ReducedPosition& b = at(static_cast<int>(d), 270.0);
-    std::swap(a.mean_deg_h, b.mean_deg_h);
+    std::swap(a.mean, b.mean);
     std::swap(r.dwells[d].gyro.value[static_cast<std::size_t>(a.gamma_slot)],
               r.dwells[d].gyro.value[static_cast<std::size_t>(b.gamma_slot)]);
   }

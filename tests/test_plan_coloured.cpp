@@ -316,7 +316,7 @@ TEST(PlanColouredNoise, SimulatedRecordsScatterAsPredicted) {
     for (Eigen::Index p = 0; p < np; ++p) {
       const auto k = static_cast<std::size_t>(p);
       ASSERT_EQ(noisy.positions[k].index, planned.positions[k].index);
-      e[p] = noisy.positions[k].mean_deg_h - reference.positions[k].mean_deg_h;
+      e[p] = noisy.positions[k].mean - reference.positions[k].mean;
     }
     chi2 += llt.matrixL().solve(e).squaredNorm();
     chi2_white += llt_white.matrixL().solve(e).squaredNorm();

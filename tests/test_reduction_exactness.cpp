@@ -91,7 +91,7 @@ Mismatch mismatch(const Scenario& s, const Reduction& r, ChannelRoute route) {
   const std::vector<PositionChannels> ch = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, route);
   Mismatch m;
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
-    const double data = r.positions[i].mean_deg_h, model = model_output_deg_h(s, ch[i]);
+    const double data = r.positions[i].mean, model = model_output_deg_h(s, ch[i]);
     m.worst = std::max(m.worst, std::abs(data - model));
     m.scale = std::max(m.scale, std::abs(data));
   }
@@ -251,7 +251,7 @@ TEST(ReductionExactness, AnAccelerometersDesignRowsAreReducedByTheOutputsOperato
       const DesignRow& row = ch[i].sensor_exact;
       double y = row.known;
       for (std::size_t j = 0; j < row.size; ++j) y += u[static_cast<Eigen::Index>(j)] * row.regressors[j];
-      w = std::max(w, std::abs(x.positions[i].mean_deg_h - y));
+      w = std::max(w, std::abs(x.positions[i].mean - y));
     }
     return w;
   };

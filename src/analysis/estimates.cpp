@@ -90,7 +90,7 @@ PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& 
     double e = row.known;
     for (std::size_t k = 0; k < row.size && static_cast<Eigen::Index>(k) < u.size(); ++k)
       e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
-    p.reduction.positions[i].mean_deg_h = e;
+    p.reduction.positions[i].mean = e;
   }
   set_predicted_std_errors(p.reduction, output_noise(s), s.test.sample_rate_hz, options);
   p.channels = reduce_sensor_channels(p.reduction, told, options, sensor, kMaxModelSamplesPerDwell);

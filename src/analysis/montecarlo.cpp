@@ -163,7 +163,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   // The identification is affine in the outputs W: errors = bias + M (W - W0).
   const auto identify_at = [&](const Eigen::VectorXd& dw) {
     Reduction r = r0;
-    for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean_deg_h += dw[i];
+    for (Eigen::Index i = 0; i < np; ++i) r.positions[static_cast<std::size_t>(i)].mean += dw[i];
     return identify(r, ch0, model0, m.calibration);
   };
   const CalibrationResult configured = identify_at(Eigen::VectorXd::Zero(np));
@@ -234,8 +234,8 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
       if (same_encoder_lines(r, r0)) {
         Eigen::VectorXd dw(np);
         for (Eigen::Index i = 0; i < np; ++i)
-          dw[i] = r.positions[static_cast<std::size_t>(i)].mean_deg_h -
-                  r0.positions[static_cast<std::size_t>(i)].mean_deg_h;
+          dw[i] =
+              r.positions[static_cast<std::size_t>(i)].mean - r0.positions[static_cast<std::size_t>(i)].mean;
         side[k] = map * dw;
       } else {
         if (p.channels.empty()) p.channels = reduce_model_channels(r, model0, ro);

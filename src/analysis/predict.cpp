@@ -81,7 +81,7 @@ void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& c
                (rate_errors.input_axis_misalignment_O_arcsec * ch.omega_O_exact_deg_h +
                 rate_errors.input_axis_misalignment_S_arcsec * ch.omega_S_exact_deg_h);
     }
-    r.positions[i].mean_deg_h = w;
+    r.positions[i].mean = w;
   }
 }
 
@@ -536,7 +536,7 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
   }
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     ReducedPosition& a = r.positions[i];
-    a.std_err_deg_h = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    a.std_err = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
     for (std::size_t j = 0; j < r.positions.size(); ++j) {
       const ReducedPosition& b = r.positions[j];
       if (a.dwell == b.dwell)
@@ -621,7 +621,7 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
   Eigen::MatrixXd gain(static_cast<Eigen::Index>(stds.size()), np);
   for (Eigen::Index k = 0; k < np; ++k) {
     Reduction shifted = r;
-    shifted.positions[static_cast<std::size_t>(k)].mean_deg_h += step;
+    shifted.positions[static_cast<std::size_t>(k)].mean += step;
     const CalibrationResult e = identify(shifted, channels, model, options);
     for (std::size_t i = 0; i < stds.size(); ++i)
       gain(static_cast<Eigen::Index>(i), k) = (value_of[i](e) - base[i]) / step;
@@ -653,7 +653,7 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
     const DesignRow& row = channels[i].sensor_exact;
     double e = row.known;
     for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
-    r.positions[i].mean_deg_h = e;
+    r.positions[i].mean = e;
   }
   // The noise as the simulator draws it, in output units (analysis/estimates.hpp output_noise); its
   // covariance through the reduction in closed form as the gyro's (coloured_noise_position_covariance).

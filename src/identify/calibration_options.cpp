@@ -20,7 +20,7 @@ bool CalibrationOptions::IsValid(std::string* error) const {
     if (error) *error = "least squares: " + e;
     return false;
   }
-  if (!(min_std_err_deg_h > 0.0)) {
+  if (!(min_std_err > 0.0)) {
     if (error) *error = "min_std_err_deg_h must be positive";
     return false;
   }

@@ -62,8 +62,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     const auto i = static_cast<std::size_t>(k16[k]);
     const PositionChannels& ch = channels[i];
     // Compensation: remove what the machine adds beyond a perfect one (docs/physics.md section 8).
-    w[k] =
-        reduction.positions[i].mean_deg_h - (ch.omega_deg_h(options.compensation) - ch.omega_nominal_deg_h);
+    w[k] = reduction.positions[i].mean - (ch.omega_deg_h(options.compensation) - ch.omega_nominal_deg_h);
     for (std::size_t l = 0; l < 16; ++l)
       se(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(l)) = all(k16[k], k16[l]);
   }
@@ -107,7 +106,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   // 16 positions and covariance (1 = nothing lost; docs/calibration.md).
   Eigen::MatrixXd x(16, static_cast<Eigen::Index>(kNumCoefficients));
   Eigen::MatrixXd cov16(16, 16);
-  const Eigen::MatrixXd floored = position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::MatrixXd floored = position_covariance(reduction, options.min_std_err);
   for (Eigen::Index k = 0; k < 16; ++k) {
     const auto& reg =
         channels[static_cast<std::size_t>(k16[static_cast<std::size_t>(k)])].regressors(options.compensation);

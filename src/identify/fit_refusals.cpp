@@ -30,7 +30,7 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
   for (Eigen::Index i = 0; i < design.rows(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     const ReducedPosition& p = reduction.positions[k];
-    if (!std::isfinite(p.mean_deg_h))
+    if (!std::isfinite(p.mean))
       throw Error(
           fmt::format("the reduced gyro output of {} is not a finite number: the record's gyro "
                       "outputs there are too large to average; check the record's gyro column.",
@@ -44,7 +44,7 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
       throw Error(
           fmt::format("the output minus the model's input rate at {} is not finite ({:g} - {:g}): "
                       "the record's gyro output and the configuration disagree beyond a double's range.",
-                      describe_position(reduction, k), p.mean_deg_h, channels[k].omega_deg_h(compensation)));
+                      describe_position(reduction, k), p.mean, channels[k].omega_deg_h(compensation)));
   }
 }
 
@@ -62,8 +62,7 @@ void refuse_overflowing_weighting(const Reduction& reduction, const Eigen::Vecto
         "error ({:g} {}) to weight the fit: the outputs, or the configured coefficients that predict them, "
         "are "
         "too large ({}).",
-        describe_position(reduction, k), observations[i], unit, reduction.positions[k].std_err_deg_h, unit,
-        limit));
+        describe_position(reduction, k), observations[i], unit, reduction.positions[k].std_err, unit, limit));
   }
 }
 

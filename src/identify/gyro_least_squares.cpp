@@ -105,17 +105,17 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     const std::vector<double> x = design_row(ch, options.compensation, unknowns);
     for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
     for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
-    observations[i] = p.mean_deg_h - ch.omega_deg_h(options.compensation);
+    observations[i] = p.mean - ch.omega_deg_h(options.compensation);
   }
   check_finite(reduction, design, observations, channels, options.compensation);
   refuse_repeated_positions(reduction);
-  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err);
   // The weights come from the covariance with one level for the whole record (the levels pooled over the
   // dwells by their degrees of freedom); the uncertainties from each dwell's own level (a sandwich). A few
   // revolutions measure a dwell's level poorly, and weights that follow those errors favour the dwells whose
   // noise was underestimated: z-scores of 1.2..1.4 at 3..6 revolutions (docs/calibration.md, "Degrees of
   // freedom").
-  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err_deg_h);
+  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
   if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
   IdentifiabilityOptions io;
@@ -182,8 +182,8 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   if (options.gyro_model == GyroModel::kDriftRate) state_rate_terms(reduction, r);
   // Residuals in deg/h, not in whitened units.
   const Eigen::VectorXd residuals = observations - design * sol.estimate;
-  r.residuals_deg_h.clear();
-  for (Eigen::Index i = 0; i < m; ++i) r.residuals_deg_h.push_back(residuals[i]);
+  r.residuals.clear();
+  for (Eigen::Index i = 0; i < m; ++i) r.residuals.push_back(residuals[i]);
   for (const std::string& w : sol.warnings) {
     // Identifiability is said once, below, in the coefficients' terms.
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)

@@ -57,8 +57,8 @@ std::optional<Reduction> permute_outputs(const Reduction& r, const std::vector<i
     const int src = position_of(r, partner[d], slot_map[d][static_cast<std::size_t>(q.gamma_slot)]);
     if (src < 0) return std::nullopt;
     const ReducedPosition& s = r.positions[static_cast<std::size_t>(src)];
-    q.mean_deg_h = s.mean_deg_h;
-    q.std_err_deg_h = s.std_err_deg_h;
+    q.mean = s.mean;
+    q.std_err = s.std_err;
     q.outliers = s.outliers;
   }
   return out;
@@ -162,7 +162,7 @@ MisfitTest test_misfit(const Reduction& reduction, double chi2, int dof, double 
   t.weight_dof = weight_dof(reduction);
   const bool measured =
       std::any_of(reduction.positions.begin(), reduction.positions.end(),
-                  [&](const ReducedPosition& p) { return !without_noise(p.std_err_deg_h, noise_free); });
+                  [&](const ReducedPosition& p) { return !without_noise(p.std_err, noise_free); });
   // A prediction's covariance is known (its outputs are noise-free by construction): nothing to test.
   t.tested = measured && dof > 0 && std::isfinite(t.weight_dof);
   t.p_value = t.tested ? misfit_p_value(chi2, dof, t.weight_dof) : 1.0;
@@ -173,8 +173,8 @@ Reduction scale_outputs(const Reduction& reduction, double factor) {
   Reduction out = reduction;
   const double a = std::abs(factor);
   for (ReducedPosition& p : out.positions) {
-    p.mean_deg_h *= factor;
-    p.std_err_deg_h *= a;
+    p.mean *= factor;
+    p.std_err *= a;
   }
   for (Dwell& d : out.dwells) {
     for (double& v : d.gyro.value) v *= factor;
@@ -239,16 +239,15 @@ std::vector<MisfitCause> accelerometer_misfit_causes() {
 void refuse_constant_output(const Reduction& reduction, const OutputConfiguration& output, double noise_free,
                             SensorKind sensor) {
   if (reduction.positions.size() < 2) return;
-  const double v0 = reduction.positions.front().mean_deg_h;
+  const double v0 = reduction.positions.front().mean;
   bool constant = true;
   double largest = 0.0;
   for (const ReducedPosition& p : reduction.positions) {
-    if (!without_noise(p.std_err_deg_h, noise_free)) return;
+    if (!without_noise(p.std_err, noise_free)) return;
     // Constant relative to the values' own magnitude: outputs of 1e-299 deg/h that differ by a third between
     // positions vary (a scale wrong by 1e300), and were called constant against an absolute 1e-9.
-    if (!(std::abs(p.mean_deg_h - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean_deg_h))))
-      constant = false;
-    largest = std::max(largest, std::abs(p.mean_deg_h));
+    if (!(std::abs(p.mean - v0) <= 1e-9 * std::max(std::abs(v0), std::abs(p.mean)))) constant = false;
+    largest = std::max(largest, std::abs(p.mean));
   }
   if (constant && sensor != SensorKind::kGyro)
     throw Error(fmt::format(

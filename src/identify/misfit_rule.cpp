@@ -145,9 +145,9 @@ GravityReading gravity_reading(const Reduction& reduction, const std::vector<Pos
     const ReducedPosition& p = reduction.positions[i];
     const auto d = static_cast<std::size_t>(p.dwell);
     if (channels[i].sensor_exact.size != kNumAccelCoefficients) return {};
-    output[d] += p.mean_deg_h;
+    output[d] += p.mean;
     ai[d] += channels[i].sensor_exact.regressors[k1_at];
-    var[d] += p.std_err_deg_h * p.std_err_deg_h;
+    var[d] += p.std_err * p.std_err;
     ++count[d];
   }
   double sum_up = 0.0, sum_down = 0.0, ai_up = 0.0, ai_down = 0.0, var_up = 0.0, var_down = 0.0;
@@ -237,8 +237,8 @@ std::optional<Reduction> shift_counter_zero(const Reduction& r, double offset_ra
   for (ReducedPosition& q : out.positions) {
     const DwellValues& v = out.dwells[static_cast<std::size_t>(q.dwell)].gyro;
     const auto k = static_cast<std::size_t>(q.gamma_slot);
-    if (k < v.value.size()) q.mean_deg_h = v.value[k];
-    if (k < v.std_err.size() && std::isfinite(v.std_err[k])) q.std_err_deg_h = v.std_err[k];
+    if (k < v.value.size()) q.mean = v.value[k];
+    if (k < v.std_err.size() && std::isfinite(v.std_err[k])) q.std_err = v.std_err[k];
   }
   return out;
 }
@@ -435,7 +435,7 @@ double accelerometer_output_per_g(const Reduction& reduction, const std::vector<
     const double ap = row.regressors[at(AccelCoefficient::delta_p)] * 1e6;
     const double ao = row.regressors[at(AccelCoefficient::delta_o)] * 1e6;
     force = std::max(force, std::sqrt(ai * ai + ap * ap + ao * ao));
-    output = std::max(output, std::abs(reduction.positions[i].mean_deg_h));
+    output = std::max(output, std::abs(reduction.positions[i].mean));
   }
   const double per_g = output / force;
   return std::isfinite(per_g) && per_g > 0.0 ? per_g : 1.0;

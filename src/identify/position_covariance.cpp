@@ -21,8 +21,7 @@ Eigen::MatrixXd position_covariance(const Reduction& r, double floor) {
       const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
       if (a.dwell != b.dwell) continue;
       const Eigen::MatrixXd& dc = r.dwells[static_cast<std::size_t>(a.dwell)].gyro.covariance;
-      const double v =
-          dc.size() ? dc(a.gamma_slot, b.gamma_slot) : (i == j ? a.std_err_deg_h * a.std_err_deg_h : 0.0);
+      const double v = dc.size() ? dc(a.gamma_slot, b.gamma_slot) : (i == j ? a.std_err * a.std_err : 0.0);
       c(i, j) = std::isfinite(v) ? v : 0.0;
     }
   }

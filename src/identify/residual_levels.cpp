@@ -65,7 +65,7 @@ std::optional<Reduction> residual_levels(const Reduction& reduction,
       if (found) residual.push_back(std::move(r));
     }
     relevel_from_periods(v, residual);
-    for (std::size_t g = 0; g < s.size(); ++g) out.positions[s[g]].std_err_deg_h = v.std_err[g];
+    for (std::size_t g = 0; g < s.size(); ++g) out.positions[s[g]].std_err = v.std_err[g];
   }
   return out;
 }

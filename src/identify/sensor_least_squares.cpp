@@ -97,8 +97,8 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
           to_string(options.sensor)));
     for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = row.regressors[static_cast<std::size_t>(j)];
     for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
-    observations[i] = p.mean_deg_h - row.known;
-    if (!std::isfinite(p.mean_deg_h))
+    observations[i] = p.mean - row.known;
+    if (!std::isfinite(p.mean))
       throw Error(
           fmt::format("the reduced output of {} is not a finite number: the record's outputs there "
                       "are too large to average; check the record's output column.",
@@ -126,10 +126,10 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
           "seven numbers of a revolution (--reduction harmonic, docs/accelerometer.md).",
           fewest));
   }
-  // The floor in the output's own g (min_std_err_deg_h is read as g for an accelerometer), so that the
+  // The floor in the output's own g (min_std_err is read as g for an accelerometer), so that the
   // weights do not depend on the unit the output is read in ([record] output_scale_per_g).
   const double floor =
-      options.min_std_err_deg_h *
+      options.min_std_err *
       (options.sensor == SensorKind::kAccelerometer ? accelerometer_output_per_g(reduction, channels) : 1.0);
   const Eigen::MatrixXd covariance = position_covariance(reduction, floor);
   const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, floor);
@@ -220,7 +220,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     }
   }
   const Eigen::VectorXd residuals = observations - design * sol.estimate;
-  r.residuals_deg_h.assign(residuals.data(), residuals.data() + residuals.size());
+  r.residuals.assign(residuals.data(), residuals.data() + residuals.size());
   for (const std::string& w : sol.warnings) {
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
       continue;

@@ -162,7 +162,7 @@ Reduction Reducer::finish() {
             : fmt::format(" ([test] revolutions = {} or more)", needed)));
   }
   for (const ReducedPosition& p : out.positions)
-    if (p.std_err_deg_h == 0.0) ++zero;
+    if (p.std_err == 0.0) ++zero;
   if (zero > 0)
     out.warnings.push_back(
         fmt::format("{}: {} position{} show no scatter at all between revolutions: a "
@@ -182,8 +182,8 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.beta_rad = p.beta_rad;
   rp.gamma_rad = p.gamma_rad;
   rp.counter_rate_offset_rad_s = p.counter_rate_offset_rad_s;
-  rp.mean_deg_h = d.gyro.value[k];
-  rp.std_err_deg_h = d.gyro.std_err[k];
+  rp.mean = d.gyro.value[k];
+  rp.std_err = d.gyro.std_err[k];
   rp.samples = d.gyro.samples[k];
   rp.outliers = d.gyro.outliers;
   rp.dwell = dwell_index;

@@ -69,19 +69,19 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
                                 {"beta_deg", p.beta_rad * kRadToDeg},
                                 {"gamma_deg", p.gamma_rad * kRadToDeg},
                                 {"rate_rad_s", p.rate_rad_s},
-                                {"mean", p.mean_deg_h},
-                                {"std_err", number_or_null(p.std_err_deg_h)},
+                                {"mean", p.mean},
+                                {"std_err", number_or_null(p.std_err)},
                                 {"unit", position_unit}};
     if (gyro) {
-      e["mean_deg_h"] = p.mean_deg_h;
-      e["std_err_deg_h"] = number_or_null(p.std_err_deg_h);
+      e["mean_deg_h"] = p.mean;
+      e["std_err_deg_h"] = number_or_null(p.std_err);
     }
     e["samples"] = p.samples;
     e["outliers"] = p.outliers;
     if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
-    if (i < r.residuals_deg_h.size()) {
-      e["residual"] = number_or_null(r.residuals_deg_h[i]);
-      if (gyro) e["residual_deg_h"] = number_or_null(r.residuals_deg_h[i]);
+    if (i < r.residuals.size()) {
+      e["residual"] = number_or_null(r.residuals[i]);
+      if (gyro) e["residual_deg_h"] = number_or_null(r.residuals[i]);
     }
     j["positions"].push_back(e);
   }

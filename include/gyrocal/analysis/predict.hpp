@@ -18,7 +18,7 @@ Reduction planned_reduction(const Scenario& scenario);
 /// Standard deviation of one sample's white rate noise, deg/h: N[deg/sqrt(h)] * 60 * sqrt(fs[Hz]).
 double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_hz);
 
-/// Set each position's mean_deg_h to its noise-free reduced output for `truth`:
+/// Set each position's mean to its noise-free reduced output for `truth`:
 /// reduce(omega_I exact) + sum_j truth_j reduce(x_j exact), and with rate errors (docs/physics.md section 15)
 /// e reduce(omega_I) + (1 + e)(dO reduce(omega_O) + dS reduce(omega_S)).
 void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
@@ -56,7 +56,7 @@ Eigen::MatrixXd predicted_noise_position_covariance(const Reduction& reduction, 
                                                     const GyroNoise& noise, double sample_rate_hz,
                                                     bool* complete = nullptr);
 
-/// Set each dwell's covariance and each position's std_err_deg_h to what white rate noise (the angle random
+/// Set each dwell's covariance and each position's std_err to what white rate noise (the angle random
 /// walk) predicts through the reduction operator. Bias instability and rate random walk are not in it: these
 /// are the weights (predict_calibration counts the rest in the uncertainties).
 void set_predicted_std_errors(Reduction& reduction, const GyroNoise& noise, double sample_rate_hz,

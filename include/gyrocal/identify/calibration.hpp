@@ -31,9 +31,11 @@ struct CalibrationOptions {
   SensorKind sensor = SensorKind::kGyro;
   ReduceOptions reduce;               ///< how dwells are reduced
   LeastSquaresOptions least_squares;  ///< the solver's options
-  /// Reduced positions whose standard error is below this (a noise-free record) are weighted with it,
-  /// deg/h. Default 1e-9.
-  double min_std_err_deg_h = 1e-9;
+  /// Reduced positions whose standard error is below this (a noise-free record) are weighted with it, in
+  /// the sensor's output unit: deg/h for a gyro, g for an accelerometer (an accelerometer's multiplied by its
+  /// output per g, identify/sensor_least_squares.cpp, so that the weights do not depend on the unit the
+  /// output is read in). Default 1e-9.
+  double min_std_err = 1e-9;
   /// A direction of the coefficients is unidentifiable when its predicted standard uncertainty is more
   /// than this many times that of the best-determined direction (both from the same weights, so the
   /// judgement does not depend on the noise level). Default 1e4.
@@ -174,7 +176,9 @@ struct CalibrationResult {
   std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
   std::vector<NamedEstimate> alternatives;  ///< closed form's second expressions (dI_1g, ...)
   std::vector<ReducedPosition> positions;   ///< the reduced positions
-  std::vector<double> residuals_deg_h;      ///< per position: W - model at the estimate (least squares)
+  /// Per position: W - model at the estimate (least squares), in the sensor's output unit: deg/h for a
+  /// gyro, g for an accelerometer.
+  std::vector<double> residuals;
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
   /// The unknowns of the least squares: the ten coefficients and the estimated machine errors' columns.

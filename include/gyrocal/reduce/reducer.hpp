@@ -121,8 +121,10 @@ struct ReducedPosition {
   double beta_rad = 0.0;    ///< planned beta
   double gamma_rad = 0.0;   ///< planned gamma
   double counter_rate_offset_rad_s = 0.0;  ///< planned counter rate offset (docs/physics.md section 15)
-  double mean_deg_h = 0.0;                 ///< reduced gyro output
-  double std_err_deg_h = 0.0;
+  /// The reduced output and its standard error, in the sensor's output unit: deg/h for a gyro, g for an
+  /// accelerometer (results name them `mean` and `std_err` with their `unit`).
+  double mean = 0.0;
+  double std_err = 0.0;
   std::size_t samples = 0;
   /// Outliers rejected in the dwell this position is reduced from (one fit reduces all its gammas).
   std::size_t outliers = 0;
