@@ -94,7 +94,7 @@ TEST(AccelerometerCalibration, SpinningDwellsKeepTheirWholeHarmonicContent) {
     for (std::size_t k = 0; k < 7; ++k)
       EXPECT_NEAR(d.gammas_rad[k], 2.0 * kPi * static_cast<double>(k) / 7.0, 1e-15);
     // A covariance of full rank: the seven values carry seven independent numbers.
-    ASSERT_EQ(d.gyro.covariance.rows(), 7);
+    ASSERT_EQ(d.output.covariance.rows(), 7);
   }
   EXPECT_EQ(spinning, 8u);
   EXPECT_EQ(holds, 16u);

@@ -238,17 +238,17 @@ TEST(AccelerometerMisfit, TheCounterPlatformCountedTheOtherWayIsNamed) {
       if (w.is_static) continue;
       const int n = static_cast<int>(w.gammas_rad.size());
       ASSERT_EQ(n, 7);
-      const DwellValues before = w.gyro;
+      const DwellValues before = w.output;
       for (int k = 0; k < n; ++k) {
         const int m = (n - k) % n;
-        w.gyro.value[k] = before.value[m];
-        w.gyro.std_err[k] = before.std_err[m];
-        for (int l = 0; l < n; ++l) w.gyro.covariance(k, l) = before.covariance(m, (n - l) % n);
+        w.output.value[k] = before.value[m];
+        w.output.std_err[k] = before.std_err[m];
+        for (int l = 0; l < n; ++l) w.output.covariance(k, l) = before.covariance(m, (n - l) % n);
       }
       for (ReducedPosition& p : r.positions)
         if (p.dwell == static_cast<int>(d)) {
-          p.mean = w.gyro.value[static_cast<std::size_t>(p.gamma_slot)];
-          p.std_err = w.gyro.std_err[static_cast<std::size_t>(p.gamma_slot)];
+          p.mean = w.output.value[static_cast<std::size_t>(p.gamma_slot)];
+          p.std_err = w.output.std_err[static_cast<std::size_t>(p.gamma_slot)];
         }
     }
   };

@@ -203,8 +203,8 @@ TEST(Misfit, TheCounterPlatformCountedTheOtherWayIsNamedOrFitsConsistently) {
     ReducedPosition& a = at(static_cast<int>(d), 90.0);
     ReducedPosition& b = at(static_cast<int>(d), 270.0);
     std::swap(a.mean, b.mean);
-    std::swap(r.dwells[d].gyro.value[static_cast<std::size_t>(a.gamma_slot)],
-              r.dwells[d].gyro.value[static_cast<std::size_t>(b.gamma_slot)]);
+    std::swap(r.dwells[d].output.value[static_cast<std::size_t>(a.gamma_slot)],
+              r.dwells[d].output.value[static_cast<std::size_t>(b.gamma_slot)]);
   }
   try {
     const CalibrationResult c = identify(r, reduce_model_channels(r, s.model(), {}), s.model(), {});

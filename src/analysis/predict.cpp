@@ -45,9 +45,9 @@ Reduction planned_reduction(const Scenario& s) {
     const JointState j = joint_state_at(timeline, d.first_time_s);
     d.main = {j.main_angle_rad, j.main_rate_rad_s, 0.0};
     d.counter = {j.counter_angle_rad, j.counter_rate_rad_s, 0.0};
-    d.gyro.value.assign(d.gammas_rad.size(), 0.0);
-    d.gyro.std_err.assign(d.gammas_rad.size(), 0.0);
-    d.gyro.samples.assign(d.gammas_rad.size(), d.samples);
+    d.output.value.assign(d.gammas_rad.size(), 0.0);
+    d.output.std_err.assign(d.gammas_rad.size(), 0.0);
+    d.output.samples.assign(d.gammas_rad.size(), d.samples);
     out.dwells.push_back(d);
   }
   for (const Position& p : test_positions(s.test)) {
@@ -532,7 +532,7 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
       predicted_position_covariance(r, options, white_noise_sample_std_deg_h(noise, sample_rate_hz));
   for (Dwell& d : r.dwells) {
     const auto ng = static_cast<Eigen::Index>(d.gammas_rad.size());
-    d.gyro.covariance = Eigen::MatrixXd::Zero(ng, ng);
+    d.output.covariance = Eigen::MatrixXd::Zero(ng, ng);
   }
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     ReducedPosition& a = r.positions[i];
@@ -540,14 +540,14 @@ void set_predicted_std_errors(Reduction& r, const GyroNoise& noise, double sampl
     for (std::size_t j = 0; j < r.positions.size(); ++j) {
       const ReducedPosition& b = r.positions[j];
       if (a.dwell == b.dwell)
-        r.dwells[static_cast<std::size_t>(a.dwell)].gyro.covariance(a.gamma_slot, b.gamma_slot) =
+        r.dwells[static_cast<std::size_t>(a.dwell)].output.covariance(a.gamma_slot, b.gamma_slot) =
             cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
     }
   }
   for (Dwell& d : r.dwells)
     for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
-      d.gyro.std_err[k] =
-          std::sqrt(d.gyro.covariance(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
+      d.output.std_err[k] =
+          std::sqrt(d.output.covariance(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
 }
 
 NoiseAllanVariances noise_allan_variances(const GyroNoise& noise, double tau_s) {

@@ -97,7 +97,7 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
     q.beyond_planned_rows = d.quality.beyond_planned_rows;
     q.encoder_glitch_rows = d.quality.encoder_glitch_rows;
     q.before_leaving_rows = d.quality.before_leaving_rows;
-    q.outliers = d.gyro.outliers;
+    q.outliers = d.output.outliers;
     q.gaps = d.gaps;
     q.ended = d.quality.ended;
     r.data_quality.dwells.push_back(q);

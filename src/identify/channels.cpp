@@ -505,7 +505,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     } else {
       // The dwell's own samples, stretch by stretch (gaps and dropped rows as the gyro output has them).
       BasisAngleCursor basis(d.basis_angle);
-      LeftOutSamples left_out(d.gyro.outlier_samples);
+      LeftOutSamples left_out(d.output.outlier_samples);
       std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];

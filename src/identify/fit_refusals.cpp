@@ -84,7 +84,7 @@ void refuse_repeated_positions(const Reduction& reduction) {
 void refuse_covariance(const Reduction& reduction, const ReduceOptions& reduce) {
   const auto& ps = reduction.positions;
   for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
-    const Eigen::MatrixXd& c = reduction.dwells[d].gyro.covariance;
+    const Eigen::MatrixXd& c = reduction.dwells[d].output.covariance;
     if (c.size() == 0 || Eigen::LLT<Eigen::MatrixXd>(c).info() == Eigen::Success) continue;
     if (!reduction.dwells[d].is_static)
       refuse_gammas_beyond_fit(reduction.dwells[d].gammas_rad.size(), reduce);

@@ -36,8 +36,8 @@ std::optional<Reduction> permute_outputs(const Reduction& r, const std::vector<i
   for (std::size_t d = 0; d < r.dwells.size(); ++d) {
     const int p = partner[d];
     if (p < 0) return std::nullopt;
-    const DwellValues& from = r.dwells[static_cast<std::size_t>(p)].gyro;
-    DwellValues& to = out.dwells[d].gyro;
+    const DwellValues& from = r.dwells[static_cast<std::size_t>(p)].output;
+    DwellValues& to = out.dwells[d].output;
     const std::vector<int>& map = slot_map[d];
     to = from;
     for (std::size_t k = 0; k < map.size(); ++k) {
@@ -148,8 +148,8 @@ double weight_dof(const Reduction& reduction) {
   double sum = 0.0;
   bool measured = false;
   for (const Dwell& d : reduction.dwells)
-    if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0) {
-      sum += d.gyro.dof;
+    if (std::isfinite(d.output.dof) && d.output.dof > 0.0) {
+      sum += d.output.dof;
       measured = true;
     }
   return measured ? sum : std::numeric_limits<double>::infinity();
@@ -177,10 +177,10 @@ Reduction scale_outputs(const Reduction& reduction, double factor) {
     p.std_err *= a;
   }
   for (Dwell& d : out.dwells) {
-    for (double& v : d.gyro.value) v *= factor;
-    for (double& v : d.gyro.std_err) v *= a;
-    d.gyro.covariance *= factor * factor;
-    d.gyro.level *= factor * factor;
+    for (double& v : d.output.value) v *= factor;
+    for (double& v : d.output.std_err) v *= a;
+    d.output.covariance *= factor * factor;
+    d.output.level *= factor * factor;
   }
   return out;
 }
@@ -309,7 +309,7 @@ std::string saturation_cause(const Reduction& reduction, const OutputRange& rang
   for (std::size_t d = 0; d < reduction.dwells.size(); ++d) {
     const Dwell& w = reduction.dwells[d];
     if (w.samples == 0) continue;
-    const double fraction = static_cast<double>(w.gyro.outliers) / static_cast<double>(w.samples);
+    const double fraction = static_cast<double>(w.output.outliers) / static_cast<double>(w.samples);
     if (fraction > worst_fraction) worst = d, worst_fraction = fraction;
   }
   if (worst < reduction.dwells.size())

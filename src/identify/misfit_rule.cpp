@@ -210,7 +210,7 @@ std::optional<Reduction> shift_counter_zero(const Reduction& r, double offset_ra
     const Dwell& w = r.dwells[d];
     if (w.is_static) continue;
     const auto n = static_cast<Eigen::Index>(w.gammas_rad.size());
-    if (n < 3 || n % 2 == 0 || static_cast<Eigen::Index>(w.gyro.value.size()) != n) return std::nullopt;
+    if (n < 3 || n % 2 == 0 || static_cast<Eigen::Index>(w.output.value.size()) != n) return std::nullopt;
     for (Eigen::Index k = 0; k < n; ++k)
       if (std::abs(w.gammas_rad[static_cast<std::size_t>(k)] -
                    2.0 * kPi * static_cast<double>(k) / static_cast<double>(n)) > 1e-9)
@@ -225,17 +225,17 @@ std::optional<Reduction> shift_counter_zero(const Reduction& r, double offset_ra
         for (int h = 1; h <= order; ++h) kernel += 2.0 * std::cos(h * x);
         m(k, j) = kernel / static_cast<double>(n);
       }
-    DwellValues& v = out.dwells[d].gyro;
-    const Eigen::VectorXd shifted = m * Eigen::Map<const Eigen::VectorXd>(w.gyro.value.data(), n);
+    DwellValues& v = out.dwells[d].output;
+    const Eigen::VectorXd shifted = m * Eigen::Map<const Eigen::VectorXd>(w.output.value.data(), n);
     for (Eigen::Index k = 0; k < n; ++k) v.value[static_cast<std::size_t>(k)] = shifted[k];
-    if (w.gyro.covariance.rows() == n) {
-      v.covariance = m * w.gyro.covariance * m.transpose();
+    if (w.output.covariance.rows() == n) {
+      v.covariance = m * w.output.covariance * m.transpose();
       for (Eigen::Index k = 0; k < n && static_cast<std::size_t>(k) < v.std_err.size(); ++k)
         v.std_err[static_cast<std::size_t>(k)] = std::sqrt(v.covariance(k, k));
     }
   }
   for (ReducedPosition& q : out.positions) {
-    const DwellValues& v = out.dwells[static_cast<std::size_t>(q.dwell)].gyro;
+    const DwellValues& v = out.dwells[static_cast<std::size_t>(q.dwell)].output;
     const auto k = static_cast<std::size_t>(q.gamma_slot);
     if (k < v.value.size()) q.mean = v.value[k];
     if (k < v.std_err.size() && std::isfinite(v.std_err[k])) q.std_err = v.std_err[k];

@@ -20,7 +20,7 @@ Eigen::MatrixXd position_covariance(const Reduction& r, double floor) {
     for (Eigen::Index j = 0; j < m; ++j) {
       const ReducedPosition& b = r.positions[static_cast<std::size_t>(j)];
       if (a.dwell != b.dwell) continue;
-      const Eigen::MatrixXd& dc = r.dwells[static_cast<std::size_t>(a.dwell)].gyro.covariance;
+      const Eigen::MatrixXd& dc = r.dwells[static_cast<std::size_t>(a.dwell)].output.covariance;
       const double v = dc.size() ? dc(a.gamma_slot, b.gamma_slot) : (i == j ? a.std_err * a.std_err : 0.0);
       c(i, j) = std::isfinite(v) ? v : 0.0;
     }
@@ -47,7 +47,7 @@ double student_factor(const Reduction& r, const Eigen::MatrixXd& c, const Eigen:
   double total = 0.0, spread = 0.0;
   for (std::size_t d = 0; d < share.size(); ++d) {
     total += share[d];
-    const double dof = r.dwells[d].gyro.dof;
+    const double dof = r.dwells[d].output.dof;
     if (std::isfinite(dof) && dof > 0.0) spread += share[d] * share[d] / dof;
   }
   *nu = std::numeric_limits<double>::infinity();
@@ -72,17 +72,17 @@ void warn_few_dof(double nu, const std::string& name, CalibrationResult& r) {
 Eigen::MatrixXd pooled_position_covariance(const Reduction& r, double floor) {
   double sum = 0.0, dof = 0.0;
   for (const Dwell& d : r.dwells)
-    if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0 && std::isfinite(d.gyro.level)) {
-      sum += d.gyro.dof * d.gyro.level;
-      dof += d.gyro.dof;
+    if (std::isfinite(d.output.dof) && d.output.dof > 0.0 && std::isfinite(d.output.level)) {
+      sum += d.output.dof * d.output.level;
+      dof += d.output.dof;
     }
   Reduction pooled;
   pooled.positions = r.positions;
   pooled.dwells = r.dwells;
   if (dof > 0.0 && sum > 0.0) {
     for (Dwell& d : pooled.dwells)
-      if (std::isfinite(d.gyro.dof) && d.gyro.dof > 0.0 && d.gyro.level > 0.0) {
-        d.gyro.covariance *= (sum / dof) / d.gyro.level;
+      if (std::isfinite(d.output.dof) && d.output.dof > 0.0 && d.output.level > 0.0) {
+        d.output.covariance *= (sum / dof) / d.output.level;
       }
   }
   return position_covariance(pooled, floor);

@@ -40,7 +40,7 @@ std::optional<Reduction> residual_levels(const Reduction& reduction,
     s[static_cast<std::size_t>(p.gamma_slot)] = i;
   }
   for (std::size_t di = 0; di < out.dwells.size(); ++di) {
-    DwellValues& v = out.dwells[di].gyro;
+    DwellValues& v = out.dwells[di].output;
     const std::vector<std::size_t>& s = slots[di];
     if (v.periods.empty() || s.size() != v.value.size() ||
         std::any_of(s.begin(), s.end(),

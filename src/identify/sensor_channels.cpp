@@ -150,7 +150,7 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
       // Following the measured motion, the operator's angle is the output's own (Dwell::basis_angle): where
       // a ripple bends the counter encoder's line window by window, the dwell's one line is not it.
       BasisAngleCursor basis(d.basis_angle);
-      LeftOutSamples left_out(d.gyro.outlier_samples);
+      LeftOutSamples left_out(d.output.outlier_samples);
       std::size_t first_sample = 0;
       for (std::size_t si = 0; si < d.stretches.size(); ++si) {
         const TimeStretch& s = d.stretches[si];

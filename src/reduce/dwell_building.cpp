@@ -144,16 +144,16 @@ void Reducer::State::finish_run(Run& r) {
           ? fmt::format("dwell at {} rad/s, counter rate offset {} rad/s, beta {:.4f} deg",
                         d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, beta_deg)
           : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
-  d.gyro = r.acc->finish(0);
+  d.output = r.acc->finish(0);
   // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
   // at which clean noise reaches the rule's threshold).
   const std::string place = fmt::format("the {} at t = {:.3f} s", what, d.first_time_s);
-  if (static_cast<double>(d.gyro.outliers) > 0.01 * static_cast<double>(d.samples))
+  if (static_cast<double>(d.output.outliers) > 0.01 * static_cast<double>(d.samples))
     warnings.add("outliers",
                  fmt::format("{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} "
                              "robust standard deviations of the dwell's fit) and left out of it.",
-                             at(d.first_time_s), what, d.gyro.outliers, d.samples,
-                             100.0 * static_cast<double>(d.gyro.outliers) / static_cast<double>(d.samples),
+                             at(d.first_time_s), what, d.output.outliers, d.samples,
+                             100.0 * static_cast<double>(d.output.outliers) / static_cast<double>(d.samples),
                              options.outlier_threshold),
                  place);
   // Checks a test engineer wants to hear about.

@@ -87,7 +87,7 @@ Reduction Reducer::finish() {
     chosen[dwell_key(st.dwells[i])] = static_cast<int>(out.dwells.size());
     out.dwells.push_back(std::move(st.dwells[i]));
     out.samples_used += out.dwells.back().samples;
-    out.outliers += out.dwells.back().gyro.outliers;
+    out.outliers += out.dwells.back().output.outliers;
     out.gaps += out.dwells.back().gaps;
     out.encoder_glitch_rows += out.dwells.back().quality.encoder_glitch_rows;
   }
@@ -127,7 +127,7 @@ Reduction Reducer::finish() {
   // (docs/calibration.md, "Degrees of freedom").
   int zero = 0;
   for (const Dwell& d : out.dwells) {
-    if (d.gyro.dof > 0.0) continue;
+    if (d.output.dof > 0.0) continue;
     // The scatter is about a mean (and a drift), and at a counter rate offset also the heading's sweep.
     const int needed =
         d.is_static
@@ -135,11 +135,11 @@ Reduction Reducer::finish() {
             : (st.options.linear_drift ? 3 : 2) +
                   (heading_sweep_rad_s(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s) != 0.0 ? 2
                                                                                                          : 0);
-    if (d.gyro.revolutions >= needed) {
+    if (d.output.revolutions >= needed) {
       // Enough revolutions, but their scatter overflowed: outputs whose squares leave a double's range (a
       // record's reader refuses them, limits::kOutputMagnitude; a caller pushing samples may not have).
       double largest = 0.0;
-      for (double v : d.gyro.value)
+      for (double v : d.output.value)
         if (!(std::abs(v) <= largest)) largest = std::abs(v);
       throw Error(fmt::format(
           "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, but the scatter "
@@ -147,14 +147,14 @@ Reduction Reducer::finish() {
           "them is not a finite number: its outputs reach {:g}, whose squares leave a double's range (an "
           "output is at most {:g} in magnitude, limits::kOutputMagnitude).",
           st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
-          d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", largest,
+          d.beta_rad * kRadToDeg, d.output.revolutions, d.is_static ? "batches" : "revolutions", largest,
           limits::kOutputMagnitude));
     }
     throw Error(fmt::format(
         "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
         "error from the scatter between them; it needs at least {}{}.",
         st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
-        d.beta_rad * kRadToDeg, d.gyro.revolutions, d.is_static ? "batches" : "revolutions", needed,
+        d.beta_rad * kRadToDeg, d.output.revolutions, d.is_static ? "batches" : "revolutions", needed,
         d.is_static ? ""
         : st.options.method == ReduceOptions::Method::kWindowMean
             ? ": raise [test] revolutions (window means count a revolution only when it passes through every "
@@ -182,10 +182,10 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.beta_rad = p.beta_rad;
   rp.gamma_rad = p.gamma_rad;
   rp.counter_rate_offset_rad_s = p.counter_rate_offset_rad_s;
-  rp.mean = d.gyro.value[k];
-  rp.std_err = d.gyro.std_err[k];
-  rp.samples = d.gyro.samples[k];
-  rp.outliers = d.gyro.outliers;
+  rp.mean = d.output.value[k];
+  rp.std_err = d.output.std_err[k];
+  rp.samples = d.output.samples[k];
+  rp.outliers = d.output.outliers;
   rp.dwell = dwell_index;
   rp.gamma_slot = slot;
   return rp;

@@ -83,9 +83,11 @@ struct Dwell {
   AngleLine main;                   ///< theta(t), from the main-axis encoder (its first stretch's phase)
   AngleLine counter;                ///< psi_r(t), from the counter-platform encoder
   double planned_duration_s = 0.0;  ///< what the plan asked for the measured part
-  DwellValues gyro;                 ///< the reduced gyro output, deg/h, per gamma
+  /// The reduced output of the sensor, per gamma, in its output unit: deg/h for a gyro, g for an
+  /// accelerometer.
+  DwellValues output;
   /// The samples of the measured part, stretch by stretch: the grid on which the model's channels are
-  /// evaluated and reduced like the gyro output. Empty: `samples` evenly spaced instants (time_of_sample)
+  /// evaluated and reduced like the sensor's output. Empty: `samples` evenly spaced instants (time_of_sample)
   /// on the lines `main` and `counter` (a planned dwell, analysis/predict).
   std::vector<TimeStretch> stretches;
   /// The main axis' motion as its encoder measured it through the measured part (a spinning dwell of a
