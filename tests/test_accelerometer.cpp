@@ -480,14 +480,14 @@ TEST(GyroSensor, WrapsTheGyroModel) {
   const SensorInputs in = exact_inputs(s.model(), spinning_joint_state(s.model(), 9.9, 0.3, 1.234));
   EXPECT_EQ(g.output(in),
             sensed_rate_deg_h(g.rate, in.rate_rad_s) + drift_deg_h(g.drift, in.specific_force_g));
-  EXPECT_EQ(g.num_unknowns(), kNumCoefficients);
+  EXPECT_EQ(g.num_unknowns(), kNumGyroCoefficients);
   g.model = GyroModel::kDriftRate;
-  ASSERT_EQ(g.num_unknowns(), kNumCoefficients + kNumRateTerms);
-  EXPECT_TRUE(g.parameters()[kNumCoefficients].identified);
+  ASSERT_EQ(g.num_unknowns(), kNumGyroCoefficients + kNumRateTerms);
+  EXPECT_TRUE(g.parameters()[kNumGyroCoefficients].identified);
   // The products of the truth reproduce the output through the design row.
   const double e = g.rate.scale_factor_error_ppm;
   Eigen::VectorXd u(static_cast<Eigen::Index>(g.num_unknowns()));
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) u(static_cast<Eigen::Index>(k)) = g.drift.values[k];
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) u(static_cast<Eigen::Index>(k)) = g.drift.values[k];
   u(10) = e;
   u(11) = (1 + e * 1e-6) * g.rate.input_axis_misalignment_O_arcsec;
   u(12) = (1 + e * 1e-6) * g.rate.input_axis_misalignment_S_arcsec;

@@ -231,7 +231,7 @@ TEST(AcquisitionTiming, TheGyrosChannelsTakeTheDelayToo) {
   const CalibrationResult ignored = calibrate(s, reduction);
   double moved = 0.0;
   int identifiable = 0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     // One speed: dF and the dII, dOO, dSS are identifiable only in combinations (docs/physics.md section 8).
     if (!plain.coefficients[k].identifiable) continue;
     ++identifiable;

@@ -63,7 +63,7 @@ TEST(Calibrate, NoiseFreeDefaultScenarioFullCompensationRecoversTheTruth) {
   const CalibrationResult ls = calibrate(s, p, Method::kLeastSquares, Compensation::kFull);
   const CalibrationResult cf = calibrate(s, p, Method::kClosedForm, Compensation::kFull);
   EXPECT_NEAR(ls.g_level, ar, 1e-12);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const auto c = static_cast<Coefficient>(k);
     const bool single_speed_identifiable =
         c != Coefficient::dF && c != Coefficient::dII && c != Coefficient::dOO && c != Coefficient::dSS;
@@ -79,9 +79,9 @@ TEST(Calibrate, NoiseFreeDefaultScenarioFullCompensationRecoversTheTruth) {
   for (const NamedEstimate& e : ls.combinations) {
     // The combination least squares estimates is the named one to ~1e-6 relative (exact regressors tilt
     // the unidentifiable direction); its value is exact for its own coefficients.
-    ASSERT_EQ(e.coefficients.size(), kNumCoefficients);
+    ASSERT_EQ(e.coefficients.size(), kNumGyroCoefficients);
     double exact = 0;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) exact += e.coefficients[k] * s.gyro.values[k];
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) exact += e.coefficients[k] * s.gyro.values[k];
     EXPECT_NEAR(e.value, exact, 1e-6) << e.name;
     EXPECT_NEAR(e.value, combos.at(e.name), 1e-5) << e.name;
   }
@@ -133,7 +133,7 @@ TEST(Calibrate, TwoSpeedPlanIdentifiesAllTenCoefficients) {
     const CalibrationResult ls = calibrate(s, p, Method::kLeastSquares, Compensation::kFull);
     EXPECT_EQ(ls.rank, 10) << "second rate " << second;
     EXPECT_TRUE(ls.combinations.empty());
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       EXPECT_TRUE(ls.coefficients[k].identifiable) << kCoefficientNames[k];
       EXPECT_NEAR(ls.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k] << " " << second;
     }
@@ -179,7 +179,7 @@ TEST(Calibrate, UncertaintiesAreHonest) {
       o.method = m;
       const CalibrationResult r = identify(red, channels, s.model(), o);
       const std::string tag = m == Method::kLeastSquares ? "ls " : "cf ";
-      for (std::size_t k = 0; k < kNumCoefficients; ++k)
+      for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
         if (r.coefficients[k].identifiable)
           z[tag + std::string(kCoefficientNames[k])].push_back((r.coefficients[k].value - s.gyro.values[k]) /
                                                                r.coefficients[k].std);
@@ -212,7 +212,7 @@ TEST(Calibrate, WindowMeansReduceAsExactlyAsTheHarmonicFit) {
   CalibrationOptions o;
   o.reduce = ro;
   const CalibrationResult ls = identify(p.reduction, p.channels, s.model(), o);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (ls.coefficients[k].identifiable) {
       EXPECT_NEAR(ls.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];
     }

@@ -81,11 +81,11 @@ double worst_ratio(const Reduction& r, const std::vector<PositionChannels>& four
                              fourier[i].omega_seed_deg_h};
     std::vector<double> b = {every[i].omega_exact_deg_h, every[i].omega_nominal_deg_h,
                              every[i].omega_seed_deg_h};
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       a.push_back(fourier[i].regressors_exact[k]);
       b.push_back(every[i].regressors_exact[k]);
     }
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       a.push_back(fourier[i].regressors_nominal[k]);
       b.push_back(every[i].regressors_nominal[k]);
     }
@@ -133,7 +133,7 @@ TEST(FourierChannels, EqualTheEverySampleChannelsWithinTheirBoundOnAMachineWithL
   o.method = Method::kLeastSquares;
   o.compensation = Compensation::kFull;
   const CalibrationResult c = identify(r, fourier, s.model(), o);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     ASSERT_TRUE(c.coefficients[k].identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(c.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
   }

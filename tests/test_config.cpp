@@ -141,7 +141,7 @@ void expect_same(const Scenario& a, const Scenario& b) {
   expect_same(a.centrifuge.heading_rad, b.centrifuge.heading_rad, "centrifuge.heading");
   expect_same(a.centrifuge.initial_main_angle_rad, b.centrifuge.initial_main_angle_rad, "centrifuge.theta0");
   expect_same(a.errors, b.errors, "errors.");
-  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i) {
     expect_same(a.gyro.values[i], b.gyro.values[i], "gyro." + std::string(kCoefficientNames[i]));
   }
   expect_same(a.noise.angle_random_walk_deg_rt_h, b.noise.angle_random_walk_deg_rt_h, "noise.arw");
@@ -194,7 +194,8 @@ Scenario changed_scenario() {
   e.position_angle_error_rad = 3.7 * kArcsecToRad;
   e.mount_misalignment_rad = Eigen::Vector3d(10.0, -20.0, 30.5) * kArcsecToRad;
   e.lever_arm_m = Eigen::Vector3d(0.01, -0.02, 0.003);
-  for (std::size_t i = 0; i < kNumCoefficients; ++i) s.gyro.values[i] = 0.1 * static_cast<double>(i) - 0.37;
+  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i)
+    s.gyro.values[i] = 0.1 * static_cast<double>(i) - 0.37;
   s.noise = {0.01, 0.02, 0.03, 0.004, 0.005};
   s.test.sample_rate_hz = 1000.0;
   s.test.revolutions = 17;

@@ -111,7 +111,7 @@ TEST(SelfCalibration, NoiseFreeTwoSpeedsGivesTheMachineAndTheCoefficients) {
   }
   ASSERT_TRUE(r.machine_errors[2].identifiable) << r.machine_errors[2].reason;
   EXPECT_NEAR(r.machine_errors[2].value, expected[2], 1e-12);
-  for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+  for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
     ASSERT_TRUE(r.coefficients[c].identifiable) << kCoefficientNames[c];
     EXPECT_NEAR(r.coefficients[c].value, truth.gyro.values[c], 1e-7) << kCoefficientNames[c];
   }
@@ -203,7 +203,7 @@ TEST(SelfCalibration, NoisyZScoresHaveUnitSpread) {
   for (int seed = 1; seed <= seeds; ++seed) {
     const CalibrationResult r =
         self_calibrate(config, simulate_and_reduce(truth, static_cast<std::uint64_t>(seed)), kCounterErrors);
-    for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
       const double z = (r.coefficients[c].value - truth.gyro.values[c]) / r.coefficients[c].std;
       sum_coefficients += z * z;
       ++n_coefficients;
@@ -251,7 +251,7 @@ TEST(SelfCalibration, CompensationSelfRemovesTheCounterPlatformsErrorsFromTheStu
         row.term.error != "counter_rate_mismatch")
       continue;
     ++checked;
-    for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
       const std::string name(kCoefficientNames[c]);
       ASSERT_EQ(row.self.count(name), 1u) << row.term.error << " " << name;
       EXPECT_NEAR(row.self.at(name), 0.0, 1e-7) << row.term.error << " " << name;

@@ -75,15 +75,15 @@ std::array<double, 3> nominal_force(const Scenario& s, double rate, double beta,
 
 /// The coefficients whose regressor is zero at every position of the plan (below 1e-6 g^degree).
 std::vector<bool> never_excited(const Scenario& s) {
-  std::vector<bool> zero(kNumCoefficients, true);
+  std::vector<bool> zero(kNumGyroCoefficients, true);
   zero[0] = false;
   for (double w : s.test.rates_rad_s)
     for (double b : s.test.beta_rad)
       for (double g : s.test.gamma_rad) {
         const auto [ai, ao, as] = nominal_force(s, w, b, g);
-        const double x[kNumCoefficients] = {1,       ai,      ao,      as,      ai * ai,
-                                            ao * ao, as * as, ai * ao, ai * as, ao * as};
-        for (std::size_t k = 1; k < kNumCoefficients; ++k)
+        const double x[kNumGyroCoefficients] = {1,       ai,      ao,      as,      ai * ai,
+                                                ao * ao, as * as, ai * ao, ai * as, ao * as};
+        for (std::size_t k = 1; k < kNumGyroCoefficients; ++k)
           if (std::abs(x[k]) > 1e-6) zero[k] = false;
       }
   return zero;
@@ -107,7 +107,7 @@ void expect_honest(const Scenario& s, const CalibrationResult& r, bool noisy, co
   SCOPED_TRACE(plan + (noisy ? ", noisy record" : ", noise-free record"));
   const DriftCoefficients& truth = s.gyro;
   // Every coefficient reported identifiable lands on the truth (a few sigma; noise-free: 1e-5 more).
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const CoefficientEstimate& e = r.coefficients[k];
     if (!e.identifiable) continue;
     ASSERT_TRUE(std::isfinite(e.std)) << kCoefficientNames[k];
@@ -116,16 +116,16 @@ void expect_honest(const Scenario& s, const CalibrationResult& r, bool noisy, co
   }
   // A coefficient whose regressor is zero in every position is never identifiable.
   const std::vector<bool> zero = never_excited(s);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (zero[k]) {
       EXPECT_FALSE(r.coefficients[k].identifiable) << kCoefficientNames[k] << " is never excited";
     }
   // Every combination is what its coefficients say, and a named one is the named combination.
   const auto named = named_definitions(r.g_level);
   for (const NamedEstimate& c : r.combinations) {
-    ASSERT_EQ(c.coefficients.size(), kNumCoefficients) << c.name;
+    ASSERT_EQ(c.coefficients.size(), kNumGyroCoefficients) << c.name;
     double value = 0.0, size = 0.0;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       value += c.coefficients[k] * truth.values[k];
       size += std::abs(c.coefficients[k] * truth.values[k]);
     }
@@ -134,7 +134,7 @@ void expect_honest(const Scenario& s, const CalibrationResult& r, bool noisy, co
     const auto it = named.find(c.name);
     if (it == named.end()) continue;
     double largest = 0.0, off = 0.0;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       largest = std::max(largest, std::abs(it->second[k]));
       off = std::max(off, std::abs(c.coefficients[k] - it->second[k]));
     }
@@ -237,7 +237,7 @@ TEST(ClosedForm, ReportsItsConditionAndWhatItGivesAwayAgainstLeastSquares) {
   EXPECT_NEAR(cf.condition_number, ls.condition_number, 1e-9 * ls.condition_number);
   // The amplification is the worst ratio of the closed form's std to least squares' for the same quantity.
   double worst = 0.0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (cf.coefficients[k].identifiable && ls.coefficients[k].identifiable)
       worst = std::max(worst, cf.coefficients[k].std / ls.coefficients[k].std);
   for (const NamedEstimate& a : cf.combinations)

@@ -271,7 +271,7 @@ TEST(MeasuredRate, ACalibrationOnARippledRecordRecoversTheTruthWithTheSameUncert
                     o);
   };
   const CalibrationResult smooth = calibrate(0.0), rippled = calibrate(2e-4);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const CoefficientEstimate& e = rippled.coefficients[k];
     ASSERT_TRUE(e.identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(e.value, s.gyro.values[k], 4.0 * e.std) << kCoefficientNames[k];

@@ -286,7 +286,7 @@ TEST(PlanCost, BoundedModelEvaluationsAgreeWithEveryRevolutionsOnALongTest) {
   ASSERT_EQ(capped.size(), every.size());
   for (std::size_t i = 0; i < every.size(); ++i) {
     EXPECT_NEAR(capped[i].omega_exact_deg_h, every[i].omega_exact_deg_h, 1e-7 * 50.0) << i;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       EXPECT_NEAR(capped[i].regressors_exact[k], every[i].regressors_exact[k],
                   1e-7 * std::max(1.0, std::abs(every[i].regressors_exact[k])))
           << i << " " << k;

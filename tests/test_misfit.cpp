@@ -67,7 +67,7 @@ Scenario default_30() {
 /// The largest |estimate - truth| / std over the identifiable coefficients.
 double worst_z(const Scenario& s, const CalibrationResult& r) {
   double worst = 0.0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (r.coefficients[k].identifiable)
       worst = std::max(worst, std::abs(r.coefficients[k].value - s.gyro.values[k]) / r.coefficients[k].std);
   return worst;
@@ -224,19 +224,19 @@ TEST(Misfit, AModestTemperatureDriftIsAcceptedWithHonestUncertainties) {
   const Scenario s = default_30();
   const Fault drift = [](RecordSample& x) { x.output += 0.5 / 3600.0 * x.time_s; };
   const int seeds = 100;
-  std::vector<std::vector<double>> z(kNumCoefficients);
+  std::vector<std::vector<double>> z(kNumGyroCoefficients);
   int scaled = 0;
   for (int seed = 0; seed < seeds; ++seed) {
     const Outcome out = calibrate_with(s, 2000 + static_cast<std::uint64_t>(seed), drift);
     ASSERT_FALSE(out.refused) << out.message;
     scaled += out.result.misfit.scale > 1.0;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       if (out.result.coefficients[k].identifiable)
         z[k].push_back((out.result.coefficients[k].value - s.gyro.values[k]) /
                        out.result.coefficients[k].std);
   }
   std::printf("temperature drift 0.5 deg/h per hour: %d of %d records scaled\n", scaled, seeds);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     if (z[k].empty()) continue;
     const double sd = std_of(z[k]);
     std::printf("  std of z for %s: %.3f\n", std::string(kCoefficientNames[k]).c_str(), sd);
@@ -263,7 +263,7 @@ TEST(Misfit, ALargeDriftScalesEveryStdAndSaysSo) {
     for (const std::string& w : r.warnings)
       warned |= w.find("every std is multiplied by") != std::string::npos;
     EXPECT_TRUE(warned);
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       if (r.coefficients[k].identifiable)
         z.push_back((r.coefficients[k].value - s.gyro.values[k]) / r.coefficients[k].std);
   }

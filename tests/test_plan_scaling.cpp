@@ -78,7 +78,7 @@ void expect_channels_equal(const Scenario& s, const std::string& what) {
     rate(closed[i].omega_S_exact_deg_h, summed[i].omega_S_exact_deg_h, "omega S");
     double largest = 1.0;
     for (double v : summed[i].regressors_exact) largest = std::max(largest, std::abs(v));
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       check(closed[i].regressors_exact[k], summed[i].regressors_exact[k], largest, "regressor exact");
       check(closed[i].regressors_nominal[k], summed[i].regressors_nominal[k], largest, "regressor nominal");
     }
@@ -157,7 +157,7 @@ TEST(PlanScaling, TwoMillionRevolutionsScaleAsTheSums) {
   const CalibrationResult small = plan_of(200), big = plan_of(2000000);
   const double scale = std::sqrt(200.0 / 2e6);
   ASSERT_EQ(small.coefficients.size(), big.coefficients.size());
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const CoefficientEstimate &a = small.coefficients[k], &b = big.coefficients[k];
     ASSERT_EQ(a.identifiable, b.identifiable) << kCoefficientNames[k];
     if (!a.identifiable) continue;

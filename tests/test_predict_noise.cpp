@@ -49,7 +49,7 @@ TEST(PredictNoise, WithoutColouredNoiseTheGainRouteEqualsTheWhiteNoisePrediction
   // same covariance it must give identify's own standard uncertainties.
   const CalibrationResult white = predict_calibration(coloured_scenario(0.0, 0.0), CalibrationOptions{});
   const CalibrationResult both = predict_calibration(coloured_scenario(1e-12, 0.0), CalibrationOptions{});
-  for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+  for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
     if (!white.coefficients[c].identifiable) continue;
     EXPECT_NEAR(both.coefficients[c].std, white.coefficients[c].std, 1e-9 * white.coefficients[c].std)
         << kCoefficientNames[c];
@@ -72,15 +72,15 @@ TEST(PredictNoise, PredictedStdMatchesTheScatterWhenBiasInstabilityAndRateRandom
   const CalibrationResult predicted = predict_calibration(s, CalibrationOptions{});
   const CalibrationResult white_only = predict_calibration(coloured_scenario(0.0, 0.0), CalibrationOptions{});
   const int seeds = sanitized() ? 60 : 400;
-  std::vector<std::vector<double>> values(kNumCoefficients);
+  std::vector<std::vector<double>> values(kNumGyroCoefficients);
   for (int seed = 1; seed <= seeds; ++seed) {
     const CalibrationResult r = calibrate_simulated(s, static_cast<std::uint64_t>(seed));
-    for (std::size_t c = 0; c < kNumCoefficients; ++c)
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c)
       if (r.coefficients[c].identifiable) values[c].push_back(r.coefficients[c].value);
   }
   double sum_ratio2 = 0.0, sum_white_ratio2 = 0.0;
   int count = 0;
-  for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+  for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
     if (!predicted.coefficients[c].identifiable) continue;
     ASSERT_EQ(values[c].size(), static_cast<std::size_t>(seeds)) << kCoefficientNames[c];
     double mean = 0.0;
@@ -116,7 +116,7 @@ TEST(PredictNoise, FastMonteCarloDrawsTheSameNoise) {
   const std::size_t columns = m.sources.size() + static_cast<std::size_t>(m.positions);
   int compared = 0;
   for (std::size_t i = 0; i < m.names.size(); ++i)
-    for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
       if (m.names[i] != kCoefficientNames[c] || !predicted.coefficients[c].identifiable) continue;
       double variance = 0.0;
       for (std::size_t k = m.sources.size(); k < columns; ++k)

@@ -203,7 +203,7 @@ TEST(RatePlatformCalibrate, NoiseFreeRecoversScaleFactorMisalignmentsAndTheDrift
   const Pipeline p = run(s);
   const CalibrationResult r = identify_with(s, p, GyroModel::kDriftRate);
   EXPECT_EQ(r.rank, 13);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     ASSERT_TRUE(r.coefficients[k].identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(r.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
   }
@@ -293,10 +293,10 @@ TEST(RatePlatformCalibrate, ARateTableAloneGivesTheScaleFactorAndTheBias) {
     for (const NamedEstimate& c : r.combinations) {
       if (c.coefficients.empty() || c.coefficients[0] == 0.0) continue;
       double truth = 0.0;
-      for (std::size_t k = 0; k < kNumCoefficients; ++k) truth += c.coefficients[k] * s.gyro.values[k];
-      for (std::size_t k = 0; k < kNumRateTerms && kNumCoefficients + k < c.coefficients.size(); ++k) {
+      for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) truth += c.coefficients[k] * s.gyro.values[k];
+      for (std::size_t k = 0; k < kNumRateTerms && kNumGyroCoefficients + k < c.coefficients.size(); ++k) {
         const double v[3] = {150.0, -25.0, 40.0};
-        truth += c.coefficients[kNumCoefficients + k] * v[k];
+        truth += c.coefficients[kNumGyroCoefficients + k] * v[k];
       }
       EXPECT_NEAR(c.value, truth, 1e-6) << c.name;
       found = true;
@@ -346,7 +346,7 @@ TEST(RatePlatformCalibrate, ClosedFormUsesTheSixteenPositionsAtOffsetZeroAndSays
   Scenario plain = s;
   plain.test.counter_rate_offsets_rad_s = {0.0};
   const CalibrationResult ref = identify_with(plain, run(plain), GyroModel::kDrift, Method::kClosedForm);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     EXPECT_EQ(cf.coefficients[k].identifiable, ref.coefficients[k].identifiable);
     if (ref.coefficients[k].identifiable) {
       EXPECT_NEAR(cf.coefficients[k].value, ref.coefficients[k].value, 1e-9) << kCoefficientNames[k];

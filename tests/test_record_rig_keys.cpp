@@ -171,7 +171,7 @@ main_angle_offset_deg = {3}
   const test::CliOutcome c = test::calibrate_in(dir, "rig.csv", scenario_to_toml(s) + mapping);
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const nlohmann::json& e = j.at("coefficients").at(std::string(kCoefficientNames[k]));
     ASSERT_TRUE(e.at("identifiable").get<bool>()) << kCoefficientNames[k];
     const double std = e.at("std").get<double>();
@@ -188,7 +188,7 @@ main_angle_offset_deg = {3}
   if (off.status == 0) {
     const nlohmann::json o = nlohmann::json::parse(off.out);
     std_scale = o.at("misfit").at("std_scale").get<double>();
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       const nlohmann::json& e = o.at("coefficients").at(std::string(kCoefficientNames[k]));
       if (!e.at("identifiable").get<bool>()) continue;
       worst_z = std::max(

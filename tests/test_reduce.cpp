@@ -110,7 +110,7 @@ TEST(Spikes, OneSampleNeverMovesAnEstimateAndIsCounted) {
       EXPECT_EQ(quality.at("gaps").get<std::size_t>(), 0u) << tag;
       EXPECT_TRUE(std::isfinite(c.result.chi2)) << tag;
       EXPECT_LT(c.result.chi2, 5.0 * (c.result.dof + 3.0 * std::sqrt(2.0 * c.result.dof))) << tag;
-      for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+      for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
         const CoefficientEstimate& e = c.result.coefficients[k];
         const CoefficientEstimate& e0 = ref.result.coefficients[k];
         ASSERT_EQ(e.identifiable, e0.identifiable) << tag;
@@ -140,7 +140,7 @@ TEST(Spikes, ANoiseFreeRecordWithASpikeIsIdentifiedExactly) {
   }
   const Calibrated c = calibrate_rows(s, rows);
   EXPECT_EQ(c.reduction.outliers, 4u);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     if (c.result.coefficients[k].identifiable) {
       EXPECT_NEAR(c.result.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];
     }
@@ -178,7 +178,7 @@ TEST(Spikes, CleanNoisyRecordsLoseNoSamplesAndKeepTheirEstimates) {
       const Calibrated a = calibrate_rows(s, rows, with), b = calibrate_rows(s, rows, without);
       EXPECT_EQ(a.reduction.outliers, 0u) << seed << " " << k.rate_hz;
       used += a.reduction.samples_used;
-      for (std::size_t c = 0; c < kNumCoefficients; ++c) {
+      for (std::size_t c = 0; c < kNumGyroCoefficients; ++c) {
         if (!b.result.coefficients[c].identifiable) continue;
         const double std = b.result.coefficients[c].std;
         EXPECT_NEAR(a.result.coefficients[c].value, b.result.coefficients[c].value, 1e-9 * std)
@@ -223,7 +223,7 @@ TEST(Spikes, AStaticHoldRejectsASpikeToo) {
   rows[row_at(rows, 0.5 * (hold.start_s + hold.end_s))].output = -1e6;
   const Calibrated c = calibrate_rows(s, rows);
   EXPECT_EQ(c.reduction.outliers, 1u);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (ref.result.coefficients[k].identifiable) {
       EXPECT_NEAR(c.result.coefficients[k].value, ref.result.coefficients[k].value,
                   0.1 * ref.result.coefficients[k].std)
@@ -296,7 +296,7 @@ std::map<std::string, double> z_spread(const Scenario& s, int trials, Method met
     CalibrationOptions o;
     o.method = method;
     const CalibrationResult r = identify(red, channels, s.model(), o);
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       if (r.coefficients[k].identifiable)
         z[std::string(kCoefficientNames[k])].push_back((r.coefficients[k].value - d.values[k]) /
                                                        r.coefficients[k].std);
@@ -427,7 +427,7 @@ TEST(RigRecord, EachImperfectionAloneAndAllTogetherCalibrateToTheTruth) {
       continue;
     }
     EXPECT_EQ(c.reduction.dwells.size(), 8u) << name;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       const CoefficientEstimate& e = c.result.coefficients[k];
       ASSERT_TRUE(e.identifiable) << name << " " << kCoefficientNames[k];
       EXPECT_NEAR(e.value, s.gyro.values[k], 4.0 * e.std) << name << " " << kCoefficientNames[k];
@@ -465,17 +465,17 @@ TEST(RigRecord, UncertaintiesDescribeTheSpreadOverSeeds) {
   const Scenario s = rig_scenario();
   const testing::RigImperfections all = rig_cases().at("all together");
   const int seeds = sanitized() ? 100 : 250;
-  std::vector<std::vector<double>> z(kNumCoefficients);
+  std::vector<std::vector<double>> z(kNumGyroCoefficients);
   // No good record is refused (a refusal throws here: docs/calibration.md, "When the residuals misfit");
   // one in a thousand may have its std scaled by chance.
   int scaled = 0;
   for (int seed = 0; seed < seeds; ++seed) {
     const Calibrated c = calibrate_rows(s, rig_record(s, all, 1000 + static_cast<std::uint64_t>(seed)));
     scaled += c.result.misfit.scale > 1.0;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       z[k].push_back((c.result.coefficients[k].value - s.gyro.values[k]) / c.result.coefficients[k].std);
   }
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     double mean = 0, var = 0;
     for (double x : z[k]) mean += x;
     mean /= static_cast<double>(z[k].size());
@@ -539,7 +539,7 @@ TEST(Exactness, ANoiseFreeTwoSpeedRecordWithLargeMachineErrorsIsExactByDefault) 
   e.position_angle_error_rad = 3e-4;
   const std::vector<RecordSample> rows = record_of(s, 1);
   const Calibrated c = calibrate_rows(s, rows);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     ASSERT_TRUE(c.result.coefficients[k].identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(c.result.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
   }
@@ -549,7 +549,7 @@ TEST(Exactness, ANoiseFreeTwoSpeedRecordWithLargeMachineErrorsIsExactByDefault) 
   strided.model_samples_per_revolution = 32;
   const Calibrated b = calibrate_rows(s, rows, strided);
   double worst = 0.0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     worst = std::max(worst, std::abs(b.result.coefficients[k].value - s.gyro.values[k]));
   std::printf("strided channel grid: largest coefficient error %.3g\n", worst);
   EXPECT_GT(worst, 1e-7);

@@ -79,7 +79,7 @@ Reduction reduce_rows(const Scenario& s, const std::vector<testing::RigRow>& row
 /// equation commutes with the reduction).
 double model_output_deg_h(const Scenario& s, const PositionChannels& ch) {
   double y = ch.omega_exact_deg_h;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) y += s.gyro.values[k] * ch.regressors_exact[k];
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) y += s.gyro.values[k] * ch.regressors_exact[k];
   return y;
 }
 

@@ -81,7 +81,7 @@ TEST(RigRecord, EveryImperfectionAtOnceInTheRigsLayoutCalibratesToTheTruthThroug
   const test::CliOutcome c = calibrate_in(dir, "rig.csv", scenario_to_toml(s) + kMapping);
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const nlohmann::json& e = j.at("coefficients").at(std::string(kCoefficientNames[k]));
     ASSERT_TRUE(e.at("identifiable").get<bool>()) << kCoefficientNames[k];
     const double value = e.at("value").get<double>(), std = e.at("std").get<double>();
@@ -137,7 +137,7 @@ TEST(RigRecord, ARateToleranceSetInTheConfigurationChangesWhatTheReducerAccepts)
   const test::CliOutcome c = calibrate_in(dir, "rig.csv", with_reduce_line(s, "rate_tolerance", "5e-3"));
   ASSERT_EQ(c.status, 0) << c.err;
   const nlohmann::json j = nlohmann::json::parse(c.out);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     const nlohmann::json& e = j.at("coefficients").at(std::string(kCoefficientNames[k]));
     ASSERT_TRUE(e.at("identifiable").get<bool>()) << kCoefficientNames[k];
     EXPECT_NEAR(e.at("value").get<double>(), s.gyro.values[k], 4.0 * e.at("std").get<double>())

@@ -256,7 +256,7 @@ TEST(Simulate, RecordIsValidWithItsMetadata) {
   EXPECT_EQ(meta["radius_m"], "1");
   EXPECT_EQ(meta["samples"], std::to_string(summary.samples));
   // The truth reads back bit for bit.
-  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i) {
     const std::string key = "truth_" + std::string(kCoefficientNames[i]);
     ASSERT_TRUE(meta.count(key)) << key;
     EXPECT_EQ(std::stod(meta[key]), s.gyro.values[i]) << key;

@@ -52,7 +52,7 @@ std::string result_table(const CalibrationResult& r) {
   for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
     out +=
         fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.identifiable ? c.value : NAN, c.std), c.unit);
-  for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k)
+  for (std::size_t k = 0; k < kNumGyroCoefficients && r.sensor == SensorKind::kGyro; ++k)
     out += fmt::format("{:<16} {:>30}  {}\n", kCoefficientNames[k],
                        value_std(r.coefficients[k].value, r.coefficients[k].std), kCoefficientUnits[k]);
   if (r.gyro_model == GyroModel::kDriftRate) {  // docs/physics.md section 15
@@ -166,7 +166,7 @@ std::string comparison_table(const std::vector<std::string>& labels,
     if (!e.identifiable) return "—";
     return format_value_std(e.value, e.std);
   };
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     out += fmt::format("{:<16}", fmt::format("{} [{}]", kCoefficientNames[k], kCoefficientUnits[k]));
     if (truth) out += fmt::format("{:>10.6g}", truth->values[k]);
     for (const CalibrationResult& r : results) out += fmt::format("{:>{}}", cell(r, k), kWidth);
@@ -181,7 +181,7 @@ std::string comparison_table(const std::vector<std::string>& labels,
       if (truth) {
         // The truth of the combination: its reported coefficients applied to the true coefficients.
         double v = 0.0;
-        for (std::size_t k = 0; k < first.coefficients.size() && k < kNumCoefficients; ++k)
+        for (std::size_t k = 0; k < first.coefficients.size() && k < kNumGyroCoefficients; ++k)
           v += first.coefficients[k] * truth->values[k];
         out += fmt::format("{:>10.6g}", v);
       }

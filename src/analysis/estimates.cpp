@@ -17,7 +17,7 @@ std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Sc
   std::vector<double> table_truth;
   if (r.sensor == SensorKind::kGyro) {
     table_truth.assign(truth.gyro.values.begin(), truth.gyro.values.end());
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       if (r.coefficients[k].identifiable)
         out.push_back({std::string(kCoefficientNames[k]), std::string(kCoefficientUnits[k]),
                        r.coefficients[k].value, r.coefficients[k].std, truth.gyro.values[k]});

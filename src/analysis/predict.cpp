@@ -73,7 +73,7 @@ void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& c
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const PositionChannels& ch = channels[i];
     double w = ch.omega_exact_deg_h;
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) w += truth.values[k] * ch.regressors_exact[k];
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) w += truth.values[k] * ch.regressors_exact[k];
     if (!rate_errors.is_zero()) {
       const double e = rate_errors.scale_factor_error_ppm * 1e-6;
       w += e * ch.omega_exact_deg_h +
@@ -591,7 +591,7 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
   std::vector<double*> stds;
   std::vector<double> base;
   std::vector<std::function<double(const CalibrationResult&)>> value_of;
-  for (std::size_t c = 0; c < kNumCoefficients && result.sensor == SensorKind::kGyro; ++c)
+  for (std::size_t c = 0; c < kNumGyroCoefficients && result.sensor == SensorKind::kGyro; ++c)
     if (result.coefficients[c].identifiable) {
       stds.push_back(&result.coefficients[c].std);
       value_of.push_back([c](const CalibrationResult& e) { return e.coefficients[c].value; });

@@ -326,7 +326,7 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
       names.push_back(name);
       noise[name] = vs.second;
     }
-    for (std::size_t k = 0; k < kNumCoefficients; ++k)
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       result.units[std::string(kCoefficientNames[k])] = std::string(kCoefficientUnits[k]);
     if (result.gyro_model == GyroModel::kDriftRate)
       for (std::size_t k = 0; k < kNumRateTerms; ++k) {

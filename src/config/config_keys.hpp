@@ -103,7 +103,7 @@ constexpr NumberKey<GyroNoise> kNoiseKeys[] = {
 };
 
 /// The meaning of each drift coefficient, in Coefficient order; the unit comes from kCoefficientUnits.
-constexpr std::string_view kCoefficientMeanings[kNumCoefficients] = {
+constexpr std::string_view kCoefficientMeanings[kNumGyroCoefficients] = {
     "bias",           "drift per g along I", "drift per g along O", "drift per g along S", "drift per aI^2",
     "drift per aO^2", "drift per aS^2",      "drift per aI*aO",     "drift per aI*aS",     "drift per aO*aS",
 };

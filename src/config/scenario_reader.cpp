@@ -307,7 +307,7 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
 
   Section gyro(reader, top.table("gyro"), "gyro");
   const toml::table* noise_table = gyro.table("noise");
-  for (std::size_t i = 0; i < kNumCoefficients; ++i)
+  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i)
     gyro.number(kCoefficientNames[i], 1.0, kGyroCoefficientRange, s.gyro.values[i]);
   // docs/physics.md section 15: the scale-factor error and the input axis' tilts toward O and S.
   gyro.number("scale_factor_error_ppm", 1.0, kRateError, s.gyro_rate.scale_factor_error_ppm);

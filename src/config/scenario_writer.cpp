@@ -245,7 +245,7 @@ std::string scenario_to_toml(const Scenario& s) {
   if (s.sensor_kind == SensorKind::kGyro) {
     w.section("gyro",
               "The gyro's drift coefficients (docs/physics.md section 6): the truth, for simulation.");
-    for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+    for (std::size_t i = 0; i < kNumGyroCoefficients; ++i) {
       w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
             std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
     }

@@ -27,7 +27,7 @@ inline Complex times(const Complex& a, const Complex& b) {
 // Columns: omega exact, nominal, seed (deg/h), then 10 exact and 10 nominal regressors, then the exact
 // omega_O and omega_S (deg/h; docs/physics.md section 15).
 constexpr int kFirstRegressor = 3;
-constexpr int kOmegaO = kFirstRegressor + 2 * static_cast<int>(kNumCoefficients);
+constexpr int kOmegaO = kFirstRegressor + 2 * static_cast<int>(kNumGyroCoefficients);
 constexpr int kColumns = kOmegaO + 2;
 
 /// A stride of at least `at_least` samples whose arm-angle step, gamma_step * stride wrapped to (-pi, pi],
@@ -58,9 +58,9 @@ void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState 
   v[kOmegaO + 1] = exact.rate_rad_s.z() * kRadPerSecToDegPerHour;
   const auto re = drift_regressors(exact.specific_force_g);
   const auto rn = drift_regressors(Eigen::Vector3d(nominal.a_I_g, nominal.a_O_g, nominal.a_S_g));
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     v[kFirstRegressor + k] = re[k];
-    v[kFirstRegressor + kNumCoefficients + k] = rn[k];
+    v[kFirstRegressor + kNumGyroCoefficients + k] = rn[k];
   }
 }
 
@@ -544,9 +544,9 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     ch.omega_seed_deg_h = at(2);
     ch.omega_O_exact_deg_h = at(kOmegaO);
     ch.omega_S_exact_deg_h = at(kOmegaO + 1);
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
       ch.regressors_exact[k] = at(kFirstRegressor + static_cast<int>(k));
-      ch.regressors_nominal[k] = at(kFirstRegressor + static_cast<int>(kNumCoefficients + k));
+      ch.regressors_nominal[k] = at(kFirstRegressor + static_cast<int>(kNumGyroCoefficients + k));
     }
     out.push_back(ch);
   }

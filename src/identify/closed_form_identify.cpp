@@ -81,7 +81,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     return f.std(se) * factor;
   };
   for (const LinearForm& f : cf.primary) {
-    for (std::size_t c = 0; c < kNumCoefficients; ++c)
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c)
       if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), std_of(f), true, {}};
   }
   for (const LinearForm& f : cf.alternatives)
@@ -104,7 +104,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   // condition of their whitened, equilibrated design; and how much uncertainty the closed forms give away:
   // the largest ratio of a form's standard uncertainty to least squares' for the same quantity from the same
   // 16 positions and covariance (1 = nothing lost; docs/calibration.md).
-  Eigen::MatrixXd x(16, static_cast<Eigen::Index>(kNumCoefficients));
+  Eigen::MatrixXd x(16, static_cast<Eigen::Index>(kNumGyroCoefficients));
   Eigen::MatrixXd cov16(16, 16);
   const Eigen::MatrixXd floored = position_covariance(reduction, options.min_std_err);
   for (Eigen::Index k = 0; k < 16; ++k) {
@@ -134,7 +134,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     if (ratio > amplification) amplification = ratio, worst = f.name;
   };
   for (const LinearForm& f : cf.primary) {
-    for (std::size_t c = 0; c < kNumCoefficients; ++c)
+    for (std::size_t c = 0; c < kNumGyroCoefficients; ++c)
       if (kCoefficientNames[c] == f.name) {
         compare(f,
                 evaluate_combination(sol, Eigen::VectorXd::Unit(x.cols(), static_cast<Eigen::Index>(c)), ls));

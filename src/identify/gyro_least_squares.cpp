@@ -158,10 +158,10 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     if (!sol.identifiable[c]) continue;
     const CoefficientEstimate estimate = {
         sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true, {}};
-    if (c < kNumCoefficients)
+    if (c < kNumGyroCoefficients)
       r.coefficients[c] = estimate;
     else
-      r.rate_terms[c - kNumCoefficients] = estimate;
+      r.rate_terms[c - kNumGyroCoefficients] = estimate;
   }
   if (extra_solution != nullptr) {
     ErrorColumnsSolution& e = *extra_solution;
@@ -211,7 +211,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
                   k > 1 ? "s" : "", listed, fit.advice, generic));
   // The combinations are of the coefficients (the estimated errors are identifiable, so their part is
   // rounding).
-  for (NamedEstimate& c : r.combinations) c.coefficients.resize(kNumCoefficients);
+  for (NamedEstimate& c : r.combinations) c.coefficients.resize(kNumGyroCoefficients);
 }
 
 }  // namespace gyrocal::identify_detail

@@ -24,7 +24,7 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr std::array<const char*, kNumCoefficients> kRegressorNames = {
+constexpr std::array<const char*, kNumGyroCoefficients> kRegressorNames = {
     "1", "a_I", "a_O", "a_S", "a_I^2", "a_O^2", "a_S^2", "a_I*a_O", "a_I*a_S", "a_O*a_S"};
 
 int degree(Index j) {
@@ -39,7 +39,7 @@ std::vector<bool> excited_columns(const MatrixXd& x, double level) {
     const double f = std::sqrt(std::max(0.0, x(i, 4) + x(i, 5) + x(i, 6)));
     for (Index j = 0; j < x.cols(); ++j) {
       // Beyond the ten coefficients (the rate errors, docs/physics.md section 15): any non-zero regressor.
-      const bool excited = j >= static_cast<Index>(kNumCoefficients)
+      const bool excited = j >= static_cast<Index>(kNumGyroCoefficients)
                                ? x(i, j) != 0.0
                                : j == 0 || std::abs(x(i, j)) > level * std::pow(f, degree(j));
       if (excited) out[static_cast<std::size_t>(j)] = true;
@@ -92,7 +92,7 @@ LeastSquaresSolution expand(const LeastSquaresSolution& s, const std::vector<Ind
 /// Rows of nominal regressors (docs/physics.md section 5) at every (rate, beta, gamma) of the three lists.
 MatrixXd nominal_rows(const CentrifugeModel& model, const std::vector<double>& rates,
                       const std::vector<double>& betas, const std::vector<double>& gammas) {
-  MatrixXd x(static_cast<Index>(rates.size() * betas.size() * gammas.size()), kNumCoefficients);
+  MatrixXd x(static_cast<Index>(rates.size() * betas.size() * gammas.size()), kNumGyroCoefficients);
   Index i = 0;
   for (double w : rates)
     for (double b : betas)
@@ -100,7 +100,7 @@ MatrixXd nominal_rows(const CentrifugeModel& model, const std::vector<double>& r
         const NominalInputs in = nominal_inputs(model.site(), model.geometry().radius_m, w,
                                                 model.geometry().heading_rad, b, g, SeedErrorTerms{});
         const auto r = drift_regressors(Eigen::Vector3d(in.a_I_g, in.a_O_g, in.a_S_g));
-        for (std::size_t j = 0; j < kNumCoefficients; ++j) x(i, static_cast<Index>(j)) = r[j];
+        for (std::size_t j = 0; j < kNumGyroCoefficients; ++j) x(i, static_cast<Index>(j)) = r[j];
         ++i;
       }
   return x;
@@ -186,15 +186,15 @@ std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& po
   // The rate errors (docs/physics.md section 15) are excited by rates, not by speeds or angles: a direction
   // that holds one asks for counter rate offsets of both signs.
   std::string rate_advice;
-  if (v.rows() > static_cast<Index>(kNumCoefficients)) {
-    const MatrixXd rate_part = v.bottomRows(v.rows() - static_cast<Index>(kNumCoefficients));
+  if (v.rows() > static_cast<Index>(kNumGyroCoefficients)) {
+    const MatrixXd rate_part = v.bottomRows(v.rows() - static_cast<Index>(kNumGyroCoefficients));
     if (rate_part.cwiseAbs().maxCoeff() > 1e-6 * v.cwiseAbs().maxCoeff())
       rate_advice =
           " Rate errors need rates about the input axis: counter rate offsets of both signs ([test] "
           "counter_rate_offsets_rad_s, docs/physics.md section 15); the misalignment toward O only sees the "
           "Earth rate's horizontal part.";
   }
-  const MatrixXd drift_part = v.topRows(std::min<Index>(v.rows(), static_cast<Index>(kNumCoefficients)));
+  const MatrixXd drift_part = v.topRows(std::min<Index>(v.rows(), static_cast<Index>(kNumGyroCoefficients)));
   if (drift_part.cwiseAbs().maxCoeff() <= 1e-6 * std::max(v.cwiseAbs().maxCoeff(), 1e-300))
     return rate_advice.empty() ? std::string() : rate_advice.substr(1);
   return advice_for_drift(drift_part, candidates) + rate_advice;
@@ -214,7 +214,7 @@ std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& ca
   if (!alone.empty()) return fmt::format("Adding {} would identify {}.", join(alone, " or "), them);
   for (std::size_t a = 0; a < candidates.size(); ++a)
     for (std::size_t b = a + 1; b < candidates.size(); ++b) {
-      MatrixXd both(candidates[a].rows.rows() + candidates[b].rows.rows(), kNumCoefficients);
+      MatrixXd both(candidates[a].rows.rows() + candidates[b].rows.rows(), kNumGyroCoefficients);
       both << candidates[a].rows, candidates[b].rows;
       if (directions_identified(both, v) == k)
         return fmt::format("Adding {} together with {} would identify {}.", candidates[a].text,
@@ -258,7 +258,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   const Index n = whitened_design.cols();
   std::vector<std::string> names = names_in;
   if (names.empty()) names.assign(kCoefficientNames.begin(), kCoefficientNames.end());
-  if (static_cast<Index>(names.size()) != n || n < static_cast<Index>(kNumCoefficients))
+  if (static_cast<Index>(names.size()) != n || n < static_cast<Index>(kNumGyroCoefficients))
     throw Error("fit_coefficients: one name per column, the ten coefficients first.");
   CoefficientFit out;
   out.excited = excited_columns(regressors, options.min_regressor_level);
@@ -308,7 +308,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
     for (Index j = 0; j < n; ++j)
       if (std::abs(shown[j]) < 1e-6 * largest) shown[j] = 0.0;
     const bool single = (shown.array() != 0.0).count() == 1;
-    if (single && pivot < static_cast<Index>(kNumCoefficients) &&
+    if (single && pivot < static_cast<Index>(kNumGyroCoefficients) &&
         !out.excited[static_cast<std::size_t>(pivot)]) {
       out.direction_texts.push_back(fmt::format("{}: its regressor {} is zero at every position of this plan",
                                                 names[std::size_t(pivot)],
@@ -330,7 +330,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   for (Index k = 0; k < svd_j.singularValues().size(); ++k)
     if (svd_j.singularValues()[k] > 1e-6) ++rank_j;
   const Index estimable_dim = nj - rank_j;
-  out.advice = advice_for(directions.topRows(static_cast<Index>(kNumCoefficients)), positions, model);
+  out.advice = advice_for(directions.topRows(static_cast<Index>(kNumGyroCoefficients)), positions, model);
   if (estimable_dim <= 0) return out;
 
   std::vector<VectorXd> chosen_scaled;  // accepted combinations, equilibrated coordinates
@@ -362,7 +362,7 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
   std::vector<Named> named;
   for (const NamedCombination& nc : named_combinations(ar)) {
     VectorXd c = VectorXd::Zero(n);
-    for (std::size_t k = 0; k < kNumCoefficients; ++k) c[static_cast<Index>(k)] = nc.weights[k];
+    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) c[static_cast<Index>(k)] = nc.weights[k];
     named.push_back({std::string(nc.name), std::string(nc.unit), c});
   }
   for (const Named& nc : named) {
@@ -394,8 +394,8 @@ CoefficientFit fit_coefficients(const MatrixXd& regressors, const MatrixXd& whit
     // In parameter units with the pivot coefficient 1: c = z / D, scaled back so that c[pivot] = 1.
     const VectorXd scaled = z * sol.column_scales[pivot];
     add(fmt::format("combination {}", ++generic),
-        pivot < static_cast<Index>(kNumCoefficients) ? std::string(kCoefficientUnits[std::size_t(pivot)])
-                                                     : "",
+        pivot < static_cast<Index>(kNumGyroCoefficients) ? std::string(kCoefficientUnits[std::size_t(pivot)])
+                                                         : "",
         scaled);
   }
   return out;

@@ -2,9 +2,9 @@
 
 namespace gyrocal {
 
-double NamedCombination::value(const std::array<double, kNumCoefficients>& c) const {
+double NamedCombination::value(const std::array<double, kNumGyroCoefficients>& c) const {
   double v = 0.0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) v += weights[k] * c[k];
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) v += weights[k] * c[k];
   return v;
 }
 

@@ -88,7 +88,7 @@ Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel&
       double diff = 0.0;
       if (options.sensor == SensorKind::kGyro) {
         diff = u.omega_exact_deg_h - d.omega_exact_deg_h;
-        for (std::size_t k = 0; k < kNumCoefficients; ++k)
+        for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
           diff += c[k] * (u.regressors_exact[k] - d.regressors_exact[k]);
       } else {
         // The sensor's reduced output at the products c: known + sum_j c_j r_j.
@@ -198,7 +198,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
       options.sensor == SensorKind::kGyro
           ? least_squares_unknowns(options.gyro_model).size()
           : std::visit([](const auto& s) { return s.num_unknowns(); }, sensor_of(options.sensor));
-  const std::vector<double> zero(std::max(unknowns_count, kNumCoefficients), 0.0);
+  const std::vector<double> zero(std::max(unknowns_count, kNumGyroCoefficients), 0.0);
   Eigen::MatrixXd all_columns = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(reduction.positions.size()),
                                                       static_cast<Eigen::Index>(k));
   {
@@ -358,7 +358,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
         coefficients[c] = v;
       }
     }
-    for (std::size_t c = 0; c < kNumCoefficients && options.sensor == SensorKind::kGyro; ++c) {
+    for (std::size_t c = 0; c < kNumGyroCoefficients && options.sensor == SensorKind::kGyro; ++c) {
       const CoefficientEstimate& ce = r.coefficients[c];
       const double v = ce.identifiable ? ce.value : 0.0;
       if (ce.identifiable && !(std::abs(v - coefficients[c]) <= options.convergence * ce.std ||
@@ -404,7 +404,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
                 : std::numeric_limits<double>::quiet_NaN());
       }
     }
-    for (std::size_t c = 0; c < kNumCoefficients && options.sensor == SensorKind::kGyro; ++c)
+    for (std::size_t c = 0; c < kNumGyroCoefficients && options.sensor == SensorKind::kGyro; ++c)
       e.correlations.emplace_back(std::string(kCoefficientNames[c]),
                                   r.coefficients[c].identifiable ? corr(nc + ai, static_cast<Eigen::Index>(c))
                                                                  : std::numeric_limits<double>::quiet_NaN());

@@ -7,7 +7,7 @@ namespace gyrocal {
 Unknowns least_squares_unknowns(GyroModel gyro_model) {
   Unknowns u;
   u.gyro_model = gyro_model;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
     u.names.emplace_back(kCoefficientNames[k]);
     u.units.emplace_back(kCoefficientUnits[k]);
   }

@@ -2,15 +2,15 @@
 
 namespace gyrocal {
 
-std::array<double, kNumCoefficients> drift_regressors(const Eigen::Vector3d& f) {
+std::array<double, kNumGyroCoefficients> drift_regressors(const Eigen::Vector3d& f) {
   const double ai = f.x(), ao = f.y(), as = f.z();
   return {1.0, ai, ao, as, ai * ai, ao * ao, as * as, ai * ao, ai * as, ao * as};
 }
 
 double drift_deg_h(const DriftCoefficients& c, const Eigen::Vector3d& specific_force_g) {
-  const std::array<double, kNumCoefficients> r = drift_regressors(specific_force_g);
+  const std::array<double, kNumGyroCoefficients> r = drift_regressors(specific_force_g);
   double sum = 0.0;
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) sum += c.values[k] * r[k];
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) sum += c.values[k] * r[k];
   return sum;
 }
 

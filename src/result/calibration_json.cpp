@@ -32,7 +32,7 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
         {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
         {"unit", c.unit},
         {"identifiable", c.identifiable}};
-  for (std::size_t k = 0; k < kNumCoefficients && r.sensor == SensorKind::kGyro; ++k) {
+  for (std::size_t k = 0; k < kNumGyroCoefficients && r.sensor == SensorKind::kGyro; ++k) {
     const CoefficientEstimate& c = r.coefficients[k];
     coefficients[std::string(kCoefficientNames[k])] = {
         {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
@@ -168,7 +168,7 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
 
 nlohmann::ordered_json coefficients_to_json(const DriftCoefficients& c) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) j[std::string(kCoefficientNames[k])] = c.values[k];
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) j[std::string(kCoefficientNames[k])] = c.values[k];
   return j;
 }
 

@@ -10,15 +10,15 @@ namespace gyrocal {
 namespace {
 
 /// The table with the rate terms identified: the gyro model drift+rate.
-constexpr std::array<SensorParameter, kNumCoefficients + kNumRateTerms> with_rate_terms() {
-  std::array<SensorParameter, kNumCoefficients + kNumRateTerms> table = kGyroParameters;
+constexpr std::array<SensorParameter, kNumGyroCoefficients + kNumRateTerms> with_rate_terms() {
+  std::array<SensorParameter, kNumGyroCoefficients + kNumRateTerms> table = kGyroParameters;
   for (SensorParameter& p : table) p.identified = true;
   return table;
 }
-constexpr std::array<SensorParameter, kNumCoefficients + kNumRateTerms> kGyroRateParameters =
+constexpr std::array<SensorParameter, kNumGyroCoefficients + kNumRateTerms> kGyroRateParameters =
     with_rate_terms();
 
-constexpr Eigen::Index kE = static_cast<Eigen::Index>(kNumCoefficients);  // index of e
+constexpr Eigen::Index kE = static_cast<Eigen::Index>(kNumGyroCoefficients);  // index of e
 
 }  // namespace
 
@@ -28,7 +28,7 @@ std::span<const SensorParameter> Gyro::parameters() const {
 }
 
 std::size_t Gyro::num_unknowns() const {
-  return model == GyroModel::kDriftRate ? kNumCoefficients + kNumRateTerms : kNumCoefficients;
+  return model == GyroModel::kDriftRate ? kNumGyroCoefficients + kNumRateTerms : kNumGyroCoefficients;
 }
 
 std::vector<std::string_view> Gyro::unknown_names() const {
@@ -48,9 +48,9 @@ double Gyro::output(const SensorInputs& inputs) const {
 DesignRow Gyro::design_row(const SensorInputs& inputs) const {
   DesignRow row;
   row.known = inputs.rate_rad_s.x() * kRadPerSecToDegPerHour;
-  const std::array<double, kNumCoefficients> r = drift_regressors(inputs.specific_force_g);
-  for (std::size_t k = 0; k < kNumCoefficients; ++k) row.regressors[k] = r[k];
-  row.size = kNumCoefficients;
+  const std::array<double, kNumGyroCoefficients> r = drift_regressors(inputs.specific_force_g);
+  for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) row.regressors[k] = r[k];
+  row.size = kNumGyroCoefficients;
   if (model == GyroModel::kDriftRate) {
     // docs/physics.md section 15: W - omega_I = e omega_I + (1 + e)(dO omega_O + dS omega_S) + drift.
     row.regressors[row.size++] = row.known * 1e-6;

@@ -143,7 +143,7 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
                {"noise_quantization_deg_h", fmt::format("{}", noise.quantization_deg_h)},
                {"noise_output_lag_s", fmt::format("{}", noise.output_lag_s)},
            });
-  for (std::size_t i = 0; i < kNumCoefficients; ++i) {
+  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i) {
     m.emplace_back(fmt::format("truth_{}", kCoefficientNames[i]), fmt::format("{}", scenario.gyro.values[i]));
   }
   // The rate-platform method (docs/physics.md section 15), written only where it is used, so that a plain

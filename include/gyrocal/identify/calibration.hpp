@@ -170,7 +170,7 @@ struct CalibrationResult {
   Compensation compensation = Compensation::kFull;
   GyroModel gyro_model = GyroModel::kDrift;
   double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
-  std::array<CoefficientEstimate, kNumCoefficients> coefficients;
+  std::array<CoefficientEstimate, kNumGyroCoefficients> coefficients;
   /// With drift+rate: e (ppm), dO, dS (arcsec) in kRateTermNames order (docs/physics.md section 15).
   std::array<CoefficientEstimate, kNumRateTerms> rate_terms;
   std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
@@ -182,7 +182,7 @@ struct CalibrationResult {
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
   /// The unknowns of the least squares: the ten coefficients and the estimated machine errors' columns.
-  int unknowns = static_cast<int>(kNumCoefficients);
+  int unknowns = static_cast<int>(kNumGyroCoefficients);
   /// Least squares: of its whitened, equilibrated design. Closed form: the same for its 16 positions.
   double condition_number = 0.0;
   /// Closed form only: the largest ratio of a closed form's standard uncertainty to the least-squares one

@@ -29,8 +29,8 @@ struct PositionChannels {
   /// (docs/physics.md section 15).
   double omega_O_exact_deg_h = 0.0;
   double omega_S_exact_deg_h = 0.0;
-  std::array<double, kNumCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
-  std::array<double, kNumCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
+  std::array<double, kNumGyroCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
+  std::array<double, kNumGyroCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
   /// A sensor other than the gyro (identify/sensor_channels.hpp): its design row (known part and the
   /// regressors of its products) at the exact inputs, reduced by the same operator as its output. The gyro's
   /// fields above are then zero. Size 0 for the gyro.
@@ -53,7 +53,7 @@ struct PositionChannels {
                                       : omega_nominal_deg_h;
   }
   /// The regressors the compensation assumes: exact with full compensation, nominal otherwise.
-  const std::array<double, kNumCoefficients>& regressors(Compensation c) const {
+  const std::array<double, kNumGyroCoefficients>& regressors(Compensation c) const {
     return c == Compensation::kFull ? regressors_exact : regressors_nominal;
   }
 };

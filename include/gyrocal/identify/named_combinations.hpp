@@ -14,10 +14,10 @@ namespace gyrocal {
 struct NamedCombination {
   std::string_view name;  ///< "dII-dSS", "dOO-dSS", "dF+(1+Ar^2)dSS"
   std::string_view unit;  ///< "deg/h/g^2" or "deg/h"
-  std::array<double, kNumCoefficients> weights{};
+  std::array<double, kNumGyroCoefficients> weights{};
 
   /// The combination's value for coefficients c (in the units of gyro.hpp).
-  double value(const std::array<double, kNumCoefficients>& c) const;
+  double value(const std::array<double, kNumGyroCoefficients>& c) const;
 };
 
 /// The three named combinations of docs/physics.md section 8 at the radial level ar_g (g, the first spinning

@@ -17,8 +17,8 @@ struct Unknowns {
   GyroModel gyro_model = GyroModel::kDrift;
 
   std::size_t size() const { return names.size(); }
-  /// Index of the first rate error (kNumCoefficients), valid with drift+rate.
-  static constexpr std::size_t first_rate_term() { return kNumCoefficients; }
+  /// Index of the first rate error (kNumGyroCoefficients), valid with drift+rate.
+  static constexpr std::size_t first_rate_term() { return kNumGyroCoefficients; }
 };
 
 /// The unknowns of `gyro_model`, in order.

@@ -12,16 +12,18 @@ namespace gyrocal {
 
 /// The ten drift coefficients, in this order everywhere (regressors, results, JSON).
 enum class Coefficient : std::size_t { dF, dI, dO, dS, dII, dOO, dSS, dIO, dIS, dOS };
-inline constexpr std::size_t kNumCoefficients = 10;
-inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientNames = {
+/// The gyro's count of drift coefficients (an accelerometer's is kNumAccelCoefficients,
+/// sensor/accelerometer.hpp).
+inline constexpr std::size_t kNumGyroCoefficients = 10;
+inline constexpr std::array<std::string_view, kNumGyroCoefficients> kCoefficientNames = {
     "dF", "dI", "dO", "dS", "dII", "dOO", "dSS", "dIO", "dIS", "dOS"};
-inline constexpr std::array<std::string_view, kNumCoefficients> kCoefficientUnits = {
+inline constexpr std::array<std::string_view, kNumGyroCoefficients> kCoefficientUnits = {
     "deg/h",     "deg/h/g",   "deg/h/g",   "deg/h/g",   "deg/h/g^2",
     "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2", "deg/h/g^2"};
 
 /// Drift coefficients: dF deg/h; dI, dO, dS deg/h/g; the rest deg/h/g^2 (docs/physics.md section 1).
 struct DriftCoefficients {
-  std::array<double, kNumCoefficients> values{};
+  std::array<double, kNumGyroCoefficients> values{};
 
   double& operator[](Coefficient c) { return values[static_cast<std::size_t>(c)]; }
   double operator[](Coefficient c) const { return values[static_cast<std::size_t>(c)]; }
@@ -29,7 +31,7 @@ struct DriftCoefficients {
 
 /// The regressors of eq. 6 at specific force f (g, gyro axes):
 /// (1, aI, aO, aS, aI^2, aO^2, aS^2, aI*aO, aI*aS, aO*aS), in Coefficient order.
-std::array<double, kNumCoefficients> drift_regressors(const Eigen::Vector3d& specific_force_g);
+std::array<double, kNumGyroCoefficients> drift_regressors(const Eigen::Vector3d& specific_force_g);
 
 /// The drift of eq. 6 (everything but omega_I and noise), deg/h.
 double drift_deg_h(const DriftCoefficients& coefficients, const Eigen::Vector3d& specific_force_g);

@@ -18,7 +18,7 @@ namespace gyrocal {
 /// The gyro's parameter table: the ten drift coefficients (configuration keys as their names in [gyro]),
 /// then the three rate terms of section 15 (identified with the gyro model drift+rate only). The two
 /// misalignments share [gyro] input_axis_misalignment_arcsec = [dO, dS]; their key names that array.
-inline constexpr std::array<SensorParameter, kNumCoefficients + kNumRateTerms> kGyroParameters = {{
+inline constexpr std::array<SensorParameter, kNumGyroCoefficients + kNumRateTerms> kGyroParameters = {{
     {"dF", "deg/h", "dF", "bias", true},
     {"dI", "deg/h/g", "dI", "drift per g along I", true},
     {"dO", "deg/h/g", "dO", "drift per g along O", true},
