@@ -1,7 +1,7 @@
 // `gyrocal plan` of the default scenario at 200 .. 2,000,000 revolutions per dwell (issue 17, item 3: a cost
-// independent of the revolutions, a 2e6-revolution plan under 1 s). The model's channels of each planned
-// dwell are summed in closed form (identify/planned_channels.hpp), and so is the coloured noise's covariance
-// (analysis/predict.hpp, coloured_noise_position_covariance), so the time should stay flat.
+// independent of the revolutions, a 2e6-revolution plan under 1 s). The model terms of each planned
+// dwell are summed in closed form (identify/planned_model_terms.hpp), and so is the coloured noise's
+// covariance (analysis/predict.hpp, coloured_noise_position_covariance), so the time should stay flat.
 #include <benchmark/benchmark.h>
 
 #include "gyrocal/analysis/predict.hpp"

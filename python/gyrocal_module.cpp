@@ -23,10 +23,10 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/history/read.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -216,8 +216,9 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
       reducer.push(s);
     }
     const Reduction reduction_result = reducer.finish();
-    const std::vector<PositionChannels> channels = calibration_channels(reduction_result, model, options);
-    j = calibration_to_json(identify(reduction_result, channels, model, options));
+    const std::vector<PositionModelTerms> model_terms =
+        calibration_model_terms(reduction_result, model, options);
+    j = calibration_to_json(identify(reduction_result, model_terms, model, options));
   }
   j["record"] = name;
   return json_to_python(j);

@@ -14,7 +14,7 @@
 #include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
@@ -51,7 +51,7 @@ std::map<std::string, double> simulated_calibration(const Scenario& truth, const
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = told.model();
   const CalibrationResult c =
-      identify(r, reduce_sensor_channels(r, model, o.reduce, told.sensor()), model, o);
+      identify(r, reduce_sensor_model_terms(r, model, o.reduce, told.sensor()), model, o);
   std::map<std::string, double> out;
   for (const SensorCoefficientEstimate& e : c.sensor_coefficients)
     if (e.identifiable) out[e.name] = e.value;

@@ -18,7 +18,7 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -38,7 +38,7 @@ bool sanitized() {
 /// truth of [accelerometer], the default machine's wobbles plus a lever arm and a main-axis runout. Few
 /// revolutions at 50 Hz, so that a record is simulated, reduced and identified in milliseconds. The settle is
 /// the default 2 s: with 0.5 s the first spinning dwell after the static holds still holds the end of the
-/// machine's transition, which the constant-rate channels lack (~20 ug at 6 rad/s; docs/accelerometer.md).
+/// machine's transition, which the constant-rate model terms lack (~20 ug at 6 rad/s; docs/accelerometer.md).
 Scenario accelerometer_scenario(bool noisy) {
   Scenario s = default_scenario();
   s.sensor_kind = SensorKind::kAccelerometer;
@@ -70,7 +70,8 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
                             CalibrationOptions o = CalibrationOptions{}) {
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_channels(reduction, model, o.reduce, config.sensor()), model, o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
+                  o);
 }
 
 /// The truth in the table's order and units.

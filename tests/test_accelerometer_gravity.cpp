@@ -18,7 +18,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -57,7 +57,8 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
                             CalibrationOptions o = CalibrationOptions{}) {
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_channels(reduction, model, o.reduce, config.sensor()), model, o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
+                  o);
 }
 
 std::string all_warnings(const CalibrationResult& r) {

@@ -17,7 +17,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -78,7 +78,7 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
   const CentrifugeModel model = config.model();
   Outcome out;
   try {
-    out.result = identify(r, reduce_sensor_channels(r, model, o.reduce, config.sensor()), model, o);
+    out.result = identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.sensor()), model, o);
     // K1 in the record's units, as calibrate_record states it.
     out.result.sensor_coefficients[1].value *= scale;
     out.result.sensor_coefficients[1].std *= std::abs(scale);

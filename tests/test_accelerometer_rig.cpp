@@ -67,7 +67,7 @@ std::string record_toml(double counts) {
 
 /// Every imperfection of the generator whose effect the calibration models exactly: its own order, ramps,
 /// jitter and rounded stamps (the reducer's uniform grid), encoder counts of `counts` a turn, a toggling
-/// position encoder, the drive's rate offset (the channels follow the measured rate), a gap, a clock jump,
+/// position encoder, the drive's rate offset (the model terms follow the measured rate), a gap, a clock jump,
 /// spikes, a beta glitch. No ripple (see ADriveRippleNeitherBiasesNorInflates).
 testing::RigImperfections exactly_modelled(double counts) {
   testing::RigImperfections imp = testing::every_imperfection();
@@ -277,9 +277,9 @@ TEST_F(AccelerometerRig, ARippledRecordOfTheDefaultTestsDwellsGivesAllElevenWith
 TEST_F(AccelerometerRig, ADriveRippleNeitherBiasesNorInflates) {
   // docs/accelerometer.md, "The drive's ripple". A ripple of 2e-4 at 0.37 Hz moves the centripetal force at
   // 12 g by 5 mg and its direction by as much again, against ~14 ug of noise a revolution.
-  // Noise-free (encoders of 2^32 counts, every exactly modelled imperfection, spikes included): the channels
-  // follow the measured motion, reduced by the output's own operator (its basis angle, its outliers left
-  // out), and every coefficient comes back as from a smooth record to the spline's approximation of the
+  // Noise-free (encoders of 2^32 counts, every exactly modelled imperfection, spikes included): the model
+  // terms follow the measured motion, reduced by the output's own operator (its basis angle, its outliers
+  // left out), and every coefficient comes back as from a smooth record to the spline's approximation of the
   // ripple (reduce/measured_rate.hpp): measured 1.0e-3 ug/g^2 on Kip, 4.9e-4 urad on delta_p and below
   // 1.3e-4 of their units on the others (K1 2e-12 relative), against 6e-3 and 7e-3 with the dwell's one line
   // as the operator's angle and 2.8 ug/g^2 and 2.2 urad before that: within 1.5e-3 of each unit, K1 within

@@ -20,7 +20,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -69,8 +69,9 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
   o.estimate = parse_machine_error_names(estimate, "test");
   const CentrifugeModel model = config.model();
   if (config.sensor_kind == SensorKind::kGyro)
-    return identify(reduction, reduce_model_channels(reduction, model, o.reduce), model, o);
-  return identify(reduction, reduce_sensor_channels(reduction, model, o.reduce, config.sensor()), model, o);
+    return identify(reduction, reduce_model_terms(reduction, model, o.reduce), model, o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
+                  o);
 }
 
 /// Each accelerometer coefficient within `z_max` of its standard uncertainty of the truth.

@@ -1,4 +1,4 @@
-// Calibration against known truth: the whole pipeline (simulate -> reduce -> channels -> identify) on
+// Calibration against known truth: the whole pipeline (simulate -> reduce -> model terms -> identify) on
 // simulated tests, noise-free and noisy, with the expectations of docs/physics.md sections 8 and 9.
 #include <cmath>
 #include <cstdlib>
@@ -24,7 +24,7 @@ CalibrationResult calibrate(const Scenario& s, const Pipeline& p, Method m, Comp
   CalibrationOptions o;
   o.method = m;
   o.compensation = c;
-  return identify(p.reduction, p.channels, s.model(), o);
+  return identify(p.reduction, p.model_terms, s.model(), o);
 }
 
 bool sanitized() {
@@ -157,7 +157,7 @@ TEST(Calibrate, SingleSpeedPlanSaysWhatIsMissingAndHowToFixIt) {
 
 TEST(Calibrate, UncertaintiesAreHonest) {
   // Over many noisy simulations (estimate - truth) / std has unit standard deviation, for every coefficient
-  // and combination, least squares and closed form. The model's channels are the same for every trial.
+  // and combination, least squares and closed form. The model terms are the same for every trial.
   // 60 revolutions give each position's standard error 58 degrees of freedom (z inflated by only ~2%); 300
   // trials pin the spread of z to +-0.04 (1 sigma).
   Scenario s = default_scenario();
@@ -166,7 +166,7 @@ TEST(Calibrate, UncertaintiesAreHonest) {
   const int trials = sanitized() ? 200 : 300;
   const double ar = radial_level(s, 9.9);
   const auto combos = true_combinations(s, ar);
-  const std::vector<PositionChannels> channels = run(s, 1).channels;
+  const std::vector<PositionModelTerms> model_terms = run(s, 1).model_terms;
   std::map<std::string, std::vector<double>> z;
   for (int trial = 0; trial < trials; ++trial) {
     Reducer reducer(s.test, ReduceOptions{}, "simulated", 9.9);
@@ -177,7 +177,7 @@ TEST(Calibrate, UncertaintiesAreHonest) {
     for (Method m : {Method::kLeastSquares, Method::kClosedForm}) {
       CalibrationOptions o;
       o.method = m;
-      const CalibrationResult r = identify(red, channels, s.model(), o);
+      const CalibrationResult r = identify(red, model_terms, s.model(), o);
       const std::string tag = m == Method::kLeastSquares ? "ls " : "cf ";
       for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
         if (r.coefficients[k].identifiable)
@@ -202,7 +202,7 @@ TEST(Calibrate, UncertaintiesAreHonest) {
 }
 
 TEST(Calibrate, WindowMeansReduceAsExactlyAsTheHarmonicFit) {
-  // The window mean is another linear operator; the model's channels go through the same one, so a noise-free
+  // The window mean is another linear operator; the model terms go through the same one, so a noise-free
   // record is still identified exactly.
   Scenario s = noise_free_default();
   s.test.revolutions = 10;
@@ -211,7 +211,7 @@ TEST(Calibrate, WindowMeansReduceAsExactlyAsTheHarmonicFit) {
   const Pipeline p = run(s, 1, ro);
   CalibrationOptions o;
   o.reduce = ro;
-  const CalibrationResult ls = identify(p.reduction, p.channels, s.model(), o);
+  const CalibrationResult ls = identify(p.reduction, p.model_terms, s.model(), o);
   for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
     if (ls.coefficients[k].identifiable) {
       EXPECT_NEAR(ls.coefficients[k].value, s.gyro.values[k], 1e-6) << kCoefficientNames[k];
@@ -272,15 +272,15 @@ TEST(Reduce, ABadPlanMatchIsAnErrorNamingThePositions) {
 
 TEST(Predict, PlannedReductionMatchesAReducedNoiseFreeRecord) {
   // Two routes to the same numbers: the record route (simulate, segment, reduce) and the plan route
-  // (dwells from the timeline, outputs from the reduced channels and the truth).
+  // (dwells from the timeline, outputs from the reduced model terms and the truth).
   for (const std::vector<double>& rates : {std::vector<double>{9.9}, std::vector<double>{9.9, 0.0}}) {
     Scenario s = noise_free_default();
     s.test.revolutions = 10;
     s.test.rates_rad_s = rates;
     const Pipeline recorded = run(s);
     Reduction planned = planned_reduction(s);
-    const auto channels = reduce_model_channels(planned, s.model(), ReduceOptions{});
-    set_noise_free_outputs(planned, channels, s.gyro);
+    const auto model_terms = reduce_model_terms(planned, s.model(), ReduceOptions{});
+    set_noise_free_outputs(planned, model_terms, s.gyro);
     ASSERT_EQ(planned.positions.size(), recorded.reduction.positions.size());
     for (std::size_t i = 0; i < planned.positions.size(); ++i) {
       EXPECT_EQ(planned.positions[i].index, recorded.reduction.positions[i].index);

@@ -61,7 +61,7 @@ CalibrationResult self_calibrate(const Scenario& config, const Reduction& reduct
   CalibrationOptions o;
   o.estimate = parse_machine_error_names(names, "test");
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_model_channels(reduction, model, o.reduce), model, o);
+  return identify(reduction, reduce_model_terms(reduction, model, o.reduce), model, o);
 }
 
 /// The truth of each estimated error of kCounterErrors, in its unit (arcsec, rad/s).
@@ -120,7 +120,7 @@ TEST(SelfCalibration, NoiseFreeTwoSpeedsGivesTheMachineAndTheCoefficients) {
   CalibrationOptions plain;
   const CentrifugeModel model = config.model();
   const CalibrationResult off =
-      identify(reduction, reduce_model_channels(reduction, model, plain.reduce), model, plain);
+      identify(reduction, reduce_model_terms(reduction, model, plain.reduce), model, plain);
   EXPECT_GT(std::abs(off.coefficients[static_cast<std::size_t>(Coefficient::dI)].value -
                      truth.gyro[Coefficient::dI]),
             1e-3);
@@ -180,11 +180,11 @@ TEST(SelfCalibration, ClosedFormAndPartialCompensationRefuse) {
   CalibrationOptions o;
   o.estimate = parse_machine_error_names(kCounterErrors, "test");
   o.method = Method::kClosedForm;
-  const auto channels = reduce_model_channels(reduction, truth.model(), o.reduce);
-  EXPECT_THROW(identify(reduction, channels, truth.model(), o), Error);
+  const auto model_terms = reduce_model_terms(reduction, truth.model(), o.reduce);
+  EXPECT_THROW(identify(reduction, model_terms, truth.model(), o), Error);
   o.method = Method::kLeastSquares;
   o.compensation = Compensation::kSeed;
-  EXPECT_THROW(identify(reduction, channels, truth.model(), o), Error);
+  EXPECT_THROW(identify(reduction, model_terms, truth.model(), o), Error);
 }
 
 /// z-scores' standard deviation over seeds: of the ten coefficients and of the three estimated errors.

@@ -21,7 +21,7 @@
 #include "gyrocal/core/random.hpp"
 #include "gyrocal/history/summary.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/history_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
@@ -311,7 +311,8 @@ CalibrationResult calibrate_accelerometer(const Scenario& config, const Scenario
   CalibrationOptions o;
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_channels(reduction, model, o.reduce, config.sensor()), model, o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
+                  o);
 }
 
 /// The run a history keeps of a calibration result: its coefficients, filled by hand.

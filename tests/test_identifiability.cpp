@@ -51,10 +51,10 @@ Scenario scenario(const Plan& plan, bool noisy) {
   return s;
 }
 
-/// simulate -> reduce -> channels -> least squares, as `gyrocal simulate` + `gyrocal calibrate` do.
+/// simulate -> reduce -> model terms -> least squares, as `gyrocal simulate` + `gyrocal calibrate` do.
 CalibrationResult calibrate_simulated(const Scenario& s, std::uint64_t seed = 7) {
   const testing::Pipeline p = testing::run(s, seed);
-  return identify(p.reduction, p.channels, s.model(), CalibrationOptions{});
+  return identify(p.reduction, p.model_terms, s.model(), CalibrationOptions{});
 }
 
 const Plan kSingleSpeed = {"single speed", {9.9}, {0, 180, 90, 270}, {0, 180, 90, 270}};
@@ -282,11 +282,11 @@ TEST(Messages, RepeatedBetaGammaOrRateIsRefusedByTheConfigurationNamingKeyAndVal
 struct Planned {
   Scenario s = scenario(kSingleSpeed, true);
   Reduction reduction;
-  std::vector<PositionChannels> channels;
+  std::vector<PositionModelTerms> model_terms;
   Planned() {
     reduction = planned_reduction(s);
-    channels = reduce_model_channels(reduction, s.model(), ReduceOptions{});
-    set_noise_free_outputs(reduction, channels, s.gyro);
+    model_terms = reduce_model_terms(reduction, s.model(), ReduceOptions{});
+    set_noise_free_outputs(reduction, model_terms, s.gyro);
     set_predicted_std_errors(reduction, s.noise, s.test.sample_rate_hz);
   }
 };
@@ -304,7 +304,7 @@ TEST(Messages, ANonFiniteReducedOutputIsNamedByItsPosition) {
   Planned p;
   p.reduction.positions[7].mean = std::numeric_limits<double>::infinity();
   const std::string message =
-      error_of([&] { identify(p.reduction, p.channels, p.s.model(), CalibrationOptions{}); });
+      error_of([&] { identify(p.reduction, p.model_terms, p.s.model(), CalibrationOptions{}); });
   EXPECT_NE(message.find("position 8 (rate 9.9 rad/s, beta 180 deg, gamma 270 deg; record time"),
             std::string::npos)
       << message;
@@ -313,9 +313,9 @@ TEST(Messages, ANonFiniteReducedOutputIsNamedByItsPosition) {
 
 TEST(Messages, ANonFiniteModelChannelIsNamedByItsPosition) {
   Planned p;
-  p.channels[2].regressors_exact[4] = std::numeric_limits<double>::quiet_NaN();
+  p.model_terms[2].regressors_exact[4] = std::numeric_limits<double>::quiet_NaN();
   const std::string message =
-      error_of([&] { identify(p.reduction, p.channels, p.s.model(), CalibrationOptions{}); });
+      error_of([&] { identify(p.reduction, p.model_terms, p.s.model(), CalibrationOptions{}); });
   EXPECT_NE(message.find("position 3 (rate 9.9 rad/s, beta 0 deg, gamma 90 deg"), std::string::npos)
       << message;
   EXPECT_EQ(message.find("design matrix"), std::string::npos) << message;
@@ -326,7 +326,7 @@ TEST(Messages, APlanThatRepeatsAPositionInCodeIsNamedNotASolverInternal) {
   Scenario s = scenario(kSingleSpeed, true);
   s.test.gamma_rad.push_back(kPi / 2);
   Reduction r = planned_reduction(s);
-  const std::vector<PositionChannels> ch = reduce_model_channels(r, s.model(), ReduceOptions{});
+  const std::vector<PositionModelTerms> ch = reduce_model_terms(r, s.model(), ReduceOptions{});
   set_noise_free_outputs(r, ch, s.gyro);
   set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz);
   const std::string message = error_of([&] { identify(r, ch, s.model(), CalibrationOptions{}); });

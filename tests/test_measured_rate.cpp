@@ -1,4 +1,4 @@
-// The rate the model's channels follow (reduce/measured_rate.hpp, identify/channels.hpp; docs/calibration.md,
+// The rate the model terms follow (reduce/measured_rate.hpp, identify/model_terms.hpp; docs/calibration.md,
 // "The rate the channels follow"): the spline of the main encoder against independent truths (a rate given in
 // closed form, the rig generator's own joint states), and what a constant-rate line misses instead.
 #include <algorithm>
@@ -11,7 +11,7 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/reduce/measured_rate.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -92,8 +92,9 @@ TEST(MeasuredRate, WithoutARippleTheFTestFindsNoneAndAStaircaseIsNotTakenForARat
   EXPECT_FALSE(slow.motion.quanta_resolved);
 }
 
-// ---- The channels on a rig's record (tests/support/rig_record.hpp: the exact model at the generator's own
-// joint states) --------------------------------------------------------------------------------------------
+// ---- The model terms on a rig's record (tests/support/rig_record.hpp: the exact model at the generator's
+// own joint states)
+// --------------------------------------------------------------------------------------------
 
 Scenario rig_scenario(double sample_rate_hz) {
   Scenario s = default_scenario();
@@ -162,8 +163,9 @@ std::vector<Eigen::Vector3d> true_reduced_force(const Scenario& s, const RigRedu
   return out;
 }
 
-/// The largest |channel - truth| of a_I, a_O, a_S over the positions, g.
-double worst_force_miss(const std::vector<PositionChannels>& ch, const std::vector<Eigen::Vector3d>& truth) {
+/// The largest |model term - truth| of a_I, a_O, a_S over the positions, g.
+double worst_force_miss(const std::vector<PositionModelTerms>& ch,
+                        const std::vector<Eigen::Vector3d>& truth) {
   double worst = 0.0;
   for (std::size_t p = 0; p < ch.size(); ++p)
     for (int c = 0; c < 3; ++c)
@@ -172,7 +174,7 @@ double worst_force_miss(const std::vector<PositionChannels>& ch, const std::vect
   return worst;
 }
 
-/// The largest miss of the channels' specific force against the truth's at the samples, on the measured
+/// The largest miss of the model terms' specific force against the truth's at the samples, on the measured
 /// joints and on the lines; and the largest miss of the main rate.
 struct SampleMiss {
   double followed = 0.0, line = 0.0, rate = 0.0;
@@ -203,18 +205,18 @@ SampleMiss sample_miss(const Scenario& s, const RigReduction& r) {
   return out;
 }
 
-/// The largest miss of the reduced channels' specific force against the truth's, following the measured
+/// The largest miss of the reduced model terms' specific force against the truth's, following the measured
 /// motion and on the lines.
 std::pair<double, double> reduced_miss(const Scenario& s, const RigReduction& r) {
   const CentrifugeModel model = s.model();
   const std::vector<Eigen::Vector3d> truth = true_reduced_force(s, r);
-  std::vector<DwellChannelsRoute> routes;
-  const std::vector<PositionChannels> followed =
-      reduce_model_channels(r.reduction, model, ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
-  for (const DwellChannelsRoute& x : routes) EXPECT_TRUE(x.measured_rate);
+  std::vector<DwellModelTermsRoute> routes;
+  const std::vector<PositionModelTerms> followed =
+      reduce_model_terms(r.reduction, model, ReduceOptions{}, 0, ModelTermsRoute::kExact, &routes);
+  for (const DwellModelTermsRoute& x : routes) EXPECT_TRUE(x.measured_rate);
   Reduction lines = r.reduction;
   for (Dwell& d : lines.dwells) d.measured = MeasuredMotion{};
-  const std::vector<PositionChannels> on_lines = reduce_model_channels(lines, model, ReduceOptions{});
+  const std::vector<PositionModelTerms> on_lines = reduce_model_terms(lines, model, ReduceOptions{});
   return {worst_force_miss(followed, truth), worst_force_miss(on_lines, truth)};
 }
 
@@ -267,8 +269,7 @@ TEST(MeasuredRate, ACalibrationOnARippledRecordRecoversTheTruthWithTheSameUncert
     const RigReduction r = reduce_rig(s, imp, 21);
     CalibrationOptions o;
     o.method = Method::kLeastSquares;
-    return identify(r.reduction, reduce_model_channels(r.reduction, s.model(), ReduceOptions{}), s.model(),
-                    o);
+    return identify(r.reduction, reduce_model_terms(r.reduction, s.model(), ReduceOptions{}), s.model(), o);
   };
   const CalibrationResult smooth = calibrate(0.0), rippled = calibrate(2e-4);
   for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) {
@@ -280,25 +281,25 @@ TEST(MeasuredRate, ACalibrationOnARippledRecordRecoversTheTruthWithTheSameUncert
 }
 
 TEST(MeasuredRate, WithoutARippleTheChannelsTakeTheLineAsBefore) {
-  // Quantised encoders, jitter, no ripple: the F-test finds none and every channel is the line route's, bit
-  // for bit.
+  // Quantised encoders, jitter, no ripple: the F-test finds none and every model term is the line route's,
+  // bit for bit.
   const Scenario s = rig_scenario(50.0);
   testing::RigImperfections imp;
   imp.angle_quantum_deg = 0.1;
   imp.jitter_s = 1e-4;
   imp.rate_offset = 1e-3;
   const RigReduction r = reduce_rig(s, imp, 4);
-  std::vector<DwellChannelsRoute> routes;
-  const std::vector<PositionChannels> ch =
-      reduce_model_channels(r.reduction, s.model(), ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
+  std::vector<DwellModelTermsRoute> routes;
+  const std::vector<PositionModelTerms> ch =
+      reduce_model_terms(r.reduction, s.model(), ReduceOptions{}, 0, ModelTermsRoute::kExact, &routes);
   Reduction lines = r.reduction;
   for (Dwell& d : lines.dwells) {
     EXPECT_FALSE(d.measured.resolved && d.measured.quanta_resolved)
         << d.measured.chi2 << " dof " << d.measured.dof;
     d.measured = MeasuredMotion{};
   }
-  for (const DwellChannelsRoute& x : routes) EXPECT_FALSE(x.measured_rate);
-  const std::vector<PositionChannels> ref = reduce_model_channels(lines, s.model(), ReduceOptions{});
+  for (const DwellModelTermsRoute& x : routes) EXPECT_FALSE(x.measured_rate);
+  const std::vector<PositionModelTerms> ref = reduce_model_terms(lines, s.model(), ReduceOptions{});
   for (std::size_t p = 0; p < ch.size(); ++p) {
     EXPECT_EQ(ch[p].omega_exact_deg_h, ref[p].omega_exact_deg_h);
     EXPECT_EQ(ch[p].regressors_exact, ref[p].regressors_exact);

@@ -22,7 +22,7 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 
@@ -272,17 +272,17 @@ TEST(PlanCost, ClosedFormDwellCovarianceEqualsTheWalkOverEverySample) {
 }
 
 TEST(PlanCost, BoundedModelEvaluationsAgreeWithEveryRevolutionsOnALongTest) {
-  // 1500 revolutions: the channels' evaluations are capped at kMaxModelSamplesPerDwell per dwell (a stride
+  // 1500 revolutions: the model terms' evaluations are capped at kMaxModelSamplesPerDwell per dwell (a stride
   // longer than a revolution) instead of 32 per revolution. Stated error (docs/calibration.md): every reduced
-  // channel within 1e-7 of its scale (omega in deg/h, regressors in g^n), i.e. far below any noise.
+  // model term within 1e-7 of its scale (omega in deg/h, regressors in g^n), i.e. far below any noise.
   Scenario s = default_scenario();
   s.test.revolutions = std::getenv("GYROCAL_SANITIZED") ? 1200 : 1500;
   const Reduction r = planned_reduction(s);
   ASSERT_GT(r.dwells.front().samples / 3, kMaxModelSamplesPerDwell);  // the cap is in force
   const CentrifugeModel model = s.model();
-  const std::vector<PositionChannels> capped =
-      reduce_model_channels(r, model, ReduceOptions{}, kMaxModelSamplesPerDwell);
-  const std::vector<PositionChannels> every = reduce_model_channels(r, model, ReduceOptions{}, 0);
+  const std::vector<PositionModelTerms> capped =
+      reduce_model_terms(r, model, ReduceOptions{}, kMaxModelSamplesPerDwell);
+  const std::vector<PositionModelTerms> every = reduce_model_terms(r, model, ReduceOptions{}, 0);
   ASSERT_EQ(capped.size(), every.size());
   for (std::size_t i = 0; i < every.size(); ++i) {
     EXPECT_NEAR(capped[i].omega_exact_deg_h, every[i].omega_exact_deg_h, 1e-7 * 50.0) << i;
@@ -294,7 +294,7 @@ TEST(PlanCost, BoundedModelEvaluationsAgreeWithEveryRevolutionsOnALongTest) {
 }
 
 TEST(PlanCost, DefaultPredictionIsUnchangedByTheClosedForm) {
-  // On the default scenario the capped channels are the uncapped ones (8500 evaluations per dwell) and the
+  // On the default scenario the capped model terms are the uncapped ones (8500 evaluations per dwell) and the
   // closed-form covariance equals the walk (above): the prediction's stds equal the walking route's to 1e-9.
   const Scenario s = default_scenario();
   Reduction r = planned_reduction(s);

@@ -49,7 +49,7 @@ Outcome calibrate_with(const Scenario& s, std::uint64_t seed, const Fault& fault
   const Reduction r = reducer.finish();
   Outcome out;
   try {
-    out.result = identify(r, reduce_model_channels(r, s.model(), o.reduce), s.model(), o);
+    out.result = identify(r, reduce_model_terms(r, s.model(), o.reduce), s.model(), o);
   } catch (const Error& e) {
     out.refused = true;
     out.message = e.what();
@@ -207,7 +207,7 @@ TEST(Misfit, TheCounterPlatformCountedTheOtherWayIsNamedOrFitsConsistently) {
               r.dwells[d].output.value[static_cast<std::size_t>(b.gamma_slot)]);
   }
   try {
-    const CalibrationResult c = identify(r, reduce_model_channels(r, s.model(), {}), s.model(), {});
+    const CalibrationResult c = identify(r, reduce_model_terms(r, s.model(), {}), s.model(), {});
     EXPECT_GE(c.misfit.p_value, 1e-3);
     EXPECT_EQ(c.misfit.scale, 1.0);
     std::printf("gamma mirrored: accepted, chi2/dof %.3g, worst |estimate - truth| / std %.3g\n",

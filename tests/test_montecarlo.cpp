@@ -125,7 +125,7 @@ TEST(MonteCarlo, FastModeAgreesWithTheWholePipeline) {
 
 // Issue 20, item 2: each source alone, the budget's predicted std against the std over simulated trials
 // (the samples mode: simulate the drawn machine, reduce its record on its own encoders, calibrate). The
-// platform's rate mismatch turns its heading, which its encoder measures, so the configured model's channels
+// platform's rate mismatch turns its heading, which its encoder measures, so the configured model terms
 // follow it and no reduced output moves (docs/self_calibration.md): its share must be nil and the spread the
 // noise's. The perpendicularity, unknown to the compensation, moves dI and dOS far beyond the noise. Trials:
 // a variance from n trials has a relative spread sqrt(2 / (n - 1)); 200 put 5 of it at 0.5, so a budget off

@@ -341,7 +341,7 @@ TEST(TinyOutputs, AVaryingOutputIsNotCalledConstant) {
   const std::string m = refusal([&] {
     const Reduction r = reduce_rows(s, rows);
     CalibrationOptions o;
-    identify(r, reduce_model_channels(r, s.model(), ReduceOptions{}), s.model(), o);
+    identify(r, reduce_model_terms(r, s.model(), ReduceOptions{}), s.model(), o);
   });
   EXPECT_FALSE(contains(m, "the constant")) << m;
   EXPECT_FALSE(contains(m, "no scatter at all")) << m;

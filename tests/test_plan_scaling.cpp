@@ -1,4 +1,4 @@
-// `plan` at a cost independent of the number of revolutions (issue 17, item 3): the model's channels of a
+// `plan` at a cost independent of the number of revolutions (issue 17, item 3): the model terms of a
 // planned dwell in closed form equal their sum over every sample, and a long plan's predictions follow from a
 // short one's as the sums over revolutions say.
 #include <algorithm>
@@ -11,8 +11,8 @@
 
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/config/scenario.hpp"
-#include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/planned_channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
+#include "gyrocal/identify/planned_model_terms.hpp"
 
 namespace gyrocal {
 namespace {
@@ -37,7 +37,7 @@ TEST(PlannedChannels, GeometricPowerSumsEqualTheirTerms) {
     }
 }
 
-/// The same reduction with each planned dwell's samples given as one stretch: reduce_model_channels then
+/// The same reduction with each planned dwell's samples given as one stretch: reduce_model_terms then
 /// evaluates the model on every sample and reduces it by the accumulator, the route of a calibration.
 Reduction as_one_stretch(Reduction r) {
   for (Dwell& d : r.dwells) {
@@ -52,12 +52,12 @@ Reduction as_one_stretch(Reduction r) {
   return r;
 }
 
-void expect_channels_equal(const Scenario& s, const std::string& what) {
+void expect_model_terms_equal(const Scenario& s, const std::string& what) {
   const Reduction r = planned_reduction(s);
   const CentrifugeModel model = s.model();
   const ReduceOptions ro;
-  const std::vector<PositionChannels> closed = reduce_model_channels(r, model, ro);
-  const std::vector<PositionChannels> summed = reduce_model_channels(as_one_stretch(r), model, ro);
+  const std::vector<PositionModelTerms> closed = reduce_model_terms(r, model, ro);
+  const std::vector<PositionModelTerms> summed = reduce_model_terms(as_one_stretch(r), model, ro);
   ASSERT_EQ(closed.size(), summed.size());
   double worst = 0.0;
   for (std::size_t i = 0; i < closed.size(); ++i) {
@@ -107,32 +107,32 @@ Scenario large_errors() {
 }
 
 TEST(PlannedChannels, EqualTheSumOverEverySample) {
-  // The closed form against the accumulator fed every sample, channel by channel, within 1e-9 relative (it
-  // gives ~1e-11: the rounding of omega_O and omega_S, differences of two 2e6 deg/h rates).
+  // The closed form against the accumulator fed every sample, model term by model term, within 1e-9 relative
+  // (it gives ~1e-11: the rounding of omega_O and omega_S, differences of two 2e6 deg/h rates).
   Scenario s = default_scenario();
   s.test.revolutions = 20;
   s.test.sample_rate_hz = 100.0;
-  expect_channels_equal(s, "default machine");
+  expect_model_terms_equal(s, "default machine");
   Scenario big = large_errors();
   big.test = s.test;
   big.test.rates_rad_s = {9.9, 4.95, 0.0};  // two speeds and a static set
-  expect_channels_equal(big, "large errors, two speeds and static holds");
+  expect_model_terms_equal(big, "large errors, two speeds and static holds");
   // The heading turning within a dwell: a counter rate offset of both signs (a rate platform, docs/physics.md
   // section 15) and a rate mismatch that turns the platform by 0.4 rad over a dwell.
   Scenario offsets = big;
   offsets.test.rates_rad_s = {9.9, 0.0};
   offsets.test.counter_rate_offsets_rad_s = {0.0, 0.25, -0.25};
-  expect_channels_equal(offsets, "counter rate offsets");
+  expect_model_terms_equal(offsets, "counter rate offsets");
   Scenario drifting = big;
   drifting.errors.counter_rate_mismatch_rad_s = 3e-2;
-  expect_channels_equal(drifting, "a platform heading drift of 3e-2 rad/s");
+  expect_model_terms_equal(drifting, "a platform heading drift of 3e-2 rad/s");
   Scenario window = s;
   // A window mean is not in closed form: the same path as before, every sample.
   ReduceOptions ro;
   ro.method = ReduceOptions::Method::kWindowMean;
   const Reduction r = planned_reduction(window);
   std::vector<DwellValues> out;
-  EXPECT_FALSE(planned_dwell_channels(
+  EXPECT_FALSE(planned_dwell_model_terms(
       r.dwells[0], ro, 1, [](double, double, double* v) { *v = 1.0; }, out));
 }
 

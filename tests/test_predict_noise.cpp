@@ -13,7 +13,7 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/simulated_pipeline.hpp"
@@ -41,7 +41,7 @@ Scenario coloured_scenario(double b, double k) {
 /// The calibration of one simulated record of `s` with `seed`.
 CalibrationResult calibrate_simulated(const Scenario& s, std::uint64_t seed) {
   const testing::Pipeline p = testing::run(s, seed);
-  return identify(p.reduction, p.channels, s.model(), CalibrationOptions{});
+  return identify(p.reduction, p.model_terms, s.model(), CalibrationOptions{});
 }
 
 TEST(PredictNoise, WithoutColouredNoiseTheGainRouteEqualsTheWhiteNoisePrediction) {

@@ -34,7 +34,7 @@ CalibrationResult identify_with(const Scenario& s, const Pipeline& p, GyroModel 
   CalibrationOptions o;
   o.method = m;
   o.gyro_model = g;
-  return identify(p.reduction, p.channels, s.model(), o);
+  return identify(p.reduction, p.model_terms, s.model(), o);
 }
 
 /// The default scenario (its machine errors and drift truth) with the rate errors of issue 12 and offsets of
@@ -242,7 +242,7 @@ TEST(RatePlatformCalibrate, UncertaintiesOfScaleFactorAndMisalignmentTowardSAreH
   s.test.revolutions = 30;
   s.test.sample_rate_hz = sanitized() ? 30.0 : 50.0;
   const int trials = sanitized() ? 100 : 120;  // the spread of sd is about 1/sqrt(2 trials) = 0.07
-  const std::vector<PositionChannels> channels = run(s, 1).channels;
+  const std::vector<PositionModelTerms> model_terms = run(s, 1).model_terms;
   std::vector<double> z_e, z_s;
   for (int trial = 0; trial < trials; ++trial) {
     Reducer reducer(s.test, ReduceOptions{}, "simulated", 9.9);
@@ -251,7 +251,7 @@ TEST(RatePlatformCalibrate, UncertaintiesOfScaleFactorAndMisalignmentTowardSAreH
     simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
     CalibrationOptions o;
     o.gyro_model = GyroModel::kDriftRate;
-    const CalibrationResult r = identify(reducer.finish(), channels, s.model(), o);
+    const CalibrationResult r = identify(reducer.finish(), model_terms, s.model(), o);
     ASSERT_TRUE(r.rate_terms[0].identifiable && r.rate_terms[2].identifiable);
     z_e.push_back((r.rate_terms[0].value - 150.0) / r.rate_terms[0].std);
     z_s.push_back((r.rate_terms[2].value - 40.0) / r.rate_terms[2].std);

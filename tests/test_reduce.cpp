@@ -60,7 +60,7 @@ Calibrated calibrate_rows(const Scenario& s, const std::vector<RecordSample>& ro
   CalibrationOptions o;
   o.method = method;
   o.reduce = ro;
-  c.result = identify(c.reduction, reduce_model_channels(c.reduction, s.model(), ro), s.model(), o);
+  c.result = identify(c.reduction, reduce_model_terms(c.reduction, s.model(), ro), s.model(), o);
   return c;
 }
 
@@ -127,7 +127,7 @@ TEST(Spikes, OneSampleNeverMovesAnEstimateAndIsCounted) {
 
 TEST(Spikes, ANoiseFreeRecordWithASpikeIsIdentifiedExactly) {
   // The outlier is replaced by the dwell's fit at its instant, so the reduction operator - the one the
-  // model's channels go through - is unchanged, and a noise-free record still gives the truth. Several
+  // model terms go through - is unchanged, and a noise-free record still gives the truth. Several
   // spikes, one of each sign, in two dwells.
   Scenario s = small_test(8);
   s.noise = GyroNoise{};
@@ -285,17 +285,17 @@ std::map<std::string, double> z_spread(const Scenario& s, int trials, Method met
       {"dII-dSS", d[Coefficient::dII] - d[Coefficient::dSS]},
       {"dOO-dSS", d[Coefficient::dOO] - d[Coefficient::dSS]},
       {"dF+(1+Ar^2)dSS", d[Coefficient::dF] + (1 + ar * ar) * d[Coefficient::dSS]}};
-  std::vector<PositionChannels> channels;
+  std::vector<PositionModelTerms> model_terms;
   for (int trial = 0; trial < trials; ++trial) {
     Reducer reducer(s.test, ReduceOptions{}, "simulated", omega);
     SimulationOptions so;
     so.seed = 5000 + static_cast<std::uint64_t>(trial);
     simulate(s, so, [&](const RecordSample& x) { reducer.push(x); });
     const Reduction red = reducer.finish();
-    if (channels.empty()) channels = reduce_model_channels(red, s.model(), ReduceOptions{});
+    if (model_terms.empty()) model_terms = reduce_model_terms(red, s.model(), ReduceOptions{});
     CalibrationOptions o;
     o.method = method;
-    const CalibrationResult r = identify(red, channels, s.model(), o);
+    const CalibrationResult r = identify(red, model_terms, s.model(), o);
     for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       if (r.coefficients[k].identifiable)
         z[std::string(kCoefficientNames[k])].push_back((r.coefficients[k].value - d.values[k]) /
@@ -522,8 +522,9 @@ TEST(RigRecord, BeyondItsToleranceARecordIsRefusedNamingThePositionTheTimeAndThe
 
 TEST(Exactness, ANoiseFreeTwoSpeedRecordWithLargeMachineErrorsIsExactByDefault) {
   // docs/physics.md section 4: W_red = omega_red + sum c_j x_j,red holds after reduction when the model's
-  // channels go through the data's operator on the data's samples. With a lever arm of 1 cm, runouts,
-  // wobbles to harmonic 3 and position-platform errors, a strided channel grid left 4.3e-6 deg/h/g^2 on dOS.
+  // model terms go through the data's operator on the data's samples. With a lever arm of 1 cm, runouts,
+  // wobbles to harmonic 3 and position-platform errors, a strided model term grid left 4.3e-6 deg/h/g^2 on
+  // dOS.
   Scenario s = small_test(8);
   s.test.sample_rate_hz = 200.0;  // 127 samples per revolution: a strided grid would skip samples
   s.test.rates_rad_s = {9.9, 7.0};
@@ -543,7 +544,7 @@ TEST(Exactness, ANoiseFreeTwoSpeedRecordWithLargeMachineErrorsIsExactByDefault) 
     ASSERT_TRUE(c.result.coefficients[k].identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(c.result.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
   }
-  // The configuration is one that a strided channel grid (the former default, 32 per revolution) does not
+  // The configuration is one that a strided model term grid (the former default, 32 per revolution) does not
   // reduce exactly: the test can tell.
   ReduceOptions strided;
   strided.model_samples_per_revolution = 32;

@@ -1,22 +1,22 @@
-// A guard on exactness (issue 26, item 6): the record's output and the model's channels are reduced by one
-// and the same operator (reduce/dwell_accumulator.hpp on the record's side; identify/channels.hpp on the
+// A guard on exactness (issue 26, item 6): the record's output and the model terms are reduced by one
+// and the same operator (reduce/dwell_accumulator.hpp on the record's side; identify/model_terms.hpp on the
 // model's: the same samples, the same times, the same basis angle, the same outliers left out). A record
-// whose output is exactly the gyro's output equation at the joints the channels take then reduces to exactly
-// the model's reduced channels times the coefficients, position by position, to rounding; a column added in
-// the wrong place, a sample left out of one and not the other, a time shifted by a sample breaks that
-// equality.
+// whose output is exactly the gyro's output equation at the joints the model terms take then reduces to
+// exactly the model's reduced model terms times the coefficients, position by position, to rounding; a column
+// added in the wrong place, a sample left out of one and not the other, a time shifted by a sample breaks
+// that equality.
 //
 // The record comes from the rig generator (tests/support/rig_record.hpp: its own timeline and the exact model
 // at its own joint states, independent of the simulator and of the reducer), noise-free, with what makes the
 // bookkeeping hard: a gap, the settle time, a drive turning off its planned rate, ramps between dwells, and,
-// where the channels follow the measured motion, a drive's ripple and spikes (rows the output's outlier rule
-// leaves out; on the dwell's lines the channels take every sample, outliers included, by design: docs/
-// calibration.md, "Rejected samples are left out"). A counter platform's wobble at its 6th harmonic puts
-// ~100 deg/h into the output at harmonics 5 and 7 of gamma, outside the dwell fit's harmonics 0 to 3: a
+// where the model terms follow the measured motion, a drive's ripple and spikes (rows the output's outlier
+// rule leaves out; on the dwell's lines the model terms take every sample, outliers included, by design:
+// docs/ calibration.md, "Rejected samples are left out"). A counter platform's wobble at its 6th harmonic
+// puts ~100 deg/h into the output at harmonics 5 and 7 of gamma, outside the dwell fit's harmonics 0 to 3: a
 // sample taken by one reduction and not the other moves its values far above rounding. The expected values
-// are the gyro's output equation (model/gyro.hpp) applied to the model's reduced channels with the scenario's
-// coefficients, or an accelerometer's design row (sensor/accelerometer.hpp) with its truth's products; the
-// data's are the reducer's.
+// are the gyro's output equation (model/gyro.hpp) applied to the model's reduced model terms with the
+// scenario's coefficients, or an accelerometer's design row (sensor/accelerometer.hpp) with its truth's
+// products; the data's are the reducer's.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -25,8 +25,8 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/units.hpp"
-#include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -47,7 +47,7 @@ Scenario exactness_scenario() {
 }
 
 /// A noise-free rig record: a gap in the third dwell, a drive 1e-3 off its planned rate; with `ripple` > 0
-/// a ripple of its rate, which the channels follow through the measured motion, and six spikes.
+/// a ripple of its rate, which the model terms follow through the measured motion, and six spikes.
 testing::RigImperfections imperfections(double ripple) {
   testing::RigImperfections imp;
   imp.gap_fraction = 0.1;
@@ -74,10 +74,10 @@ Reduction reduce_rows(const Scenario& s, const std::vector<testing::RigRow>& row
   return reducer.finish();
 }
 
-/// The gyro's output equation on a position's reduced channels: omega_I + sum_k c_k x_k, deg/h
-/// (model/gyro.hpp, docs/physics.md section 4; the channels are linear functionals of the samples, so the
+/// The gyro's output equation on a position's reduced model terms: omega_I + sum_k c_k x_k, deg/h
+/// (model/gyro.hpp, docs/physics.md section 4; the model terms are linear functionals of the samples, so the
 /// equation commutes with the reduction).
-double model_output_deg_h(const Scenario& s, const PositionChannels& ch) {
+double model_output_deg_h(const Scenario& s, const PositionModelTerms& ch) {
   double y = ch.omega_exact_deg_h;
   for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) y += s.gyro.values[k] * ch.regressors_exact[k];
   return y;
@@ -87,8 +87,8 @@ double model_output_deg_h(const Scenario& s, const PositionChannels& ch) {
 struct Mismatch {
   double worst = 0.0, scale = 0.0;
 };
-Mismatch mismatch(const Scenario& s, const Reduction& r, ChannelRoute route) {
-  const std::vector<PositionChannels> ch = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, route);
+Mismatch mismatch(const Scenario& s, const Reduction& r, ModelTermsRoute route) {
+  const std::vector<PositionModelTerms> ch = reduce_model_terms(r, s.model(), ReduceOptions{}, 0, route);
   Mismatch m;
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const double data = r.positions[i].mean, model = model_output_deg_h(s, ch[i]);
@@ -126,8 +126,8 @@ TEST(ReductionExactness, OnTheDwellsLinesTheDataAndTheModelAreReducedByOneOperat
     EXPECT_FALSE(d.measured.resolved && d.measured.quanta_resolved);  // the lines, no ripple
   }
   // Every sample evaluated, and the Fourier series summed in closed form (the default): the same to rounding.
-  const Mismatch every = mismatch(s, r, ChannelRoute::kEverySample);
-  const Mismatch fourier = mismatch(s, r, ChannelRoute::kExact);
+  const Mismatch every = mismatch(s, r, ModelTermsRoute::kEverySample);
+  const Mismatch fourier = mismatch(s, r, ModelTermsRoute::kExact);
   EXPECT_GT(every.scale, 10.0);
   EXPECT_LT(every.worst, 1e-9) << "largest reduced output " << every.scale << " deg/h";
   EXPECT_LT(fourier.worst, 1e-9) << "largest reduced output " << fourier.scale << " deg/h";
@@ -135,16 +135,16 @@ TEST(ReductionExactness, OnTheDwellsLinesTheDataAndTheModelAreReducedByOneOperat
   // One sample of the record moved by 1 deg/h, the model left as it is: the guard sees it (the fit spreads
   // it over its dwell's positions at ~1/samples, ~1e-3 deg/h).
   rows[a_measured_row(r, rows)].output += 1.0;
-  const Mismatch moved = mismatch(s, reduce_rows(s, rows), ChannelRoute::kEverySample);
+  const Mismatch moved = mismatch(s, reduce_rows(s, rows), ModelTermsRoute::kEverySample);
   EXPECT_GT(moved.worst, 1e-5);
 }
 
 TEST(ReductionExactness, WhereTheChannelsFollowTheMeasuredMotionTheDataAndTheModelAreReducedByOneOperator) {
-  // A drive's ripple (2e-4 at 0.37 Hz): the channels follow the main axis' measured motion (its spline, the
-  // counter platform turning back what the arm departs from its line) and the output's basis angle as the
+  // A drive's ripple (2e-4 at 0.37 Hz): the model terms follow the main axis' measured motion (its spline,
+  // the counter platform turning back what the arm departs from its line) and the output's basis angle as the
   // reducer took it. The rig's output is the gyro at its true joints, which the spline approximates only;
   // so the record is written twice: the rows as the rig gives them, reduced; then each measured sample's
-  // output replaced by the gyro's output equation at the joints the channels take for it (measured_joints,
+  // output replaced by the gyro's output equation at the joints the model terms take for it (measured_joints,
   // the spikes kept on their rows), and reduced again. The encoders are the same rows: the second reduction
   // finds the same dwells, lines, splines and outliers.
   const Scenario s = exactness_scenario();
@@ -187,19 +187,19 @@ TEST(ReductionExactness, WhereTheChannelsFollowTheMeasuredMotionTheDataAndTheMod
   EXPECT_EQ(r.outliers, first.outliers);
   EXPECT_GE(r.outliers, 3u);
   EXPECT_GE(r.gaps, 1u);
-  const Mismatch m = mismatch(s, r, ChannelRoute::kExact);
+  const Mismatch m = mismatch(s, r, ModelTermsRoute::kExact);
   EXPECT_GT(m.scale, 10.0);
   EXPECT_LT(m.worst, 1e-9) << "largest reduced output " << m.scale << " deg/h";
 
   rows[a_measured_row(r, rows)].output += 1.0;
-  const Mismatch moved = mismatch(s, reduce_rows(s, rows), ChannelRoute::kExact);
+  const Mismatch moved = mismatch(s, reduce_rows(s, rows), ModelTermsRoute::kExact);
   EXPECT_GT(moved.worst, 1e-5);
 }
 
 TEST(ReductionExactness, AnAccelerometersDesignRowsAreReducedByTheOutputsOperator) {
-  // The same for an accelerometer (identify/sensor_channels.hpp): the default accelerometer's truth,
+  // The same for an accelerometer (identify/sensor_model_terms.hpp): the default accelerometer's truth,
   // noise-free, at 6 and 12 rad/s, its spinning dwells reduced to seven gamma; a ripple, spikes and a gap;
-  // each measured sample's output rewritten as the accelerometer's output at the joints the channels take.
+  // each measured sample's output rewritten as the accelerometer's output at the joints the model terms take.
   // The model: the design row's known part plus its regressors times the truth's products
   // (sensor/accelerometer.hpp).
   Scenario s = exactness_scenario();
@@ -244,8 +244,8 @@ TEST(ReductionExactness, AnAccelerometersDesignRowsAreReducedByTheOutputsOperato
   EXPECT_GE(r.gaps, 1u);
   const Eigen::VectorXd u = s.accelerometer.products();
   const auto worst = [&](const Reduction& x) {
-    const std::vector<PositionChannels> ch =
-        reduce_sensor_channels(x, model, ReduceOptions{}, Sensor{Accelerometer{}});
+    const std::vector<PositionModelTerms> ch =
+        reduce_sensor_model_terms(x, model, ReduceOptions{}, Sensor{Accelerometer{}});
     double w = 0.0;
     for (std::size_t i = 0; i < x.positions.size(); ++i) {
       const DesignRow& row = ch[i].sensor_exact;

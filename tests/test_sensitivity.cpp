@@ -208,7 +208,7 @@ CalibrationResult simulate_and_calibrate(const Scenario& s) {
   CalibrationOptions o;
   o.gyro_model = GyroModel::kDriftRate;
   o.compensation = Compensation::kNone;
-  return identify(reduction, reduce_model_channels(reduction, s.model(), o.reduce), s.model(), o);
+  return identify(reduction, reduce_model_terms(reduction, s.model(), o.reduce), s.model(), o);
 }
 
 TEST(SensitivityRateTerms, ShiftOfScaleFactorAndMisalignmentIsTheSimulatedFiniteDifference) {

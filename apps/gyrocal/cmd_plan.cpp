@@ -4,7 +4,7 @@
 #include "cli.hpp"
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/result/calibration_json.hpp"

@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "gyrocal/analysis/predict.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/simulate/accelerometer_noise.hpp"
@@ -81,8 +81,8 @@ PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& 
   p.reduction = planned_reduction(planned);
   const Sensor sensor = s.sensor();
   // The sensor's truth on the true machine: known + sum_j u_j r_j, u its products.
-  const std::vector<PositionChannels> truth =
-      reduce_sensor_channels(p.reduction, s.model(), options, sensor, kMaxModelSamplesPerDwell);
+  const std::vector<PositionModelTerms> truth =
+      reduce_sensor_model_terms(p.reduction, s.model(), options, sensor, kMaxModelSamplesPerDwell);
   Eigen::VectorXd u;
   if (const auto* a = std::get_if<Accelerometer>(&sensor)) u = a->products();
   for (std::size_t i = 0; i < p.reduction.positions.size(); ++i) {
@@ -93,7 +93,7 @@ PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& 
     p.reduction.positions[i].mean = e;
   }
   set_predicted_std_errors(p.reduction, output_noise(s), s.test.sample_rate_hz, options);
-  p.channels = reduce_sensor_channels(p.reduction, told, options, sensor, kMaxModelSamplesPerDwell);
+  p.model_terms = reduce_sensor_model_terms(p.reduction, told, options, sensor, kMaxModelSamplesPerDwell);
   return p;
 }
 

@@ -18,7 +18,7 @@
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/random.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -54,7 +54,7 @@ std::vector<double> estimate_errors(const CalibrationResult& r, const Scenario& 
 }
 
 /// True when the dwells of a and b lie on the same encoder lines at the same samples: a calibration then
-/// evaluates the same model channels on both.
+/// evaluates the same model terms on both.
 bool same_encoder_lines(const Reduction& a, const Reduction& b) {
   if (a.dwells.size() != b.dwells.size()) return false;
   for (std::size_t i = 0; i < a.dwells.size(); ++i) {
@@ -135,28 +135,29 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
         "plan "
         "estimates machine errors from its data (docs/accelerometer.md).");
   const CentrifugeModel model0 = m.told.model();
-  // The planned test of `s`'s machine with its outputs and std errors, and (`with_channels`) the channels of
-  // `told` on its dwells: the gyro's (predict.hpp), or another sensor's reduced as its record would be
-  // (estimates.hpp). `told_is_true`: `told` is `s`'s own machine, whose channels give the outputs too.
-  const auto planned = [&](const Scenario& s, const CentrifugeModel& told, bool with_channels,
+  // The planned test of `s`'s machine with its outputs and std errors, and (`with_model_terms`) the model
+  // terms of `told` on its dwells: the gyro's (predict.hpp), or another sensor's reduced as its record would
+  // be (estimates.hpp). `told_is_true`: `told` is `s`'s own machine, whose model terms give the outputs too.
+  const auto planned = [&](const Scenario& s, const CentrifugeModel& told, bool with_model_terms,
                            bool told_is_true) {
     if (!gyro) return planned_sensor_test(s, told, ro);
     PlannedSensorTest p;
     p.reduction = planned_reduction(s);
-    const std::vector<PositionChannels> truth =
-        told_is_true ? std::vector<PositionChannels>{} : reduce_model_channels(p.reduction, s.model(), ro);
-    if (with_channels || told_is_true) p.channels = reduce_model_channels(p.reduction, told, ro);
-    set_noise_free_outputs(p.reduction, told_is_true ? p.channels : truth, scenario.gyro, scenario.gyro_rate);
+    const std::vector<PositionModelTerms> truth =
+        told_is_true ? std::vector<PositionModelTerms>{} : reduce_model_terms(p.reduction, s.model(), ro);
+    if (with_model_terms || told_is_true) p.model_terms = reduce_model_terms(p.reduction, told, ro);
+    set_noise_free_outputs(p.reduction, told_is_true ? p.model_terms : truth, scenario.gyro,
+                           scenario.gyro_rate);
     set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz, ro);
     return p;
   };
   const GyroNoise noise = output_noise(scenario);
 
-  // The configured machine: its reduction, channels (what the compensation knows), outputs, std errors.
+  // The configured machine: its reduction, model terms (what the compensation knows), outputs, std errors.
   // (The outputs are the true machine's: the told one differs under "self".)
   PlannedSensorTest p0 = planned(scenario, model0, true, !options.self);
   const Reduction& r0 = p0.reduction;
-  const std::vector<PositionChannels>& ch0 = p0.channels;
+  const std::vector<PositionModelTerms>& ch0 = p0.model_terms;
   const auto np = static_cast<Eigen::Index>(r0.positions.size());
   m.positions = static_cast<int>(np);
 
@@ -214,11 +215,11 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
 
   // Each source's effect on the estimates at one standard uncertainty, (E(e0 + u) - E(e0 - u)) / 2, exact to
   // second order: the drawn machine reduced on its own planned encoder lines, as a record of it would be.
-  // Where the drawn machine's encoder lines are the configured one's, the calibration sees the same channels
-  // and the effect is the affine map of the outputs' change. Where they differ (counter_rate_mismatch turns
-  // the platform's heading, which its encoder measures), a record's calibration evaluates the configured
-  // model on the drawn lines: the channels follow the heading, and the effect is that whole calibration's
-  // (docs/montecarlo.md, "The sources through the encoders").
+  // Where the drawn machine's encoder lines are the configured one's, the calibration sees the same model
+  // terms and the effect is the affine map of the outputs' change. Where they differ (counter_rate_mismatch
+  // turns the platform's heading, which its encoder measures), a record's calibration evaluates the
+  // configured model on the drawn lines: the model terms follow the heading, and the effect is that whole
+  // calibration's (docs/montecarlo.md, "The sources through the encoders").
   const auto ns = static_cast<Eigen::Index>(m.sources.size());
   Eigen::MatrixXd effect(ne, ns);
   parallel_for(static_cast<std::size_t>(ns), options.threads, [&](std::size_t s) {
@@ -226,7 +227,7 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
     for (int k = 0; k < 2; ++k) {
       Scenario drawn = scenario;
       m.sources[s].add_to(drawn, (k == 0 ? 1.0 : -1.0) * m.sources[s].std_si);
-      // The drawn machine's outputs; the channels of the configured machine on its encoder lines.
+      // The drawn machine's outputs; the model terms of the configured machine on its encoder lines.
       PlannedSensorTest p = planned(drawn, model0, false, false);
       const Reduction& r = p.reduction;
       if (static_cast<Eigen::Index>(r.positions.size()) != np)
@@ -238,8 +239,8 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
               r.positions[static_cast<std::size_t>(i)].mean - r0.positions[static_cast<std::size_t>(i)].mean;
         side[k] = map * dw;
       } else {
-        if (p.channels.empty()) p.channels = reduce_model_channels(r, model0, ro);
-        const std::vector<double> e = estimate_errors(identify(r, p.channels, model0, m.calibration),
+        if (p.model_terms.empty()) p.model_terms = reduce_model_terms(r, model0, ro);
+        const std::vector<double> e = estimate_errors(identify(r, p.model_terms, model0, m.calibration),
                                                       scenario, m.names, nullptr, nullptr);
         side[k] = Eigen::Map<const Eigen::VectorXd>(e.data(), ne) -
                   Eigen::Map<const Eigen::VectorXd>(m.bias.data(), ne);
@@ -319,12 +320,12 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     so.seed = rng.next_u64();
     simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
     const Reduction r = reducer.finish();
-    const auto channels = s.sensor_kind == SensorKind::kGyro
-                              ? reduce_model_channels(r, model0, m.calibration.reduce)
-                              : reduce_sensor_channels(r, model0, m.calibration.reduce, s.sensor());
+    const auto model_terms = s.sensor_kind == SensorKind::kGyro
+                                 ? reduce_model_terms(r, model0, m.calibration.reduce)
+                                 : reduce_sensor_model_terms(r, model0, m.calibration.reduce, s.sensor());
     std::vector<std::string> names = m.names;
     std::vector<double> stated;
-    const std::vector<double> e = estimate_errors(identify(r, channels, model0, m.calibration), m.scenario,
+    const std::vector<double> e = estimate_errors(identify(r, model_terms, model0, m.calibration), m.scenario,
                                                   names, nullptr, nullptr, &stated);
     std::copy(e.begin(), e.end(), out);
     for (std::size_t i = 0; i < ne; ++i)

@@ -14,7 +14,7 @@
 
 #include "gyrocal/analysis/estimates.hpp"
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/reduce/dwell_reduction.hpp"
@@ -68,10 +68,10 @@ double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_h
   return noise.angle_random_walk_deg_rt_h * 60.0 * std::sqrt(sample_rate_hz);
 }
 
-void set_noise_free_outputs(Reduction& r, const std::vector<PositionChannels>& channels,
+void set_noise_free_outputs(Reduction& r, const std::vector<PositionModelTerms>& model_terms,
                             const DriftCoefficients& truth, const GyroRateErrors& rate_errors) {
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
-    const PositionChannels& ch = channels[i];
+    const PositionModelTerms& ch = model_terms[i];
     double w = ch.omega_exact_deg_h;
     for (std::size_t k = 0; k < kNumGyroCoefficients; ++k) w += truth.values[k] * ch.regressors_exact[k];
     if (!rate_errors.is_zero()) {
@@ -584,7 +584,7 @@ namespace {
 /// W0 + e_k (the same weights as `result`'s, which the white noise sets: a calibration of a record weights
 /// its dwells the same way), and the variance of an estimate with gain g is g' C g.
 void count_whole_noise(CalibrationResult& result, const Reduction& r,
-                       const std::vector<PositionChannels>& channels, const CentrifugeModel& model,
+                       const std::vector<PositionModelTerms>& model_terms, const CentrifugeModel& model,
                        const CalibrationOptions& options, const Eigen::MatrixXd& covariance) {
   const auto np = static_cast<Eigen::Index>(r.positions.size());
   // The estimates: the coefficients, then the combinations, then the closed form's alternatives.
@@ -622,7 +622,7 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
   for (Eigen::Index k = 0; k < np; ++k) {
     Reduction shifted = r;
     shifted.positions[static_cast<std::size_t>(k)].mean += step;
-    const CalibrationResult e = identify(shifted, channels, model, options);
+    const CalibrationResult e = identify(shifted, model_terms, model, options);
     for (std::size_t i = 0; i < stds.size(); ++i)
       gain(static_cast<Eigen::Index>(i), k) = (value_of[i](e) - base[i]) / step;
   }
@@ -646,11 +646,12 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
   Reduction r = planned_reduction(planned);
   const CentrifugeModel model = s.model();
   const Sensor sensor = s.sensor();
-  const std::vector<PositionChannels> channels = reduce_sensor_channels(r, model, options.reduce, sensor);
+  const std::vector<PositionModelTerms> model_terms =
+      reduce_sensor_model_terms(r, model, options.reduce, sensor);
   const Accelerometer& a = std::get<Accelerometer>(sensor);
   const Eigen::VectorXd u = a.products();
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
-    const DesignRow& row = channels[i].sensor_exact;
+    const DesignRow& row = model_terms[i].sensor_exact;
     double e = row.known;
     for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
     r.positions[i].mean = e;
@@ -661,14 +662,14 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
   set_predicted_std_errors(r, noise, s.test.sample_rate_hz, options.reduce);
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
-  CalibrationResult result = identify(r, channels, model, identify_options);
+  CalibrationResult result = identify(r, model_terms, model, identify_options);
   if (a.noise.bias_instability_ug > 0.0 || a.noise.quantization_ug > 0.0) {
     // The noise correlated across positions (the bias instability's), as the gyro's plan counts it: each
     // estimate's variance g' C g over every position's covariance C.
     bool complete = true;
     const Eigen::MatrixXd covariance =
         predicted_noise_position_covariance(r, options.reduce, noise, s.test.sample_rate_hz, &complete);
-    count_whole_noise(result, r, channels, model, identify_options, covariance);
+    count_whole_noise(result, r, model_terms, model, identify_options, covariance);
     if (!complete)
       result.warnings.push_back(
           "the predicted uncertainties leave out the bias instability and quantization of the dwells reduced "
@@ -690,17 +691,17 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
   Reduction r = planned_reduction(s);
   const CentrifugeModel model = s.model();
   // A bounded number of model evaluations per dwell: the prediction's cost does not grow with the test.
-  const std::vector<PositionChannels> channels =
-      reduce_model_channels(r, model, options.reduce, kMaxModelSamplesPerDwell);
-  set_noise_free_outputs(r, channels, s.gyro, s.gyro_rate);
+  const std::vector<PositionModelTerms> model_terms =
+      reduce_model_terms(r, model, options.reduce, kMaxModelSamplesPerDwell);
+  set_noise_free_outputs(r, model_terms, s.gyro, s.gyro_rate);
   set_predicted_std_errors(r, s.noise, s.test.sample_rate_hz, options.reduce);
   // The predicted outputs are noise-free, so chi2 is ~0 by construction: its test against the degrees of
   // freedom says nothing about a plan and must not warn.
   CalibrationOptions identify_options = options;
   identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
-  // A self-calibration's Jacobian evaluated on the same bounded samples as the channels.
+  // A self-calibration's Jacobian evaluated on the same bounded samples as the model terms.
   identify_options.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
-  CalibrationResult result = identify(r, channels, model, identify_options);
+  CalibrationResult result = identify(r, model_terms, model, identify_options);
   // The Allan variances compared at the longest dwell's duration: where the colored noise dominates,
   // averaging longer stops paying (issue 10, item 2).
   double longest_dwell_s = 0.0;
@@ -712,7 +713,7 @@ CalibrationResult predict_calibration(const Scenario& s, const CalibrationOption
     bool complete = true;
     const Eigen::MatrixXd covariance =
         predicted_noise_position_covariance(r, options.reduce, s.noise, s.test.sample_rate_hz, &complete);
-    count_whole_noise(result, r, channels, model, identify_options, covariance);
+    count_whole_noise(result, r, model_terms, model, identify_options, covariance);
     if (!complete)
       result.warnings.push_back(
           "the predicted uncertainties leave out the bias instability, rate random walk, quantization and "

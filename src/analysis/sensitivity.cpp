@@ -15,7 +15,7 @@
 #include "gyrocal/analysis/estimates.hpp"
 #include "gyrocal/analysis/predict.hpp"
 #include "gyrocal/core/error.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 
 namespace gyrocal {
@@ -98,16 +98,16 @@ std::vector<std::pair<std::string, std::pair<double, double>>> estimates(const C
   return out;
 }
 
-/// The noise-free reduced test of `s` with predicted standard errors, and its model channels.
+/// The noise-free reduced test of `s` with predicted standard errors, and its model terms.
 struct PlannedTest {
   Reduction reduction;
-  std::vector<PositionChannels> channels;
+  std::vector<PositionModelTerms> model_terms;
 };
 PlannedTest planned_test(const Scenario& s, const ReduceOptions& ro) {
   PlannedTest p;
   p.reduction = planned_reduction(s);
-  p.channels = reduce_model_channels(p.reduction, s.model(), ro, kMaxModelSamplesPerDwell);
-  set_noise_free_outputs(p.reduction, p.channels, s.gyro, s.gyro_rate);
+  p.model_terms = reduce_model_terms(p.reduction, s.model(), ro, kMaxModelSamplesPerDwell);
+  set_noise_free_outputs(p.reduction, p.model_terms, s.gyro, s.gyro_rate);
   set_predicted_std_errors(p.reduction, s.noise, s.test.sample_rate_hz);
   return p;
 }
@@ -128,7 +128,7 @@ SixCalibrations calibrate_six(const Scenario& s, const CalibrationOptions& base)
       if (m == 0) o.gyro_model = GyroModel::kDrift;
       o.compensation = kCompensations[c];
       out[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] =
-          identify(p.reduction, p.channels, model, o);
+          identify(p.reduction, p.model_terms, model, o);
     }
   return out;
 }
@@ -148,7 +148,7 @@ CalibrationResult calibrate_self(const Scenario& s, const CalibrationOptions& ba
   // The predicted outputs are noise-free: chi2 says nothing (as in predict_calibration).
   o.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
   const CentrifugeModel model = told.model();
-  return identify(p.reduction, reduce_model_channels(p.reduction, model, o.reduce, kMaxModelSamplesPerDwell),
+  return identify(p.reduction, reduce_model_terms(p.reduction, model, o.reduce, kMaxModelSamplesPerDwell),
                   model, o);
 }
 
@@ -161,8 +161,9 @@ int spinning_rates(const TestSpec& test) {
 /// The study for a sensor other than the gyro (docs/accelerometer.md, "Sensitivity, Monte Carlo and
 /// report"): least squares only (its calibration has no closed forms and no seed compensation). Per error,
 /// compensation "none": the record of the machine with the error, reduced on its own planned encoder lines,
-/// calibrated with the channels of the machine without it (the error not told); "full": with the channels of
-/// the machine with it (told). Shifts against the base case (no error) in the coefficients' own units.
+/// calibrated with the model terms of the machine without it (the error not told); "full": with the model
+/// terms of the machine with it (told). Shifts against the base case (no error) in the coefficients' own
+/// units.
 SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const SensitivityOptions& options) {
   Scenario base = scenario;
   base.errors = CentrifugeErrors{};
@@ -193,11 +194,11 @@ SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const Sensi
         }
         const CentrifugeModel told = s.model();
         PlannedSensorTest p = planned_sensor_test(s, told, o.reduce);
-        runs[i][1] = identify(p.reduction, p.channels, told, o);
+        runs[i][1] = identify(p.reduction, p.model_terms, told, o);
         runs[i][0] = i == 0 ? runs[i][1]
                             : identify(p.reduction,
-                                       reduce_sensor_channels(p.reduction, base_model, o.reduce, s.sensor(),
-                                                              kMaxModelSamplesPerDwell),
+                                       reduce_sensor_model_terms(p.reduction, base_model, o.reduce,
+                                                                 s.sensor(), kMaxModelSamplesPerDwell),
                                        base_model, o);
         ++done;
       },

@@ -1,6 +1,6 @@
 #include "gyrocal/identify/calibration.hpp"
 
-// Identification's orchestration: the record reduced, the model's channels of the sensor, then the fit the
+// Identification's orchestration: the record reduced, the model terms of the sensor, then the fit the
 // options ask for (closed forms, least squares, self-calibration) and the misfit rule. Each step lives in its
 // own file of src/identify (docs/architecture.md, "identify").
 #include <algorithm>
@@ -14,7 +14,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/misfit.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "gyrocal/reduce/feasibility.hpp"
 
@@ -26,13 +26,13 @@
 
 namespace gyrocal::identify_detail {
 
-/// The model's channels of the options' sensor, reduced by the operator of the record's output.
-std::vector<PositionChannels> model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                             const CalibrationOptions& options) {
+/// The model terms of the options' sensor, reduced by the operator of the record's output.
+std::vector<PositionModelTerms> model_terms_for(const Reduction& reduction, const CentrifugeModel& model,
+                                                const CalibrationOptions& options) {
   if (options.sensor == SensorKind::kGyro)
-    return reduce_model_channels(reduction, model, options.reduce, options.max_model_samples_per_dwell);
-  return reduce_sensor_channels(reduction, model, options.reduce, sensor_of(options.sensor),
-                                options.max_model_samples_per_dwell);
+    return reduce_model_terms(reduction, model, options.reduce, options.max_model_samples_per_dwell);
+  return reduce_sensor_model_terms(reduction, model, options.reduce, sensor_of(options.sensor),
+                                   options.max_model_samples_per_dwell);
 }
 
 }  // namespace gyrocal::identify_detail
@@ -63,12 +63,13 @@ void warn_radius_is_over_gravity(const CentrifugeModel& model, const Calibration
 
 using namespace identify_detail;
 
-CalibrationResult identify(const Reduction& record_reduction, const std::vector<PositionChannels>& channels,
-                           const CentrifugeModel& model, const CalibrationOptions& options) {
+CalibrationResult identify(const Reduction& record_reduction,
+                           const std::vector<PositionModelTerms>& model_terms, const CentrifugeModel& model,
+                           const CalibrationOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw Error("calibration options: " + error + ".");
-  // Where a sensor's channels follow the measured motion, the dwells' levels are the residual's.
-  const std::optional<Reduction> releveled = residual_levels(record_reduction, channels, model, options);
+  // Where a sensor's model terms follow the measured motion, the dwells' levels are the residual's.
+  const std::optional<Reduction> releveled = residual_levels(record_reduction, model_terms, model, options);
   const Reduction& reduction = releveled ? *releveled : record_reduction;
   CalibrationResult r;
   r.method = options.method;
@@ -107,18 +108,18 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   if (options.test_misfit)
-    refuse_constant_output(reduction, options.output, noise_free_level(reduction, channels, options.sensor),
-                           options.sensor);
+    refuse_constant_output(reduction, options.output,
+                           noise_free_level(reduction, model_terms, options.sensor), options.sensor);
   if (!options.estimate.empty()) {
     if (options.test_misfit)
-      refuse_setup_mistake_before_estimating(reduction, channels, model, options, r.g_level);
+      refuse_setup_mistake_before_estimating(reduction, model_terms, model, options, r.g_level);
     // No closed-form alternatives: they would compensate the configured errors, not the estimated ones.
-    r = self_calibrate(reduction, channels, model, options, r);
+    r = self_calibrate(reduction, model_terms, model, options, r);
     if (options.sensor == SensorKind::kAccelerometer) warn_radius_is_over_gravity(model, options, r);
   } else if (options.method == Method::kClosedForm) {
-    closed_form_identify(reduction, channels, model, options, r);
+    closed_form_identify(reduction, model_terms, model, options, r);
   } else {
-    least_squares_identify(reduction, channels, model, options, r);
+    least_squares_identify(reduction, model_terms, model, options, r);
 
     // The closed form's second expressions are a useful cross-check whenever the plan holds the 16 positions.
     if (options.sensor == SensorKind::kGyro && !sixteen_positions(reduction.positions).empty()) {
@@ -126,21 +127,23 @@ CalibrationResult identify(const Reduction& record_reduction, const std::vector<
       cf.g_level = r.g_level;
       CalibrationOptions drift_only = options;
       drift_only.gyro_model = GyroModel::kDrift;
-      closed_form_identify(reduction, channels, model, drift_only, cf);
+      closed_form_identify(reduction, model_terms, model, drift_only, cf);
       r.alternatives = cf.alternatives;
     }
   }
   const bool accelerometer = options.sensor == SensorKind::kAccelerometer;
   // A K1 no accelerometer has (a wrong output column) is refused before its residuals are judged.
   if (options.test_misfit && accelerometer) refuse_insignificant_k1(options, r);
-  if (options.test_misfit) apply_misfit_rule(reduction, channels, model, options, r);
-  if (options.test_misfit && accelerometer) check_accelerometer_after_misfit(reduction, channels, options, r);
+  if (options.test_misfit) apply_misfit_rule(reduction, model_terms, model, options, r);
+  if (options.test_misfit && accelerometer)
+    check_accelerometer_after_misfit(reduction, model_terms, options, r);
   return r;
 }
 
-std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                   const CalibrationOptions& options) {
-  return model_channels(reduction, model, options);
+std::vector<PositionModelTerms> calibration_model_terms(const Reduction& reduction,
+                                                        const CentrifugeModel& model,
+                                                        const CalibrationOptions& options) {
+  return model_terms_for(reduction, model, options);
 }
 
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,
@@ -163,16 +166,16 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
     o.output_unit = layout->column_unit();
   }
   // The output's range is kept for the misfit's causes (identify/misfit.hpp: a flat top).
-  // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_channels.hpp).
+  // An accelerometer's spinning dwells are reduced to their whole harmonic content (sensor_model_terms.hpp).
   const Reduction reduction =
       reduce_record(reader, reduction_plan(plan, options.sensor, options.reduce), options.reduce,
                     model.geometry().rate_rad_s, [&o](std::span<const RecordSample> rows) {
                       for (const RecordSample& s : rows) o.output.range.push(s.output);
                     });
-  const std::vector<PositionChannels> channels = options.sensor == SensorKind::kGyro
-                                                     ? reduce_model_channels(reduction, model, options.reduce)
-                                                     : model_channels(reduction, model, options);
-  CalibrationResult result = identify(reduction, channels, model, o);
+  const std::vector<PositionModelTerms> model_terms =
+      options.sensor == SensorKind::kGyro ? reduce_model_terms(reduction, model, options.reduce)
+                                          : model_terms_for(reduction, model, options);
+  CalibrationResult result = identify(reduction, model_terms, model, o);
   // K1 is fitted on the record's output as read, in g. A rig's channel read through [record]
   // output_scale_per_g (output units per g) has its scale factor in those units: K1 = scale x the fitted
   // ratio (docs/contract.md); the other coefficients are ratios to K1 and do not change.

@@ -23,7 +23,7 @@ double first_spinning_rate(const std::vector<ReducedPosition>& positions) {
   return 0.0;
 }
 
-void closed_form_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void closed_form_identify(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                           const CentrifugeModel& model, const CalibrationOptions& options,
                           CalibrationResult& r) {
   if (options.gyro_model != GyroModel::kDrift)
@@ -60,7 +60,7 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   Eigen::Matrix<double, 16, 16> se;
   for (std::size_t k = 0; k < 16; ++k) {
     const auto i = static_cast<std::size_t>(k16[k]);
-    const PositionChannels& ch = channels[i];
+    const PositionModelTerms& ch = model_terms[i];
     // Compensation: remove what the machine adds beyond a perfect one (docs/physics.md section 8).
     w[k] = reduction.positions[i].mean - (ch.omega_deg_h(options.compensation) - ch.omega_nominal_deg_h);
     for (std::size_t l = 0; l < 16; ++l)
@@ -108,8 +108,8 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
   Eigen::MatrixXd cov16(16, 16);
   const Eigen::MatrixXd floored = position_covariance(reduction, options.min_std_err);
   for (Eigen::Index k = 0; k < 16; ++k) {
-    const auto& reg =
-        channels[static_cast<std::size_t>(k16[static_cast<std::size_t>(k)])].regressors(options.compensation);
+    const auto& reg = model_terms[static_cast<std::size_t>(k16[static_cast<std::size_t>(k)])].regressors(
+        options.compensation);
     for (Eigen::Index j = 0; j < x.cols(); ++j) x(k, j) = reg[static_cast<std::size_t>(j)];
     for (Eigen::Index l = 0; l < 16; ++l)
       cov16(k, l) = floored(k16[static_cast<std::size_t>(k)], k16[static_cast<std::size_t>(l)]);

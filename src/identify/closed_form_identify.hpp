@@ -13,7 +13,7 @@ double first_spinning_rate(const std::vector<ReducedPosition>& positions);
 
 /// The ten drift coefficients, the alternatives and the named combinations by the closed forms into `r`;
 /// with --method closed-form also its condition and its uncertainty amplification over least squares.
-void closed_form_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void closed_form_identify(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                           const CentrifugeModel& model, const CalibrationOptions& options,
                           CalibrationResult& r);
 

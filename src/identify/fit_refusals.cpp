@@ -22,10 +22,10 @@ std::string describe_position(const Reduction& reduction, std::size_t i) {
   return where + ")";
 }
 
-/// Refuses, naming the position, a reduced value or model channel that is not finite (a record whose outputs
+/// Refuses, naming the position, a reduced value or model term that is not finite (a record whose outputs
 /// overflow, a configuration whose levels do).
 void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
-                  const Eigen::VectorXd& observations, const std::vector<PositionChannels>& channels,
+                  const Eigen::VectorXd& observations, const std::vector<PositionModelTerms>& model_terms,
                   Compensation compensation) {
   for (Eigen::Index i = 0; i < design.rows(); ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -35,7 +35,7 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
           fmt::format("the reduced gyro output of {} is not a finite number: the record's gyro "
                       "outputs there are too large to average; check the record's gyro column.",
                       describe_position(reduction, k)));
-    if (!std::isfinite(channels[k].omega_deg_h(compensation)) || !design.row(i).allFinite())
+    if (!std::isfinite(model_terms[k].omega_deg_h(compensation)) || !design.row(i).allFinite())
       throw Error(
           fmt::format("the model's input rate or specific force at {} is not finite: the configured "
                       "radius, rate or machine errors are too large to evaluate.",
@@ -44,7 +44,7 @@ void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
       throw Error(
           fmt::format("the output minus the model's input rate at {} is not finite ({:g} - {:g}): "
                       "the record's gyro output and the configuration disagree beyond a double's range.",
-                      describe_position(reduction, k), p.mean, channels[k].omega_deg_h(compensation)));
+                      describe_position(reduction, k), p.mean, model_terms[k].omega_deg_h(compensation)));
   }
 }
 

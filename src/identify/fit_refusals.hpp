@@ -1,7 +1,7 @@
 #pragma once
 // What a least-squares fit refuses before it weights anything, each refusal naming the position or dwell at
-// fault: a value or channel that is not finite, an observation that leaves a double's range once whitened, a
-// measurement repeated, a covariance that cannot weight a fit. Internal to src/identify.
+// fault: a value or model term that is not finite, an observation that leaves a double's range once whitened,
+// a measurement repeated, a covariance that cannot weight a fit. Internal to src/identify.
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -16,9 +16,9 @@ namespace gyrocal::identify_detail {
 /// "position 8 (rate 9.9 rad/s, beta 180 deg, gamma 270 deg; record time 812.3 s to 1013.4 s)".
 std::string describe_position(const Reduction& reduction, std::size_t i);
 
-/// Refuses, naming the position, a reduced value or model channel that is not finite.
+/// Refuses, naming the position, a reduced value or model term that is not finite.
 void check_finite(const Reduction& reduction, const Eigen::MatrixXd& design,
-                  const Eigen::VectorXd& observations, const std::vector<PositionChannels>& channels,
+                  const Eigen::VectorXd& observations, const std::vector<PositionModelTerms>& model_terms,
                   Compensation compensation);
 
 /// Refuses, naming the position, an observation that leaves a double's range once whitened. `unit` is the

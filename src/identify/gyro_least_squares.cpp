@@ -79,12 +79,12 @@ void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
 
 }  // namespace
 
-void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void least_squares_identify(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                             const CentrifugeModel& model, const CalibrationOptions& options,
                             CalibrationResult& r, const ErrorColumns& extra,
                             ErrorColumnsSolution* extra_solution) {
   if (options.sensor != SensorKind::kGyro) {
-    sensor_least_squares(reduction, channels, options, r, extra, extra_solution);
+    sensor_least_squares(reduction, model_terms, options, r, extra, extra_solution);
     return;
   }
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());
@@ -101,13 +101,13 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   Eigen::VectorXd observations(m);
   for (Eigen::Index i = 0; i < m; ++i) {
     const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
-    const PositionChannels& ch = channels[static_cast<std::size_t>(i)];
+    const PositionModelTerms& ch = model_terms[static_cast<std::size_t>(i)];
     const std::vector<double> x = design_row(ch, options.compensation, unknowns);
     for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = x[static_cast<std::size_t>(j)];
     for (Eigen::Index j = nc; j < n; ++j) design(i, j) = extra.columns(i, j - nc);
     observations[i] = p.mean - ch.omega_deg_h(options.compensation);
   }
-  check_finite(reduction, design, observations, channels, options.compensation);
+  check_finite(reduction, design, observations, model_terms, options.compensation);
   refuse_repeated_positions(reduction);
   const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err);
   // The weights come from the covariance with one level for the whole record (the levels pooled over the

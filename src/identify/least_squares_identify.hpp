@@ -1,6 +1,6 @@
 #pragma once
 // The two least-squares routes of identification (docs/physics.md section 9): the gyro's
-// (gyro_least_squares.cpp: its 25-column model channels, the unknowns of identify/unknowns.hpp) and a
+// (gyro_least_squares.cpp: its 25-column model terms, the unknowns of identify/unknowns.hpp) and a
 // sensor's through its design rows (sensor_least_squares.cpp: the products, then the coefficients by the
 // delta method). Both are generalised least squares on the dwells' covariance with the record's pooled level
 // and a sandwich for the uncertainties; a self-calibration's machine-error columns follow the sensor's
@@ -34,21 +34,21 @@ struct ErrorColumnsSolution {
 /// step back from the products do not depend on the sensor's configured truth, so the default one serves.
 Sensor sensor_of(SensorKind kind);
 
-/// The model's channels of the options' sensor, reduced by the operator of the record's output
+/// The model terms of the options' sensor, reduced by the operator of the record's output
 /// (calibration.cpp).
-std::vector<PositionChannels> model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                             const CalibrationOptions& options);
+std::vector<PositionModelTerms> model_terms_for(const Reduction& reduction, const CentrifugeModel& model,
+                                                const CalibrationOptions& options);
 
 /// A sensor's least squares (sensor_least_squares.cpp): the products u of its design rows, then its
 /// coefficients by from_products and the delta method. Extra columns (a self-calibration's machine errors)
 /// follow the products; their solution goes to *extra_solution when given.
-void sensor_least_squares(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void sensor_least_squares(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                           const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
                           ErrorColumnsSolution* extra_solution);
 
 /// Least squares of the options' sensor into `r` (gyro_least_squares.cpp): the gyro's route, or
 /// sensor_least_squares for any other sensor.
-void least_squares_identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void least_squares_identify(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                             const CentrifugeModel& model, const CalibrationOptions& options,
                             CalibrationResult& r, const ErrorColumns& extra = {},
                             ErrorColumnsSolution* extra_solution = nullptr);

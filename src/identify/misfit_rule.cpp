@@ -34,14 +34,14 @@ constexpr double kStaticK1Tolerance = 0.01;
 
 /// A plain least-squares fit of `reduction` with the options' gyro model and compensation (no machine error
 /// estimated): the fit the misfit test and its causes are judged on.
-CalibrationResult plain_fit(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+CalibrationResult plain_fit(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                             const CentrifugeModel& model, const CalibrationOptions& options, double g_level) {
   CalibrationOptions o = options;
   o.method = Method::kLeastSquares;
   o.estimate.clear();
   CalibrationResult r;
   r.g_level = g_level;
-  least_squares_identify(reduction, channels, model, o, r);
+  least_squares_identify(reduction, model_terms, model, o, r);
   return r;
 }
 
@@ -85,7 +85,7 @@ std::string accelerometer_scale_key(const OutputConfiguration& output) {
 /// the radius error estimated with the coefficients. Refuses the calibration naming both when that fit is
 /// consistent and the radius it finds is off the configured one by more than 3 sigma. Not tried when
 /// --estimate already holds radius_error.
-void refuse_radius_or_gravity(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void refuse_radius_or_gravity(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                               const CentrifugeModel& model, const CalibrationOptions& options, double g_level,
                               double noise_free, const std::string& stated) {
   const std::vector<MachineErrorParameter> radius =
@@ -99,7 +99,7 @@ void refuse_radius_or_gravity(const Reduction& reduction, const std::vector<Posi
   base.g_level = g_level;
   CalibrationResult f;
   try {
-    f = self_calibrate(reduction, channels, model, o, base);
+    f = self_calibrate(reduction, model_terms, model, o, base);
   } catch (const Error&) {
     return;
   }
@@ -135,18 +135,18 @@ struct GravityReading {
   int up = 0, down = 0;
 };
 
-GravityReading gravity_reading(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+GravityReading gravity_reading(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                                bool statics) {
   const auto k1_at = static_cast<std::size_t>(AccelCoefficient::K1);
   const std::size_t n = reduction.dwells.size();
   std::vector<double> output(n, 0.0), ai(n, 0.0), var(n, 0.0);
   std::vector<int> count(n, 0);
-  for (std::size_t i = 0; i < reduction.positions.size() && i < channels.size(); ++i) {
+  for (std::size_t i = 0; i < reduction.positions.size() && i < model_terms.size(); ++i) {
     const ReducedPosition& p = reduction.positions[i];
     const auto d = static_cast<std::size_t>(p.dwell);
-    if (channels[i].sensor_exact.size != kNumAccelCoefficients) return {};
+    if (model_terms[i].sensor_exact.size != kNumAccelCoefficients) return {};
     output[d] += p.mean;
-    ai[d] += channels[i].sensor_exact.regressors[k1_at];
+    ai[d] += model_terms[i].sensor_exact.regressors[k1_at];
     var[d] += p.std_err * p.std_err;
     ++count[d];
   }
@@ -169,11 +169,11 @@ GravityReading gravity_reading(const Reduction& reduction, const std::vector<Pos
 /// The static holds at a_i = +1 g and -1 g judged against the fit's K1 (`k1`, as the reduction holds it)
 /// and against the spinning dwells' own reading of gravity: one sentence when they do not read about +K1 g
 /// and -K1 g (beyond kStaticK1Tolerance and 5 std), empty otherwise or without such holds.
-std::string static_holds_cause(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+std::string static_holds_cause(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                                const CalibrationOptions& options, double k1) {
-  const GravityReading statics = gravity_reading(reduction, channels, true);
+  const GravityReading statics = gravity_reading(reduction, model_terms, true);
   if (!std::isfinite(statics.k1)) return {};
-  const GravityReading spinning = gravity_reading(reduction, channels, false);
+  const GravityReading spinning = gravity_reading(reduction, model_terms, false);
   const auto agree = [&](double other, double other_std) {
     const double std = std::sqrt(statics.std * statics.std + other_std * other_std);
     return std::abs(statics.k1 - other) <= kStaticK1Tolerance * std::abs(other) + 5.0 * std;
@@ -245,14 +245,14 @@ std::optional<Reduction> shift_counter_zero(const Reduction& r, double offset_ra
 
 /// An accelerometer's counter encoder zero refitted: the offset that minimises chi2 (three parabolic steps
 /// from 0, within 0.01 rad). Refuses the calibration naming it when the fit is then consistent.
-void refuse_counter_zero(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void refuse_counter_zero(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                          const CentrifugeModel& model, const CalibrationOptions& options, double g_level,
                          double noise_free, const std::string& stated) {
   const auto chi2_at = [&](double offset) {
     const std::optional<Reduction> fixed = shift_counter_zero(reduction, offset);
     if (!fixed) return std::numeric_limits<double>::quiet_NaN();
     try {
-      return plain_fit(*fixed, channels, model, options, g_level).chi2;
+      return plain_fit(*fixed, model_terms, model, options, g_level).chi2;
     } catch (const Error&) {
       return std::numeric_limits<double>::quiet_NaN();
     }
@@ -274,7 +274,7 @@ void refuse_counter_zero(const Reduction& reduction, const std::vector<PositionC
   // whose counter angle was offset, tests/test_accelerometer_misfit.cpp).
   CalibrationResult f;
   try {
-    f = plain_fit(*fixed, channels, model, options, g_level);
+    f = plain_fit(*fixed, model_terms, model, options, g_level);
   } catch (const Error&) {
     return;
   }
@@ -292,11 +292,11 @@ void refuse_counter_zero(const Reduction& reduction, const std::vector<PositionC
 /// refuses the calibration naming the first the data fit (refit so, consistent and with a plausible scale-
 /// factor error), then a flat top read from the data. Returns the names of the mistakes tried.
 std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
-                                        const std::vector<PositionChannels>& channels,
+                                        const std::vector<PositionModelTerms>& model_terms,
                                         const CentrifugeModel& model, const CalibrationOptions& options,
                                         double g_level, const std::string& stated) {
   std::string tried;
-  const double noise_free = noise_free_level(reduction, channels, options.sensor);
+  const double noise_free = noise_free_level(reduction, model_terms, options.sensor);
   // The gyro's table holds its units and sign; an accelerometer fits its scale K1, so its unit and sign
   // never misfit (check_accelerometer_after_misfit judges them): its table holds the encoders' directions,
   // then the radius and the local gravity are refitted.
@@ -309,7 +309,7 @@ std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
     tried += (tried.empty() ? "" : ", ") + cause.name;
     CalibrationResult f;
     try {
-      f = plain_fit(*fixed, channels, model, options, g_level);
+      f = plain_fit(*fixed, model_terms, model, options, g_level);
     } catch (const Error&) {
       continue;
     }
@@ -322,16 +322,16 @@ std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
           stated, cause.explain, ft.dof > 0 ? ft.chi2 / ft.dof : 0.0, ft.p_value));
   }
   if (options.sensor == SensorKind::kAccelerometer) {
-    refuse_radius_or_gravity(reduction, channels, model, options, g_level, noise_free, stated);
+    refuse_radius_or_gravity(reduction, model_terms, model, options, g_level, noise_free, stated);
     tried += (tried.empty() ? "" : ", ") + std::string("the radius and the local gravity");
-    refuse_counter_zero(reduction, channels, model, options, g_level, noise_free, stated);
+    refuse_counter_zero(reduction, model_terms, model, options, g_level, noise_free, stated);
     tried += ", the counter encoder's zero";
     // Then the data: static holds that do not read +-K1 g.
     try {
-      const CalibrationResult plain = plain_fit(reduction, channels, model, options, g_level);
+      const CalibrationResult plain = plain_fit(reduction, model_terms, model, options, g_level);
       const SensorCoefficientEstimate& k1 = plain.sensor_coefficients.at(1);
       const std::string statics =
-          k1.identifiable ? static_holds_cause(reduction, channels, options, k1.value) : std::string();
+          k1.identifiable ? static_holds_cause(reduction, model_terms, options, k1.value) : std::string();
       if (!statics.empty()) throw Error(fmt::format("calibration refused: {}. {}.", stated, statics));
     } catch (const std::out_of_range&) {
     }
@@ -364,45 +364,45 @@ std::string unexplained_misfit(const std::string& tried, SensorKind sensor) {
 /// refused naming it (the Gauss-Newton iteration would otherwise fail to converge, or fit the mistake with
 /// machine errors). A misfit no mistake explains is left to the estimated errors.
 void refuse_setup_mistake_before_estimating(const Reduction& reduction,
-                                            const std::vector<PositionChannels>& channels,
+                                            const std::vector<PositionModelTerms>& model_terms,
                                             const CentrifugeModel& model, const CalibrationOptions& options,
                                             double g_level) {
   CalibrationResult plain;
   try {
-    plain = plain_fit(reduction, channels, model, options, g_level);
+    plain = plain_fit(reduction, model_terms, model, options, g_level);
   } catch (const Error&) {
     return;  // the self-calibration says what is wrong
   }
   const MisfitTest t =
-      test_misfit(reduction, plain.chi2, plain.dof, noise_free_level(reduction, channels, options.sensor));
+      test_misfit(reduction, plain.chi2, plain.dof, noise_free_level(reduction, model_terms, options.sensor));
   if (!t.tested) return;  // a noise-free record or a prediction: nothing measured to judge it by
   const double gross_e = gross_scale_factor_error(plain, options);
   if (t.p_value >= options.misfit.p_min && gross_e == 0.0) return;
-  refuse_a_cause_the_data_fit(reduction, channels, model, options, g_level,
+  refuse_a_cause_the_data_fit(reduction, model_terms, model, options, g_level,
                               state_misfit(t, gross_e, options.misfit));
 }
 
 /// Tests the fit's chi2 and, when the residuals exceed what chance explains, tries each set-up mistake of the
 /// sensor's table: one the data fit refuses the calibration, naming it and its fix; otherwise every std is
 /// scaled by sqrt(chi2 / dof), or the calibration is refused when that is beyond MisfitRule::max_scale.
-void apply_misfit_rule(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void apply_misfit_rule(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                        const CentrifugeModel& model, const CalibrationOptions& options,
                        CalibrationResult& r) {
   if (options.method == Method::kClosedForm && options.estimate.empty()) {
-    const CalibrationResult ls = plain_fit(reduction, channels, model, options, r.g_level);
+    const CalibrationResult ls = plain_fit(reduction, model_terms, model, options, r.g_level);
     r.chi2 = ls.chi2;
     r.dof = ls.dof;
   }
   const MisfitRule& rule = options.misfit;
   const MisfitTest t =
-      test_misfit(reduction, r.chi2, r.dof, noise_free_level(reduction, channels, options.sensor));
+      test_misfit(reduction, r.chi2, r.dof, noise_free_level(reduction, model_terms, options.sensor));
   r.misfit = t;
   if (!t.tested) return;  // a noise-free record or a prediction: nothing measured to judge it by
   const double gross_e = gross_scale_factor_error(r, options);
   if (t.p_value >= rule.p_min && gross_e == 0.0) return;
   const std::string stated = state_misfit(t, gross_e, rule);
   const std::string tried =
-      refuse_a_cause_the_data_fit(reduction, channels, model, options, r.g_level, stated);
+      refuse_a_cause_the_data_fit(reduction, model_terms, model, options, r.g_level, stated);
   const std::string unexplained = unexplained_misfit(tried, options.sensor);
   if (gross_e != 0.0) throw Error(fmt::format("calibration refused: {}; {}.", stated, unexplained));
   const double scale = std::sqrt(t.chi2 / t.dof);
@@ -424,11 +424,12 @@ void apply_misfit_rule(const Reduction& reduction, const std::vector<PositionCha
       stated, scale, unexplained));
 }
 
-double accelerometer_output_per_g(const Reduction& reduction, const std::vector<PositionChannels>& channels) {
+double accelerometer_output_per_g(const Reduction& reduction,
+                                  const std::vector<PositionModelTerms>& model_terms) {
   const auto at = [](AccelCoefficient c) { return static_cast<std::size_t>(c); };
   double output = 0.0, force = 0.0;
-  for (std::size_t i = 0; i < reduction.positions.size() && i < channels.size(); ++i) {
-    const DesignRow& row = channels[i].sensor_exact;
+  for (std::size_t i = 0; i < reduction.positions.size() && i < model_terms.size(); ++i) {
+    const DesignRow& row = model_terms[i].sensor_exact;
     if (row.size != kNumAccelCoefficients) return 1.0;
     // The regressors of delta_p and delta_o are a_p and a_o per urad (x 1e-6); K1's is a_i.
     const double ai = row.regressors[at(AccelCoefficient::K1)];
@@ -441,10 +442,10 @@ double accelerometer_output_per_g(const Reduction& reduction, const std::vector<
   return std::isfinite(per_g) && per_g > 0.0 ? per_g : 1.0;
 }
 
-double noise_free_level(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+double noise_free_level(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                         SensorKind sensor) {
   if (sensor == SensorKind::kGyro) return kGyroNoiseFreeDegH;
-  return kAccelerometerNoiseFreeRelative * accelerometer_output_per_g(reduction, channels);
+  return kAccelerometerNoiseFreeRelative * accelerometer_output_per_g(reduction, model_terms);
 }
 
 void refuse_insignificant_k1(const CalibrationOptions& options, const CalibrationResult& r) {
@@ -468,7 +469,7 @@ void refuse_insignificant_k1(const CalibrationOptions& options, const Calibratio
 }
 
 void check_accelerometer_after_misfit(const Reduction& reduction,
-                                      const std::vector<PositionChannels>& channels,
+                                      const std::vector<PositionModelTerms>& model_terms,
                                       const CalibrationOptions& options, CalibrationResult& r) {
   const auto k1_at = static_cast<std::size_t>(AccelCoefficient::K1);
   if (r.sensor_coefficients.size() <= k1_at) return;
@@ -479,7 +480,7 @@ void check_accelerometer_after_misfit(const Reduction& reduction,
   const double stated = k1.value * scale;
   // A tested record whose static holds disagree misfits, and the misfit rule has named them.
   if (!r.misfit.tested) {
-    const std::string statics = static_holds_cause(reduction, channels, options, k1.value);
+    const std::string statics = static_holds_cause(reduction, model_terms, options, k1.value);
     if (!statics.empty()) throw Error(fmt::format("calibration refused: {}.", statics));
   }
   const double ratio = std::abs(k1.value);

@@ -10,15 +10,16 @@ namespace gyrocal::identify_detail {
 
 /// An accelerometer's output per g as the reduction holds it (the record's output divided by the configured
 /// [record] output_scale_per_g): the largest reduced output over the largest specific force the model's
-/// channels give (|f| of the design rows' a_i, a_p, a_o), about |K1| / output_scale_per_g. It scales with
+/// model terms give (|f| of the design rows' a_i, a_p, a_o), about |K1| / output_scale_per_g. It scales with
 /// the output whatever unit it is read in, so that a threshold in it does not depend on the configured
-/// scale. 1 when the outputs are all zero or the channels are not an accelerometer's.
-double accelerometer_output_per_g(const Reduction& reduction, const std::vector<PositionChannels>& channels);
+/// scale. 1 when the outputs are all zero or the model terms are not an accelerometer's.
+double accelerometer_output_per_g(const Reduction& reduction,
+                                  const std::vector<PositionModelTerms>& model_terms);
 
 /// The level below which a reduced position's standard error is a noise-free output's rounding, in the
 /// reduction's units: kGyroNoiseFreeDegH for the gyro; kAccelerometerNoiseFreeRelative of the record's own
 /// g (accelerometer_output_per_g) for an accelerometer.
-double noise_free_level(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+double noise_free_level(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                         SensorKind sensor);
 
 /// An accelerometer's fitted K1 (in `r`, as the reduction holds it: K1 / output_scale_per_g) refused when
@@ -32,20 +33,20 @@ void refuse_insignificant_k1(const CalibrationOptions& options, const Calibratio
 /// configured nominal (output_scale_per_g) by more than a factor 2 (a unit), or is negative (the input axis
 /// points the other way), or has the other sign than a negative output_scale_per_g.
 void check_accelerometer_after_misfit(const Reduction& reduction,
-                                      const std::vector<PositionChannels>& channels,
+                                      const std::vector<PositionModelTerms>& model_terms,
                                       const CalibrationOptions& options, CalibrationResult& r);
 
 /// Before a self-calibration: a record that misfits the configured machine because of a set-up mistake is
 /// refused naming it. A misfit no mistake explains is left to the estimated errors.
 void refuse_setup_mistake_before_estimating(const Reduction& reduction,
-                                            const std::vector<PositionChannels>& channels,
+                                            const std::vector<PositionModelTerms>& model_terms,
                                             const CentrifugeModel& model, const CalibrationOptions& options,
                                             double g_level);
 
 /// Tests the fit's chi2 and, when the residuals exceed what chance explains, refuses the calibration naming a
 /// set-up mistake the data fit, or scales every std by sqrt(chi2 / dof) (refused beyond
 /// MisfitRule::max_scale).
-void apply_misfit_rule(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void apply_misfit_rule(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                        const CentrifugeModel& model, const CalibrationOptions& options, CalibrationResult& r);
 
 }  // namespace gyrocal::identify_detail

@@ -10,7 +10,7 @@
 #include "least_squares_identify.hpp"
 
 namespace gyrocal::identify_detail {
-/// A sensor's dwells whose channels follow the measured motion (PositionChannels::sensor_periods), with
+/// A sensor's dwells whose model terms follow the measured motion (PositionModelTerms::sensor_periods), with
 /// their covariance's level measured from the scatter between revolutions of the output minus the model
 /// (docs/accelerometer.md, "The drive's ripple"): a drive's ripple moves an accelerometer's centripetal input
 /// from one revolution to the next by far more than its noise, and that motion is in the model. The model
@@ -18,17 +18,17 @@ namespace gyrocal::identify_detail {
 /// that scatter's weights' only use; the machine errors a self-calibration estimates change the model by
 /// far less between revolutions and are left out). nullopt when no dwell follows.
 std::optional<Reduction> residual_levels(const Reduction& reduction,
-                                         const std::vector<PositionChannels>& channels,
+                                         const std::vector<PositionModelTerms>& model_terms,
                                          const CentrifugeModel& model, const CalibrationOptions& options) {
-  if (options.sensor == SensorKind::kGyro || channels.size() != reduction.positions.size())
+  if (options.sensor == SensorKind::kGyro || model_terms.size() != reduction.positions.size())
     return std::nullopt;
-  if (std::none_of(channels.begin(), channels.end(),
-                   [](const PositionChannels& c) { return !c.sensor_periods.empty(); }))
+  if (std::none_of(model_terms.begin(), model_terms.end(),
+                   [](const PositionModelTerms& c) { return !c.sensor_periods.empty(); }))
     return std::nullopt;
   CalibrationResult first;
   first.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
-  sensor_least_squares(reduction, channels, options, first, ErrorColumns{}, nullptr);
+  sensor_least_squares(reduction, model_terms, options, first, ErrorColumns{}, nullptr);
   const std::vector<double>& u = first.sensor_products;
   Reduction out = reduction;
   std::vector<std::vector<std::size_t>> slots(out.dwells.size());  // per dwell and gamma slot: its position
@@ -44,15 +44,15 @@ std::optional<Reduction> residual_levels(const Reduction& reduction,
     const std::vector<std::size_t>& s = slots[di];
     if (v.periods.empty() || s.size() != v.value.size() ||
         std::any_of(s.begin(), s.end(),
-                    [&](std::size_t i) { return i == SIZE_MAX || channels[i].sensor_periods.empty(); }))
+                    [&](std::size_t i) { return i == SIZE_MAX || model_terms[i].sensor_periods.empty(); }))
       continue;
     std::vector<PeriodValues> residual;
     for (const PeriodValues& pv : v.periods) {
       PeriodValues r{pv.index, pv.t_scaled, pv.values};
       bool found = true;
       for (std::size_t g = 0; g < s.size() && found; ++g) {
-        const auto& rows = channels[s[g]].sensor_periods;
-        const auto it = std::find_if(rows.begin(), rows.end(), [&](const PositionChannels::PeriodRow& x) {
+        const auto& rows = model_terms[s[g]].sensor_periods;
+        const auto it = std::find_if(rows.begin(), rows.end(), [&](const PositionModelTerms::PeriodRow& x) {
           return x.index == pv.index;
         });
         found = it != rows.end();

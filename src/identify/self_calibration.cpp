@@ -22,7 +22,7 @@ namespace {
 // Self-calibration (docs/physics.md section 12; docs/self_calibration.md).
 
 /// A reduced output's change below this (deg/h) for an error's typical magnitude at every position means the
-/// plan does not excite the error: it is the rounding level of the reduced channels (~1e-10 deg/h).
+/// plan does not excite the error: it is the rounding level of the reduced model terms (~1e-10 deg/h).
 constexpr double kMinErrorEffectDegH = 1e-9;
 /// An estimated error whose predicted standard uncertainty exceeds this multiple of its typical magnitude is
 /// not identifiable: the data bound it no better than a hundred times the size such an error has (the same
@@ -64,10 +64,10 @@ CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<Mach
 
 /// The columns of the parameters `which` (indices into ps): the derivative of each reduced model output,
 /// omega_I + sum_j c_j x_j, with respect to the error, in deg/h per the error's unit, by a central difference
-/// of the reduced exact channels (the same reduction operator as the data) with the error's typical magnitude
-/// as the step: omega_I and the regressors are smooth in a machine error of that size (their curvature is
-/// of relative order 1e-5 per arcsec), so the difference's truncation error is ~1e-11 relative, and its
-/// rounding ~1e-10 deg/h over a step that moves the output by ~10 deg/h (docs/self_calibration.md).
+/// of the reduced exact model terms (the same reduction operator as the data) with the error's typical
+/// magnitude as the step: omega_I and the regressors are smooth in a machine error of that size (their
+/// curvature is of relative order 1e-5 per arcsec), so the difference's truncation error is ~1e-11 relative,
+/// and its rounding ~1e-10 deg/h over a step that moves the output by ~10 deg/h (docs/self_calibration.md).
 Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel& model,
                               const std::vector<MachineErrorParameter>& ps,
                               const std::vector<double>& values_si, const std::vector<std::size_t>& which,
@@ -80,11 +80,11 @@ Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel&
     std::vector<double> plus = values_si, minus = values_si;
     plus[which[a]] += h;
     minus[which[a]] -= h;
-    const auto up = model_channels(reduction, with_errors(model, ps, plus), options);
-    const auto down = model_channels(reduction, with_errors(model, ps, minus), options);
+    const auto up = model_terms_for(reduction, with_errors(model, ps, plus), options);
+    const auto down = model_terms_for(reduction, with_errors(model, ps, minus), options);
     for (Eigen::Index i = 0; i < m; ++i) {
-      const PositionChannels& u = up[static_cast<std::size_t>(i)];
-      const PositionChannels& d = down[static_cast<std::size_t>(i)];
+      const PositionModelTerms& u = up[static_cast<std::size_t>(i)];
+      const PositionModelTerms& d = down[static_cast<std::size_t>(i)];
       double diff = 0.0;
       if (options.sensor == SensorKind::kGyro) {
         diff = u.omega_exact_deg_h - d.omega_exact_deg_h;
@@ -136,7 +136,8 @@ std::string error_advice(const MachineErrorParameter& p, const Reduction& reduct
 
 }  // namespace
 
-CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+CalibrationResult self_calibrate(const Reduction& reduction,
+                                 const std::vector<PositionModelTerms>& model_terms,
                                  const CentrifugeModel& model, const CalibrationOptions& options,
                                  const CalibrationResult& base) {
   if (options.method != Method::kLeastSquares)
@@ -164,7 +165,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     e.configured = configured[j] / f.unit_to_si;
   }
   // The platform's rate mismatch is not estimated from the gyro: the record's encoders measure it (the model
-  // takes the joints from their fitted lines, so delta omega is already in every channel and its column is
+  // takes the joints from their fitted lines, so delta omega is already in every model term and its column is
   // zero). It is reported as the encoders give it: the mean over spinning dwells of their platform's heading
   // rate, counter + main (docs/self_calibration.md).
   std::vector<std::size_t> active;
@@ -207,7 +208,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     std::vector<double> start = zero;
     if (options.sensor != SensorKind::kGyro) {
       CalibrationResult plain = base;
-      least_squares_identify(reduction, channels, model, options, plain);
+      least_squares_identify(reduction, model_terms, model, options, plain);
       std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), start.begin());
     }
     const Eigen::MatrixXd cols = error_columns(reduction, model, ps, configured, active, start, options);
@@ -247,7 +248,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
     if (active.empty()) break;
     CalibrationResult trial = base;
     ErrorColumnsSolution es;
-    least_squares_identify(reduction, channels, model, options, trial, columns_of(active), &es);
+    least_squares_identify(reduction, model_terms, model, options, trial, columns_of(active), &es);
     // The errors' columns follow the gyro model's unknowns (identify/unknowns.hpp) or the sensor's.
     const auto nc = static_cast<Eigen::Index>(unknowns_count);
     std::size_t drop = k;
@@ -297,7 +298,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
   std::vector<double> coefficients = zero;
   if (options.sensor != SensorKind::kGyro) {
     CalibrationResult plain = base;
-    least_squares_identify(reduction, channels, model, options, plain);
+    least_squares_identify(reduction, model_terms, model, options, plain);
     std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), coefficients.begin());
   }
   CalibrationResult r = base;
@@ -319,8 +320,8 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
           options.max_iterations, steps));
     }
     const CentrifugeModel current = with_errors(model, ps, values);
-    const std::vector<PositionChannels> current_channels =
-        iteration == 1 ? channels : model_channels(reduction, current, options);
+    const std::vector<PositionModelTerms> current_model_terms =
+        iteration == 1 ? model_terms : model_terms_for(reduction, current, options);
     if (iteration > 1) {
       const Eigen::MatrixXd cols =
           error_columns(reduction, current, ps, values, active, coefficients, options);
@@ -328,7 +329,7 @@ CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<P
         all_columns.col(static_cast<Eigen::Index>(active[a])) = cols.col(static_cast<Eigen::Index>(a));
     }
     r = base;
-    least_squares_identify(reduction, current_channels, current, options, r, columns_of(active), &last);
+    least_squares_identify(reduction, current_model_terms, current, options, r, columns_of(active), &last);
     converged = true;
     for (std::size_t a = 0; a < active.size(); ++a) {
       const auto ai = static_cast<Eigen::Index>(a);

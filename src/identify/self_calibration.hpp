@@ -11,7 +11,8 @@ namespace gyrocal::identify_detail {
 /// `base` (a result holding the record's data quality and g-level) with the coefficients and the estimated
 /// machine errors of options.estimate; the errors the plan does not identify are reported with their reason
 /// and kept at their configured value.
-CalibrationResult self_calibrate(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+CalibrationResult self_calibrate(const Reduction& reduction,
+                                 const std::vector<PositionModelTerms>& model_terms,
                                  const CentrifugeModel& model, const CalibrationOptions& options,
                                  const CalibrationResult& base);
 

@@ -67,7 +67,7 @@ Sensor sensor_of(SensorKind kind) {
 /// from_products, the delta method on the products' sandwich covariance, each std widened for the degrees of
 /// freedom of the scatter as the gyro's are. Extra columns (a self-calibration's machine errors) follow the
 /// products.
-void sensor_least_squares(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+void sensor_least_squares(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                           const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
                           ErrorColumnsSolution* extra_solution) {
   const Sensor sensor = sensor_of(options.sensor);
@@ -89,7 +89,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   Eigen::VectorXd observations(m);
   for (Eigen::Index i = 0; i < m; ++i) {
     const ReducedPosition& p = reduction.positions[static_cast<std::size_t>(i)];
-    const DesignRow& row = channels[static_cast<std::size_t>(i)].sensor_exact;
+    const DesignRow& row = model_terms[static_cast<std::size_t>(i)].sensor_exact;
     if (static_cast<Eigen::Index>(row.size) != nc)
       throw Error(fmt::format(
           "sensor.kind is \"{}\", but the model's channels given are the gyro's: this command does not yet "
@@ -128,9 +128,9 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   }
   // The floor in the output's own g (min_std_err is read as g for an accelerometer), so that the
   // weights do not depend on the unit the output is read in ([record] output_scale_per_g).
-  const double floor =
-      options.min_std_err *
-      (options.sensor == SensorKind::kAccelerometer ? accelerometer_output_per_g(reduction, channels) : 1.0);
+  const double floor = options.min_std_err * (options.sensor == SensorKind::kAccelerometer
+                                                  ? accelerometer_output_per_g(reduction, model_terms)
+                                                  : 1.0);
   const Eigen::MatrixXd covariance = position_covariance(reduction, floor);
   const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, floor);
   const Eigen::LLT<Eigen::MatrixXd> llt(weighting);

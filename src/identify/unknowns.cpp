@@ -20,7 +20,7 @@ Unknowns least_squares_unknowns(GyroModel gyro_model) {
   return u;
 }
 
-std::vector<double> design_row(const PositionChannels& ch, Compensation compensation,
+std::vector<double> design_row(const PositionModelTerms& ch, Compensation compensation,
                                const Unknowns& unknowns) {
   const auto& x = ch.regressors(compensation);
   std::vector<double> row(x.begin(), x.end());

@@ -121,7 +121,7 @@ void DwellAccumulator::break_revolution() {
 // docs/physics.md section 14: each sample's residual about the fit of the dwell so far and its block; beyond
 // outlier_threshold robust standard deviations of the block's residuals it is an outlier, the fit is
 // repeated without the outliers and the test with it, until the outliers do not change. Outliers are left
-// out of the fit, and their numbers kept, so that the model's channels go through the same operator
+// out of the fit, and their numbers kept, so that the model terms go through the same operator
 // (docs/calibration.md, "Spikes").
 void DwellAccumulator::test_block() {
   const std::size_t n = pending_.size();
@@ -321,7 +321,7 @@ void DwellAccumulator::test_block() {
   }
   // An outlier is left out of the fit (as the settled normal equations already leave it): replaced by the
   // fit's value it would be the same for a signal the fit holds whole, but a drive's ripple moves an
-  // accelerometer's output by far more than the fit holds (docs/accelerometer.md), and the model's channels
+  // accelerometer's output by far more than the fit holds (docs/accelerometer.md), and the model terms
   // that follow the measured motion leave out the same samples (outlier_samples), so the two stay one
   // operator. Without outliers the block's runs serve the reference sums and the fit whole; a block with
   // outliers adds its kept samples one by one, and a gap's mark passes to the next sample kept.

@@ -68,7 +68,7 @@ void Reducer::State::finish_run(Run& r) {
   d.planned_rate_rad_s = r.match.planned_rate_rad_s;
   d.planned_counter_rate_offset_rad_s = r.match.planned_counter_rate_offset_rad_s;
   d.measured_beta_rad = r.beta_sum / static_cast<double>(r.n) * kDegToRad;
-  // The channels take the plan's beta (and a static hold's gamma): an encoder's mean reading at rest is
+  // The model terms take the plan's beta (and a static hold's gamma): an encoder's mean reading at rest is
   // biased by up to half a count (docs/calibration.md).
   d.beta_rad = r.match.beta_rad;
   d.gammas_rad = d.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan);
@@ -169,7 +169,7 @@ void Reducer::State::finish_run(Run& r) {
                  place);
   }
   // A rate that wanders: the main encoder's scatter about its line beyond its white part (half the mean
-  // square of successive differences: quantisation and stamp jitter), which the channels' constant-rate
+  // square of successive differences: quantisation and stamp jitter), which the model terms' constant-rate
   // line does not follow.
   const double white2 =
       r.diff_n > 0 ? 0.5 * (r.diff_yy - 2.0 * bt * r.diff_yt + bt * bt * r.diff_tt) / r.diff_n : 0.0;

@@ -416,7 +416,7 @@ void Reducer::State::measure(const Row& u, bool gap, bool dropped, double t_reco
   // turn; after a gap, until a window has closed, the reading itself.
   const double psi = r.psi_line_valid ? u.psi + wrap_deg_quick(r.psi_line(u.t) - u.psi) : u.psi;
   if (r.motion) {
-    // Recorded for the channels (Dwell::basis_angle): a piece where the line or its whole turns change.
+    // Recorded for the model terms (Dwell::basis_angle): a piece where the line or its whole turns change.
     // psi - line is a whole number of turns up to rounding: the nearest by a truncating conversion (a
     // call of libm's round a row was 1 % of calibrate's time).
     const double q = r.psi_line_valid ? (psi - r.psi_line(u.t)) * (1.0 / 360.0) : 0.0;

@@ -1,13 +1,13 @@
 #pragma once
 // For tests: the scenario's test simulated in memory (simulate/simulator.hpp), streamed through the reducer
-// (reduce/reducer.hpp), and the model's channels reduced on the same dwells (identify/channels.hpp): what
+// (reduce/reducer.hpp), and the model terms reduced on the same dwells (identify/model_terms.hpp): what
 // `gyrocal simulate` then `gyrocal calibrate` do, without a file.
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include "gyrocal/config/scenario.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -15,7 +15,7 @@ namespace gyrocal::testing {
 
 struct Pipeline {
   Reduction reduction;
-  std::vector<PositionChannels> channels;
+  std::vector<PositionModelTerms> model_terms;
 };
 
 /// Simulates the scenario's test with `seed` (none: the scenario's test.seed) and reduces it with `ro`.
@@ -28,11 +28,11 @@ inline Reduction simulate_and_reduce(const Scenario& s, std::optional<std::uint6
   return reducer.finish();
 }
 
-/// Simulates the scenario's test with `seed`, reduces it with `ro`, and reduces the exact model's channels.
+/// Simulates the scenario's test with `seed`, reduces it with `ro`, and reduces the exact model terms.
 inline Pipeline run(const Scenario& s, std::uint64_t seed = 1, const ReduceOptions& ro = {}) {
   Pipeline p;
   p.reduction = simulate_and_reduce(s, seed, ro);
-  p.channels = reduce_model_channels(p.reduction, s.model(), ro);
+  p.model_terms = reduce_model_terms(p.reduction, s.model(), ro);
   return p;
 }
 

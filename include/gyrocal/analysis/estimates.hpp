@@ -9,7 +9,7 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/model/gyro.hpp"
 
 namespace gyrocal {
@@ -39,12 +39,12 @@ GyroNoise output_noise(const Scenario& scenario);
 
 /// The planned test of `scenario`'s sensor other than the gyro: the dwells its record would give, reduced as
 /// a calibration reduces them (an accelerometer's spinning dwells to their whole harmonic content,
-/// identify/sensor_channels.hpp's reduction_plan), each position's output the noise-free reduced output of
+/// identify/sensor_model_terms.hpp's reduction_plan), each position's output the noise-free reduced output of
 /// the sensor's configured truth on `scenario`'s machine, its std error what the white noise predicts; and
-/// the channels of `told` (the machine the calibration is told) on the same dwells.
+/// the model terms of `told` (the machine the calibration is told) on the same dwells.
 struct PlannedSensorTest {
   Reduction reduction;
-  std::vector<PositionChannels> channels;
+  std::vector<PositionModelTerms> model_terms;
 };
 PlannedSensorTest planned_sensor_test(const Scenario& scenario, const CentrifugeModel& told,
                                       const ReduceOptions& options);

@@ -6,11 +6,11 @@
 //
 // Two modes. Fast: the estimates are linear in the drawn errors and the noise, E = E0 + G*delta + M*n:
 // each source's column a central difference of the noise-free calibration of the drawn machine reduced on its
-// own planned encoder lines, with the configured model's channels on those lines (as a record's calibration
+// own planned encoder lines, with the configured model terms on those lines (as a record's calibration
 // evaluates them: docs/montecarlo.md, "The sources through the encoders"); n the noise through the reduction
 // operator (with its correlation between the gammas of one dwell) and M the identification's affine map of
 // the outputs (precomputed from identify itself), so a trial is one small matrix-vector product. Samples:
-// the whole time-series pipeline per trial (simulate with the drawn errors, reduce, channels of the
+// the whole time-series pipeline per trial (simulate with the drawn errors, reduce, model terms of the
 // configured model, identify), to check the fast mode.
 //
 // Trial k draws from RandomSource(seed, k) alone, and statistics are combined in trial order, so the same

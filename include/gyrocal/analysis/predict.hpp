@@ -7,7 +7,7 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 
 namespace gyrocal {
 
@@ -21,7 +21,7 @@ double white_noise_sample_std_deg_h(const GyroNoise& noise, double sample_rate_h
 /// Set each position's mean to its noise-free reduced output for `truth`:
 /// reduce(omega_I exact) + sum_j truth_j reduce(x_j exact), and with rate errors (docs/physics.md section 15)
 /// e reduce(omega_I) + (1 + e)(dO reduce(omega_O) + dS reduce(omega_S)).
-void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionChannels>& channels,
+void set_noise_free_outputs(Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                             const DriftCoefficients& truth, const GyroRateErrors& rate_errors = {});
 
 /// gamma x gamma: the covariance of a planned dwell's reduced values per unit variance of white noise on each

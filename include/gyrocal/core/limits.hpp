@@ -44,7 +44,7 @@ inline constexpr double kTestSamples = 1e10;
 
 /// The highest harmonic of the main or counter axis in a runout or wobble series, or in --estimate's `:n`.
 /// A geometric error of a bearing or a spindle lives in its first few harmonics; beyond the 64th it is
-/// vibration, which a dwell's fit averages away. The channels' Fourier route resolves up to this harmonic.
+/// vibration, which a dwell's fit averages away. The model terms' Fourier route resolves up to this harmonic.
 inline constexpr int kHarmonic = 64;
 /// The most terms in one harmonic series of the configuration: a runout or a wobble is stated in its first
 /// few harmonics. The model's work grows with the terms: eight series of 64 terms made `plan` take 4 s of CPU
@@ -143,7 +143,7 @@ inline constexpr double kUnitTemperatureMaxC = 1000.0;
 
 /// The most revolutions of gamma a calibration holds, over all the spinning dwells of its test together
 /// ([test] revolutions x the spinning dwells). A calibration keeps, per revolution of a spinning dwell until
-/// the model's channels are evaluated, the measured-motion spline's 4 knots and the revolution's values for
+/// the model terms are evaluated, the measured-motion spline's 4 knots and the revolution's values for
 /// the residual levels: ~150 B held, ~450 B more for the dwell being fitted; measured 240 B a revolution of
 /// RSS at 9.9 rad/s (issue 29, D19). 150 000 keep calibrate near 50 MB, under its 64 MB target
 /// (docs/performance.md); `plan` and `simulate` hold no such state and are not bounded by it.

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "gyrocal/identify/channels.hpp"
 #include "gyrocal/identify/misfit.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -26,8 +26,9 @@ struct CalibrationOptions {
   /// default: the ten drift coefficients; drift+rate adds the rate errors (docs/physics.md section 15).
   GyroModel gyro_model = GyroModel::kDrift;
   /// Which sensor the record's output is ([sensor] kind). An accelerometer is identified through its design
-  /// rows (identify/sensor_channels.hpp) by least squares with full compensation only; the closed forms, the
-  /// seed's and no compensation, and drift+rate are the gyro's and are refused (IsValid names the option).
+  /// rows (identify/sensor_model_terms.hpp) by least squares with full compensation only; the closed forms,
+  /// the seed's and no compensation, and drift+rate are the gyro's and are refused (IsValid names the
+  /// option).
   SensorKind sensor = SensorKind::kGyro;
   ReduceOptions reduce;               ///< how dwells are reduced
   LeastSquaresOptions least_squares;  ///< the solver's options
@@ -59,9 +60,9 @@ struct CalibrationOptions {
   /// Self-calibration: at most this many Gauss-Newton iterations, else the calibration is refused.
   /// Default 20.
   int max_iterations = 20;
-  /// Self-calibration: bound on the model evaluations per spinning dwell of the Jacobian's channels, as
-  /// reduce_model_channels' max_samples_per_dwell (0 = every ReduceOptions::model_samples_per_revolution; a
-  /// prediction passes the bound it evaluated its channels with).
+  /// Self-calibration: bound on the model evaluations per spinning dwell of the Jacobian's model terms, as
+  /// reduce_model_terms' max_samples_per_dwell (0 = every ReduceOptions::model_samples_per_revolution; a
+  /// prediction passes the bound it evaluated its model terms with).
   std::size_t max_model_samples_per_dwell = 0;
   /// When the residuals misfit the weights, scale every std or refuse, naming the set-up mistake the data fit
   /// (identify/misfit.hpp; docs/calibration.md, "When the residuals misfit"). False for a prediction, whose
@@ -212,18 +213,19 @@ std::string to_string(Compensation c);
 Method parse_method(const std::string& text);
 Compensation parse_compensation(const std::string& text);
 
-/// Identify from a reduction and its model channels (identify/channels.hpp).
-CalibrationResult identify(const Reduction& reduction, const std::vector<PositionChannels>& channels,
+/// Identify from a reduction and its model terms (identify/model_terms.hpp).
+CalibrationResult identify(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                            const CentrifugeModel& model, const CalibrationOptions& options);
 
-/// The model's channels of `reduction` for the options' sensor, reduced by the operator of the record's
-/// output: the gyro's (reduce_model_channels) or another sensor's design rows (reduce_sensor_channels). What
+/// The model terms of `reduction` for the options' sensor, reduced by the operator of the record's
+/// output: the gyro's (reduce_model_terms) or another sensor's design rows (reduce_sensor_model_terms). What
 /// identify() takes; a caller reducing a record itself reduces it with reduction_plan(plan, options.sensor,
-/// options.reduce) (identify/sensor_channels.hpp).
-std::vector<PositionChannels> calibration_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                   const CalibrationOptions& options);
+/// options.reduce) (identify/sensor_model_terms.hpp).
+std::vector<PositionModelTerms> calibration_model_terms(const Reduction& reduction,
+                                                        const CentrifugeModel& model,
+                                                        const CalibrationOptions& options);
 
-/// The whole pipeline on a record file: read as a stream, reduce, evaluate the model's channels, identify.
+/// The whole pipeline on a record file: read as a stream, reduce, evaluate the model terms, identify.
 /// `layout`: how the record is laid out (the configuration's [record], docs/records.md); nullopt for
 /// gyrocal's own format. A layout without all three angle columns is refused, naming the keys.
 CalibrationResult calibrate_record(const std::string& record_path, const CentrifugeModel& model,

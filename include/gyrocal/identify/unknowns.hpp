@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/model/gyro.hpp"
 
 namespace gyrocal {
@@ -28,7 +28,7 @@ Unknowns least_squares_unknowns(GyroModel gyro_model);
 /// compensation, then with drift+rate omega_I * 1e-6 (per ppm of e), omega_O and omega_S * 1 arcsec in rad
 /// (per arcsec of the misalignments; docs/physics.md section 15). The misalignments' columns carry (1 + e)
 /// dO and (1 + e) dS, so that the model is linear: rate_terms_from_solution() divides the (1 + e) out.
-std::vector<double> design_row(const PositionChannels& channels, Compensation compensation,
+std::vector<double> design_row(const PositionModelTerms& model_terms, Compensation compensation,
                                const Unknowns& unknowns);
 
 /// The identified rate errors from the solved unknowns x (size of unknowns): e, then dO = x_O / (1 + e) and

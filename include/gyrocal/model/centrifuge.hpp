@@ -154,7 +154,7 @@ JointState joints_before(const JointState& at_stamp, double delay_s);
 /// The inputs that the sensor's output stamped at the encoder readings `at_stamp` holds: exact_inputs at the
 /// joints the errors' output_delay_s earlier (joints_before), where the output's time meets the encoders'
 /// (docs/calibration.md, "The acquisition's timing"). exact_inputs itself, bit for bit, when the delay is 0.
-/// The model's channels of a calibration are evaluated through it; the simulator takes the timeline's joints
+/// The model terms of a calibration are evaluated through it; the simulator takes the timeline's joints
 /// at the earlier instant instead (an independent route).
 SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp);
 

@@ -1,6 +1,6 @@
 #pragma once
 // The reduction of one dwell: a linear operator from a dwell's samples to one value per gamma of the
-// plan. The same operator reduces the gyro output and, in the identify stage, the model's channels
+// plan. The same operator reduces the gyro output and, in the identify stage, the model terms
 // (omega_I and the drift regressors) evaluated on the dwell's samples, so that
 //   reduce(W) = reduce(omega_I) + sum_j c_j reduce(x_j)
 // holds exactly whatever harmonics the machine's errors add.
@@ -49,7 +49,8 @@ struct ReduceOptions {
   double rate_steadiness = 1e-3;
   double static_rate_tolerance_rad_s = 0.01;  ///< below this the main axis (or platform) counts as stopped
   /// A dwell's main encoder leaving its constant-rate line by more than this RMS, beyond its sample-to-sample
-  /// scatter (quantisation, jitter), is warned about ("the rate wanders"), deg: the channels follow the line.
+  /// scatter (quantisation, jitter), is warned about ("the rate wanders"), deg: the model terms follow the
+  /// line.
   double wander_warning_deg = 0.01;
   /// An interval between two rows longer than this many planned sample intervals is a gap (a dwell with
   /// gaps is still one dwell; inside a dwell each gap counts as one sample interval, since a clock jump
@@ -61,14 +62,14 @@ struct ReduceOptions {
   /// The machine is seen leaving a dwell only once an encoder has left its tolerance: a platform starting a
   /// move at 20 deg/s^2 leaves beta_tolerance_deg after 0.14 s, and encoder_glitch_rows more rows pass
   /// before the run ends. The samples of this last interval before the end of a run that left its steady
-  /// state are dropped (counted as "before_leaving"), since the model's channels assume the steady state,
+  /// state are dropped (counted as "before_leaving"), since the model terms assume the steady state,
   /// s. A run that ends at its planned duration or with the record loses nothing.
   double leave_guard_s = 0.25;
-  /// A dwell broken into more stretches than this (by gaps and glitches) is refused: the channels keep one
+  /// A dwell broken into more stretches than this (by gaps and glitches) is refused: the model terms keep one
   /// entry per stretch, so this bounds their memory.
   int max_stretches_per_dwell = 4096;
   int static_batches = 16;  ///< a static hold's standard error from this many batch means
-  /// The model's channels (identify/channels.hpp) are smooth in gamma (harmonics up to ~6), so they are
+  /// The model terms (identify/model_terms.hpp) are smooth in gamma (harmonics up to ~6), so they are
   /// evaluated on every k-th sample of a dwell with k chosen to keep at least this many samples per
   /// revolution (and 64 per static hold); the dwell's first and last samples are always in. 0 (default):
   /// every sample, the only choice that is exact on any configuration (docs/calibration.md: a stride of 32
@@ -109,9 +110,9 @@ struct DwellValues {
   double level = std::numeric_limits<double>::quiet_NaN();
   /// Samples rejected as outliers (ReduceOptions::outlier_threshold) and left out of the fit.
   std::size_t outliers = 0;
-  /// Their numbers in the dwell (from 0, in the order added), ascending: the model's channels evaluated
+  /// Their numbers in the dwell (from 0, in the order added), ascending: the model terms evaluated
   /// sample by sample where they follow the measured motion leave out the same samples
-  /// (identify/channels.hpp).
+  /// (identify/model_terms.hpp).
   std::vector<std::size_t> outlier_samples;
   /// With the standard errors: the values of each period (revolution or batch) that entered the scatter,
   /// the fit in time the scatter is taken about (mid-time, drift, the sweep's phase rate), and the
@@ -139,7 +140,7 @@ void relevel_from_periods(DwellValues& v, const std::vector<PeriodValues>& perio
 /// offset.
 class DwellAccumulator {
  public:
-  /// columns: how many value columns each sample carries (1 for the gyro output, more for model channels).
+  /// columns: how many value columns each sample carries (1 for the gyro output, more for model terms).
   /// planned_duration_s: the planned length of the measured part (> 0), to scale time and size batches.
   /// with_std_err: also compute the standard errors of column 0 (scatter between revolutions or batches).
   /// sweep_rate_rad_s: a spinning dwell at a counter rate offset (docs/physics.md section 15) turns the
@@ -148,7 +149,7 @@ class DwellAccumulator {
   /// noise. The outlier rule and the scatter between revolutions (the standard errors' level) fit these two
   /// terms too, so that they measure the noise, not the sweep. The values stay the plain fit's: fitted over
   /// the fraction of a sweep a dwell holds, the two terms would take the constant's place and multiply its
-  /// variance; the same operator reduces the model's channels, so the sweep is carried, not lost. 0
+  /// variance; the same operator reduces the model terms, so the sweep is carried, not lost. 0
   /// (default): none.
   DwellAccumulator(const ReduceOptions& options, std::vector<double> gammas_rad, bool is_static, int columns,
                    double planned_duration_s, bool with_std_err, double sweep_rate_rad_s = 0.0);
@@ -175,7 +176,7 @@ class DwellAccumulator {
     }
     add_general(time_s, gamma_rad, values);
   }
-  /// A whole dwell's samples at once, given by their sums (identify/channels.hpp: the model's channels summed
+  /// A whole dwell's samples at once, given by their sums (identify/model_terms.hpp: the model terms summed
   /// in closed form): `samples` samples from first_time_s to last_time_s (s); for a harmonic fit `normal` and
   /// `rhs` as HarmonicFit::add_sums takes them (the basis' time is scaled as add() scales it), for a static
   /// hold rhs's one row holds the columns' sums (`normal` unused). Only on an accumulator without standard
@@ -212,7 +213,7 @@ class DwellAccumulator {
   void break_revolution();
   /// The revolution of gamma (rad) counted from a dwell's first gamma, in either sense of rotation: the
   /// periods of a spinning dwell's scatter, and so of any reduction that must cut a dwell where it does
-  /// (identify/sensor_channels.cpp). The quotient is >= 0, so the conversion's truncation is its floor
+  /// (identify/sensor_model_terms.cpp). The quotient is >= 0, so the conversion's truncation is its floor
   /// (std::floor is a call of libm on the baseline x86-64 and was 4 % of a calibration's time); a product by
   /// 1 / (2 pi), not a division (a sample within a rounding of a whole turn may fall in either revolution,
   /// the same one for every caller).

@@ -129,8 +129,8 @@ class StaticMean {
   /// with_periods: also keep the batch's sum of column 0 (for the scatter).
   StaticMean(std::size_t gammas, int columns, bool with_periods);
   void add(double t_scaled, double gamma_rad, const double* values);
-  /// `samples` samples at once whose values sum, per column, to rhs's one row (identify/channels.hpp: the
-  /// model's channels summed in closed form). No periods.
+  /// `samples` samples at once whose values sum, per column, to rhs's one row (identify/model_terms.hpp: the
+  /// model terms summed in closed form). No periods.
   void add_sums(std::size_t samples, const Eigen::MatrixXd& rhs);
   /// The batch's mean of column 0 into `scatter` (if it holds a sample); the batch starts again.
   void close_period(RevolutionSums& scatter);
@@ -171,7 +171,7 @@ class HarmonicFit {
   void add_run(std::size_t samples, double t_scaled_sum, const double* lower, const double* rhs);
   /// `samples` samples at once, given by their sums: `normal` = sum b b' (basis_size() square, the lower
   /// triangle is read) and `rhs` = sum b v' (basis_size() x columns), b = basis(gamma, t_scaled) (identify/
-  /// channels.hpp: the model's channels summed in closed form). No periods.
+  /// model_terms.hpp: the model terms summed in closed form). No periods.
   void add_sums(std::size_t samples, const Eigen::MatrixXd& normal, const Eigen::MatrixXd& rhs);
   /// The revolution's fit (without drift) at every gamma, at its mean time, into `scatter` if it holds at
   /// least two samples per parameter; the revolution's sums start again.

@@ -52,13 +52,14 @@ void check_test_feasible(const TestSpec& test, const ReduceOptions& options, dou
 /// with many revolutions rounding lets it factor and the fit agrees with a higher order's (8 gamma at order
 /// 3, 200 revolutions: the estimates and standard errors of order 4), so such a test is not refused. An
 /// accelerometer's spinning dwells are reduced to exactly 2 harmonic_order + 1 angles whatever gamma_deg
-/// lists (identify/sensor_channels.hpp), so only the gyro's route meets this; the window mean has no bound.
+/// lists (identify/sensor_model_terms.hpp), so only the gyro's route meets this; the window mean has no
+/// bound.
 void refuse_gammas_beyond_fit(std::size_t gammas, const ReduceOptions& options);
 
 /// Throws gyrocal::Error naming the [test] keys when reducing a record of `test` would hold more than
 /// limits::kCalibrationRevolutions revolutions or limits::kCalibrationRateWindows rate windows over its
 /// spinning dwells together: a reduction keeps a few numbers a revolution and a window of each dwell until
-/// the model's channels are evaluated (the spline's knots, the revolutions' values, the basis angle's
+/// the model terms are evaluated (the spline's knots, the revolutions' values, the basis angle's
 /// pieces), so this bounds a calibration's memory (< 64 MB). The Reducer calls it before the first row.
 void check_calibration_memory(const TestSpec& test, const ReduceOptions& options);
 

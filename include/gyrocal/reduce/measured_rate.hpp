@@ -1,7 +1,7 @@
 #pragma once
 // The main axis' motion as its encoder measures it through a dwell (docs/calibration.md, "The rate the
 // channels follow"): a smoothing cubic spline of the main angle against the sample grid, fitted streaming, so
-// that the model's channels can be evaluated at the angle, rate and angular acceleration the arm really had
+// that the model terms can be evaluated at the angle, rate and angular acceleration the arm really had
 // at each sample (a drive's rate ripple moves an accelerometer's centripetal input at first order) rather
 // than on the dwell's constant-rate line. Physics-free: angles in rad, times in s.
 #include <algorithm>
@@ -113,14 +113,14 @@ class MeasuredMotionFit {
 };
 
 /// The spline's knot interval in revolutions of gamma (MeasuredMotionFit, at least 8 sample intervals): a
-/// quarter of a revolution. The channels' exactness on a rippling drive is the spline's approximation of the
-/// ripple: on the tests' rig-like records (a ripple of 2e-4 at 0.37 Hz, 6 and 12 rad/s, 50 Hz, 8
+/// quarter of a revolution. The model terms' exactness on a rippling drive is the spline's approximation of
+/// the ripple: on the tests' rig-like records (a ripple of 2e-4 at 0.37 Hz, 6 and 12 rad/s, 50 Hz, 8
 /// revolutions, 2^32-count encoders; tests/test_accelerometer_rig.cpp) half a revolution with a floor of 16
 /// samples missed the specific force by up to 3e-5 g a sample and left 6e-3 ug/g^2 on Kio and 7e-3 urad on
 /// delta_p; a quarter with a floor of 8 leaves 1.0e-3 ug/g^2 on Kip, 5e-4 urad on delta_p and below 1.3e-4
 /// of their units on the others. An eighth with a floor of 4 left 2.6e-4 urad on delta_p and below 6e-5 on
 /// the others, but then the F-test took a smooth simulated record with large machine errors for a ripple
-/// (tests/test_channels_fourier.cpp): not taken until that is understood. The spline's noise grows as
+/// (tests/test_model_terms_fourier.cpp): not taken until that is understood. The spline's noise grows as
 /// h^-3/2; an accelerometer's stated std is taken from the scatter of the output minus the model, which
 /// holds it (docs/accelerometer.md).
 inline constexpr double kMeasuredKnotRevolutions = 0.25;

@@ -43,9 +43,10 @@ struct TimeStretch {
 /// `first_sample`-th measured sample on (counted over the stretches in order), the counter platform's angle
 /// psi_r = at_rad + rate_rad_s (t - t0_s) on the dwell's clock, gamma = -psi_r (rad, unwrapped as the output
 /// had it). The reducer takes the counter encoder's line of its last rate window, and after a gap, until a
-/// window has closed, each reading itself (one piece a sample, rate 0). The model's channels that follow a
-/// dwell's measured motion take the same angle (identify/channels.hpp, basis_counter_angle), so that data and
-/// model are reduced by one operator when a drive's ripple bends the counter encoder's line window by window.
+/// window has closed, each reading itself (one piece a sample, rate 0). The model terms that follow a
+/// dwell's measured motion take the same angle (identify/model_terms.hpp, basis_counter_angle), so that data
+/// and model are reduced by one operator when a drive's ripple bends the counter encoder's line window by
+/// window.
 struct BasisAngle {
   std::size_t first_sample = 0;
   double t0_s = 0.0, at_rad = 0.0, rate_rad_s = 0.0;
@@ -86,13 +87,13 @@ struct Dwell {
   /// The reduced output of the sensor, per gamma, in its output unit: deg/h for a gyro, g for an
   /// accelerometer.
   DwellValues output;
-  /// The samples of the measured part, stretch by stretch: the grid on which the model's channels are
+  /// The samples of the measured part, stretch by stretch: the grid on which the model terms are
   /// evaluated and reduced like the sensor's output. Empty: `samples` evenly spaced instants (time_of_sample)
   /// on the lines `main` and `counter` (a planned dwell, analysis/predict).
   std::vector<TimeStretch> stretches;
   /// The main axis' motion as its encoder measured it through the measured part (a spinning dwell of a
-  /// record; empty otherwise): what the channels follow where it departs from the line `main`
-  /// (identify/channels.hpp, docs/calibration.md).
+  /// record; empty otherwise): what the model terms follow where it departs from the line `main`
+  /// (identify/model_terms.hpp, docs/calibration.md).
   MeasuredMotion measured;
   /// The output's basis angle through the measured part, piece by piece (a spinning dwell of a record; empty
   /// otherwise).

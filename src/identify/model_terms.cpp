@@ -1,4 +1,4 @@
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "gyrocal/core/parallel.hpp"
 #include "gyrocal/core/units.hpp"
-#include "gyrocal/identify/planned_channels.hpp"
+#include "gyrocal/identify/planned_model_terms.hpp"
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -18,8 +18,8 @@ using Complex = std::complex<double>;
 
 /// a b, as std::complex's operator* gives it for finite operands, without the recovery of infinite results
 /// that C's Annex G asks of it (GCC checks every product for NaN and calls __muldc3): in the closed forms'
-/// inner loops that check was ~100 instructions a product, half of the channels' time after the reading.
-/// The channels and their sums are finite.
+/// inner loops that check was ~100 instructions a product, half of the model terms' time after the reading.
+/// The model terms and their sums are finite.
 inline Complex times(const Complex& a, const Complex& b) {
   return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
 }
@@ -42,11 +42,11 @@ std::size_t long_stride(std::size_t at_least, double gamma_step_rad, double samp
   return at_least;  // not reached for >= 14 samples per revolution (reduce/feasibility.hpp)
 }
 
-/// The channels (kColumns values) of dwell d at joint state j, the encoders at the output's stamp; beta as
+/// The model terms (kColumns values) of dwell d at joint state j, the encoders at the output's stamp; beta as
 /// planned (reduce/reducer.cpp: an encoder's mean at rest is biased by up to half a count). The exact inputs
 /// are those the output holds (sensed_inputs: the joints the acquisition's delay earlier); the nominal ones
 /// are a perfect machine's and acquisition's.
-void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState j, double* v) {
+void evaluate_model_terms(const CentrifugeModel& model, const Dwell& d, JointState j, double* v) {
   j.position_angle_rad = d.beta_rad;
   const SensorInputs exact = sensed_inputs(model, j);
   const double offset = d.planned_counter_rate_offset_rad_s;
@@ -64,16 +64,16 @@ void evaluate_channels(const CentrifugeModel& model, const Dwell& d, JointState 
   }
 }
 
-/// The channels of dwell d with the main axis at main_rad and the counter platform at counter_rad, the
+/// The model terms of dwell d with the main axis at main_rad and the counter platform at counter_rad, the
 /// joints on the dwell's constant-rate lines fitted to the encoders (the measured mean rates).
-void evaluate_channels(const CentrifugeModel& model, const Dwell& d, double main_rad, double counter_rad,
-                       double* v) {
+void evaluate_model_terms(const CentrifugeModel& model, const Dwell& d, double main_rad, double counter_rad,
+                          double* v) {
   JointState j;
   j.main_angle_rad = main_rad;
   j.main_rate_rad_s = d.main.rate_rad_s;
   j.counter_angle_rad = counter_rad;
   j.counter_rate_rad_s = d.counter.rate_rad_s;
-  evaluate_channels(model, d, j, v);
+  evaluate_model_terms(model, d, j, v);
 }
 
 /// x reduced to [-pi, pi) with 2 pi split in two parts, so that an angle of thousands of revolutions keeps
@@ -136,17 +136,17 @@ std::vector<Run> runs_of(const Dwell& d) {
   return runs;
 }
 
-/// The channels of one dwell as a two-dimensional Fourier series in the main angle theta and the counter
+/// The model terms of one dwell as a two-dimensional Fourier series in the main angle theta and the counter
 /// platform's angle psi_r, on which they depend alone during a dwell (the rates and beta are the dwell's):
 ///   c(theta, psi) = sum_{|n|, |m| <= H} C_nm e^{j (n theta + m psi)},
-/// C_nm from the channels on a (2H+1) x (2H+1) grid of angles (the discrete Fourier transform). On a
+/// C_nm from the model terms on a (2H+1) x (2H+1) grid of angles (the discrete Fourier transform). On a
 /// stretch's samples theta and psi advance by constant steps, so every sum the reduction operator takes of
-/// the channels times its basis (1, cos k gamma, sin k gamma with gamma = -psi, the scaled time) is a sum of
-/// geometric series in closed form (power_sums): the cost depends on H and the stretches, not the samples.
+/// the model terms times its basis (1, cos k gamma, sin k gamma with gamma = -psi, the scaled time) is a sum
+/// of geometric series in closed form (power_sums): the cost depends on H and the stretches, not the samples.
 /// docs/calibration.md, "The model's side of each position", states the bound.
-class FourierChannels {
+class FourierModelTerms {
  public:
-  FourierChannels(const DwellChannelEvaluator& evaluate, int column_count, int harmonics)
+  FourierModelTerms(const DwellModelTermsEvaluator& evaluate, int column_count, int harmonics)
       : h_(harmonics),
         size_(2 * harmonics + 1),
         columns_(column_count),
@@ -261,7 +261,7 @@ class FourierChannels {
 
 }  // namespace
 
-/// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
+/// Whether dwell d's model terms follow its measured motion (reduce/measured_rate.hpp) rather than its line
 /// (docs/calibration.md, "The rate the channels follow"): where the spline departs from the line beyond the
 /// readings' scatter (its F-test), the encoder resolves the change (quanta_resolved), and what the line then
 /// misses of the specific force at the arm's radius R, the centripetal force's change 2 |w| dw R, the
@@ -274,8 +274,8 @@ bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d) {
 }
 
 namespace {
-/// The Fourier route for one dwell (FourierChannels) into `acc`, when its check holds, column by column: the
-/// channels' coefficients in the outer quarter of the band (max(|n|, |m|) > 3H/4) sum to at most
+/// The Fourier route for one dwell (FourierModelTerms) into `acc`, when its check holds, column by column:
+/// the model terms' coefficients in the outer quarter of the band (max(|n|, |m|) > 3H/4) sum to at most
 ///   e x (coefficients in that quarter) / (2H + 1),
 /// the flat floor the model's own rounding e leaves on a grid's transform: for a regressor (g, g^2)
 /// kRegressorRounding x max(1, the sum of all its |C_nm|); for a rate (deg/h) kRateRounding x (|main rate| +
@@ -293,7 +293,7 @@ constexpr int kMaxFourierHarmonic = 64;
 
 bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
                              DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
-                             const DwellChannelEvaluator& evaluate, DwellChannelsRoute& route) {
+                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route) {
   const std::vector<Run> runs = runs_of(d);
   if (runs.empty()) return false;
   const int order = d.is_static ? 0 : options.harmonic_order;
@@ -307,7 +307,7 @@ bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const
     const double closed_cost =
         width * width * (static_cast<double>(runs.size()) * (order + 2.0) * columns + 1000.0);
     if (closed_cost > 1000.0 * static_cast<double>(total)) return false;
-    const FourierChannels fourier(evaluate, columns, harmonics);
+    const FourierModelTerms fourier(evaluate, columns, harmonics);
     std::vector<double> outer, all;
     const double outer_count = fourier.tails(outer, all);
     const double rates_deg_h =
@@ -425,12 +425,12 @@ double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d) {
          radius / kStandardGravityMS2;
 }
 
-std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                    const ReduceOptions& options,
-                                                    std::size_t max_samples_per_dwell, ChannelRoute route,
-                                                    std::vector<DwellChannelsRoute>* routes) {
+std::vector<PositionModelTerms> reduce_model_terms(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const ReduceOptions& options,
+                                                   std::size_t max_samples_per_dwell, ModelTermsRoute route,
+                                                   std::vector<DwellModelTermsRoute>* routes) {
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
-  std::vector<DwellChannelsRoute> chosen(reduction.dwells.size());
+  std::vector<DwellModelTermsRoute> chosen(reduction.dwells.size());
   // The rates (deg/h): omega exact, nominal, seed, omega_O, omega_S; the rest are regressors (g, g^2).
   std::vector<bool> rate_columns(kColumns, false);
   for (int c = 0; c < kColumns; ++c)
@@ -443,30 +443,30 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, kColumns, d.planned_duration_s, false, sweep);
     const auto evaluate = [&](double main_rad, double counter_rad, double* row) {
-      evaluate_channels(model, d, main_rad, counter_rad, row);
+      evaluate_model_terms(model, d, main_rad, counter_rad, row);
     };
     // A record's dwell whose arm departs from its line (a drive's ripple): every sample on the measured
     // motion.
     const bool follow = follows_measured_rate(model, d);
     chosen[di].measured_rate = follow;
     // A planned dwell (no stretches: evenly spaced samples on the lines) summed on every sample or for a
-    // prediction: in closed form, at a cost independent of its length (identify/planned_channels.hpp).
-    if (route == ChannelRoute::kExact && d.stretches.empty() &&
+    // prediction: in closed form, at a cost independent of its length (identify/planned_model_terms.hpp).
+    if (route == ModelTermsRoute::kExact && d.stretches.empty() &&
         (options.model_samples_per_revolution == 0 || max_samples_per_dwell > 0) &&
-        planned_dwell_channels(d, options, kColumns, evaluate, per_dwell[di]))
+        planned_dwell_model_terms(d, options, kColumns, evaluate, per_dwell[di]))
       return;
     // Exact (every sample, the default): the same numbers by closed forms when the check holds.
     const bool exact_requested = options.model_samples_per_revolution == 0 &&
                                  (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
-    if (!follow && exact_requested && route == ChannelRoute::kExact &&
+    if (!follow && exact_requested && route == ModelTermsRoute::kExact &&
         reduce_dwell_by_fourier(model, d, options, acc, kColumns, rate_columns, evaluate, chosen[di])) {
       for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
       return;
     }
     double v[kColumns];
     // Every k-th sample (ReduceOptions::model_samples_per_revolution), the last one always: for the harmonic
-    // fit and a static hold's mean, which see the channels' smooth shape; a window holds a few samples only,
-    // so window means take every sample.
+    // fit and a static hold's mean, which see the model terms' smooth shape; a window holds a few samples
+    // only, so window means take every sample.
     std::size_t stride = 1;
     // A spinning dwell at a counter rate offset: the Earth rate's horizontal part sweeps with the platform's
     // heading (docs/physics.md section 15), a term outside the fit's harmonics of gamma, whose projection a
@@ -492,7 +492,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
       }
     }
     const auto add_sample = [&](double t, double main_rad, double counter_rad) {
-      evaluate_channels(model, d, main_rad, counter_rad, v);
+      evaluate_model_terms(model, d, main_rad, counter_rad, v);
       acc.add(t, -counter_rad, v);
     };
     if (d.stretches.empty()) {
@@ -516,7 +516,7 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
           if (follow) {
             // The joints the model is evaluated at follow the measured motion, and the operator's gamma is
             // the output's own (Dwell::basis_angle), which a ripple bends window by window.
-            evaluate_channels(model, d, measured_joints(d, si, i), v);
+            evaluate_model_terms(model, d, measured_joints(d, si, i), v);
             acc.add(s.first_time_s + dt,
                     d.basis_angle.empty() ? -counter_line : -basis.at(first_sample + i, s.first_time_s + dt),
                     v);
@@ -532,13 +532,13 @@ std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, 
     for (int c = 0; c < kColumns; ++c) per_dwell[di].push_back(acc.finish(c));
   });
   if (routes) *routes = std::move(chosen);
-  std::vector<PositionChannels> out;
+  std::vector<PositionModelTerms> out;
   for (const ReducedPosition& p : reduction.positions) {
     const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];
     const auto at = [&](int c) {
       return cols[static_cast<std::size_t>(c)].value[static_cast<std::size_t>(p.gamma_slot)];
     };
-    PositionChannels ch;
+    PositionModelTerms ch;
     ch.omega_exact_deg_h = at(0);
     ch.omega_nominal_deg_h = at(1);
     ch.omega_seed_deg_h = at(2);

@@ -3,11 +3,11 @@
 // pipeline"): the sensor's design row (sensor/sensor_model.hpp: the known part of its output and the
 // regressors of its products) evaluated at the exact inputs on each dwell's samples and reduced by the very
 // operator that reduced the sensor's output, so that reduce(E) = reduce(known) + sum_j u_j reduce(r_j) holds
-// exactly whatever harmonics the machine's errors add. The gyro keeps identify/channels.hpp's 25 columns.
+// exactly whatever harmonics the machine's errors add. The gyro keeps identify/model_terms.hpp's 25 columns.
 #include <cstddef>
 #include <vector>
 
-#include "gyrocal/identify/channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
@@ -27,18 +27,17 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
 /// K3 and the radius (docs/accelerometer.md). Static holds keep gamma_deg.
 TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options);
 
-/// Channels of every position of `reduction`, in its order, for `sensor` on `model`: PositionChannels::
+/// Model terms of every position of `reduction`, in its order, for `sensor` on `model`: PositionModelTerms::
 /// sensor_exact holds the reduced design row (the gyro's fields zero). Every sample of a dwell is reduced
 /// (its stretches as the output has them; a planned dwell's evenly spaced instants): by default (route
 /// kExact) from the design row's Fourier series in the two joint angles in closed form where its check holds
-/// (reduce_dwell_by_fourier, as the gyro's channels), else by evaluating every sample (kEverySample, or a
+/// (reduce_dwell_by_fourier, as the gyro's model terms), else by evaluating every sample (kEverySample, or a
 /// dwell that follows its measured motion); or every k-th sample as ReduceOptions::
-/// model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_channels). `routes`, when
+/// model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_terms). `routes`, when
 /// given, receives what was done per dwell.
-std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                     const ReduceOptions& options, const Sensor& sensor,
-                                                     std::size_t max_samples_per_dwell = 0,
-                                                     ChannelRoute route = ChannelRoute::kExact,
-                                                     std::vector<DwellChannelsRoute>* routes = nullptr);
+std::vector<PositionModelTerms> reduce_sensor_model_terms(
+    const Reduction& reduction, const CentrifugeModel& model, const ReduceOptions& options,
+    const Sensor& sensor, std::size_t max_samples_per_dwell = 0,
+    ModelTermsRoute route = ModelTermsRoute::kExact, std::vector<DwellModelTermsRoute>* routes = nullptr);
 
 }  // namespace gyrocal

@@ -1,8 +1,8 @@
-// The model's channels summed in closed form from their Fourier series in the two joint angles
-// (identify/channels.hpp, ChannelRoute::kExact) against the same channels evaluated at every sample
-// (ChannelRoute::kEverySample): on machines with large errors, each reduced channel is within the bound the
-// series states (docs/calibration.md, "The model's side of each position"), and where the series' check
-// fails the channels are taken at every sample.
+// The model terms summed in closed form from their Fourier series in the two joint angles
+// (identify/model_terms.hpp, ModelTermsRoute::kExact) against the same model terms evaluated at every sample
+// (ModelTermsRoute::kEverySample): on machines with large errors, each reduced model term is within the bound
+// the series states (docs/calibration.md, "The model's side of each position"), and where the series' check
+// fails the model terms are taken at every sample.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,8 +13,8 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/calibration.hpp"
-#include "gyrocal/identify/channels.hpp"
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/model_terms.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
 namespace gyrocal {
@@ -32,7 +32,7 @@ Scenario two_speed_test(int revolutions) {
 
 /// Large machine errors: a lever arm of 1 cm, runouts and wobbles of every joint to harmonic `highest`
 /// (amplitudes 2e-4 falling by half a harmonic), position-platform errors, a counter rate mismatch (so that
-/// the platform's heading drifts and the channels depend on both joint angles).
+/// the platform's heading drifts and the model terms depend on both joint angles).
 void set_large_errors(Scenario& s, int highest) {
   CentrifugeErrors& e = s.errors;
   e.lever_arm_m = Eigen::Vector3d(0.01, -0.01, 0.01);
@@ -62,19 +62,19 @@ Reduction reduce(const Scenario& s) {
   return reducer.finish();
 }
 
-/// Every reduced channel of `fourier` within the stated bound of `every`'s: the aliased and truncated part
+/// Every reduced model term of `fourier` within the stated bound of `every`'s: the aliased and truncated part
 /// of the series (twice the outer half band's sum, which majorises the tail of a decaying series) through
 /// the operator's L1 norm (at most sqrt(samples x white-noise gain) by Cauchy-Schwarz), plus the two sums'
-/// rounding (1e-13 of the channel's scale a sample, and 1e-15 of the joints' rates for a rate). Returns the
-/// largest ratio of difference to bound.
-double worst_ratio(const Reduction& r, const std::vector<PositionChannels>& fourier,
-                   const std::vector<PositionChannels>& every,
-                   const std::vector<DwellChannelsRoute>& routes) {
+/// rounding (1e-13 of the model term's scale a sample, and 1e-15 of the joints' rates for a rate). Returns
+/// the largest ratio of difference to bound.
+double worst_ratio(const Reduction& r, const std::vector<PositionModelTerms>& fourier,
+                   const std::vector<PositionModelTerms>& every,
+                   const std::vector<DwellModelTermsRoute>& routes) {
   double worst = 0.0;
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const ReducedPosition& p = r.positions[i];
     const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
-    const DwellChannelsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
+    const DwellModelTermsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
     EXPECT_TRUE(route.fourier) << "position " << p.index;
     if (!route.fourier) return worst;
     std::vector<double> a = {fourier[i].omega_exact_deg_h, fourier[i].omega_nominal_deg_h,
@@ -118,9 +118,9 @@ TEST(FourierChannels, EqualTheEverySampleChannelsWithinTheirBoundOnAMachineWithL
   Scenario s = two_speed_test(60);
   set_large_errors(s, 3);
   const Reduction r = reduce(s);
-  std::vector<DwellChannelsRoute> routes;
-  const auto fourier = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
-  const auto every = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kEverySample);
+  std::vector<DwellModelTermsRoute> routes;
+  const auto fourier = reduce_model_terms(r, s.model(), ReduceOptions{}, 0, ModelTermsRoute::kExact, &routes);
+  const auto every = reduce_model_terms(r, s.model(), ReduceOptions{}, 0, ModelTermsRoute::kEverySample);
   ASSERT_EQ(routes.size(), r.dwells.size());
   for (std::size_t i = 0; i < routes.size(); ++i)
     std::printf("dwell %zu: %zu samples, %s, H = %d\n", i, r.dwells[i].samples,
@@ -128,7 +128,7 @@ TEST(FourierChannels, EqualTheEverySampleChannelsWithinTheirBoundOnAMachineWithL
   const double worst = worst_ratio(r, fourier, every, routes);
   std::printf("largest |fourier - every sample| / bound: %.3g (H = %d)\n", worst, routes.front().harmonics);
   // And the calibration from them is exact: every coefficient within 1e-7 of the truth (least squares, full
-  // compensation), as with the every-sample channels.
+  // compensation), as with the every-sample model terms.
   CalibrationOptions o;
   o.method = Method::kLeastSquares;
   o.compensation = Compensation::kFull;
@@ -141,14 +141,14 @@ TEST(FourierChannels, EqualTheEverySampleChannelsWithinTheirBoundOnAMachineWithL
 
 TEST(FourierChannels, TakeEverySampleWhereTheSeriesCheckFails) {
   // Wobbles and runouts to harmonic 9: H = 8 x 9 + 4 = 76 is beyond the closed forms' limit (64), so the
-  // channels are evaluated at every sample, and equal the every-sample route's exactly.
+  // model terms are evaluated at every sample, and equal the every-sample route's exactly.
   Scenario s = two_speed_test(4);
   set_large_errors(s, 9);
   const Reduction r = reduce(s);
-  std::vector<DwellChannelsRoute> routes;
-  const auto exact = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kExact, &routes);
-  const auto every = reduce_model_channels(r, s.model(), ReduceOptions{}, 0, ChannelRoute::kEverySample);
-  for (const DwellChannelsRoute& route : routes) EXPECT_FALSE(route.fourier);
+  std::vector<DwellModelTermsRoute> routes;
+  const auto exact = reduce_model_terms(r, s.model(), ReduceOptions{}, 0, ModelTermsRoute::kExact, &routes);
+  const auto every = reduce_model_terms(r, s.model(), ReduceOptions{}, 0, ModelTermsRoute::kEverySample);
+  for (const DwellModelTermsRoute& route : routes) EXPECT_FALSE(route.fourier);
   for (std::size_t i = 0; i < exact.size(); ++i) {
     EXPECT_EQ(exact[i].omega_exact_deg_h, every[i].omega_exact_deg_h);
     EXPECT_EQ(exact[i].regressors_exact, every[i].regressors_exact);
@@ -175,15 +175,17 @@ TEST(FourierChannels, AnAccelerometersDesignRowsEqualTheEverySampleOnesWithinThe
   so.seed = 3;
   simulate(s, so, [&](const RecordSample& x) { reducer.push(x); });
   const Reduction r = reducer.finish();
-  std::vector<DwellChannelsRoute> routes;
-  const auto fourier = reduce_sensor_channels(r, s.model(), ro, s.sensor(), 0, ChannelRoute::kExact, &routes);
-  const auto every = reduce_sensor_channels(r, s.model(), ro, s.sensor(), 0, ChannelRoute::kEverySample);
+  std::vector<DwellModelTermsRoute> routes;
+  const auto fourier =
+      reduce_sensor_model_terms(r, s.model(), ro, s.sensor(), 0, ModelTermsRoute::kExact, &routes);
+  const auto every =
+      reduce_sensor_model_terms(r, s.model(), ro, s.sensor(), 0, ModelTermsRoute::kEverySample);
   ASSERT_EQ(routes.size(), r.dwells.size());
   double worst = 0.0;
   for (std::size_t i = 0; i < r.positions.size(); ++i) {
     const ReducedPosition& p = r.positions[i];
     const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
-    const DwellChannelsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
+    const DwellModelTermsRoute& route = routes[static_cast<std::size_t>(p.dwell)];
     ASSERT_TRUE(route.fourier) << "position " << p.index << " (" << d.samples << " samples)";
     const DesignRow& a = fourier[i].sensor_exact;
     const DesignRow& b = every[i].sensor_exact;

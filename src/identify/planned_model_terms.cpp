@@ -1,4 +1,4 @@
-#include "gyrocal/identify/planned_channels.hpp"
+#include "gyrocal/identify/planned_model_terms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,10 +13,11 @@ namespace {
 
 using Complex = std::complex<double>;
 
-/// Grids of 16 .. 128 points per angle: harmonics up to 63 in each (the default machine's channels need 32).
+/// Grids of 16 .. 128 points per angle: harmonics up to 63 in each (the default machine's model terms need
+/// 32).
 constexpr int kFirstGrid = 16;
 constexpr int kLastGrid = 128;
-/// The M / 2 grid's values agree with the M grid's within this fraction of the channel's largest value on
+/// The M / 2 grid's values agree with the M grid's within this fraction of the model term's largest value on
 /// the grid (beyond the evaluations' own rounding): then the M grid's are converged, every harmonic the M / 2
 /// grid aliases being below it.
 constexpr double kConverged = 1e-10;
@@ -29,7 +30,7 @@ struct WeightSet {
 
 /// The quadrature's weights K_ab for grid size (mt, mh) (1 along an angle that does not turn): sum_i w_i F_i
 /// = sum_ab K_ab G(2 pi a / mt, 2 pi b / mh) for every G below mt / 2 and mh / 2 harmonics, where G(u, v) =
-/// F(theta0 + u, psi0 + v - u) is the channel as a function of the main angle and the platform's heading
+/// F(theta0 + u, psi0 + v - u) is the model term as a function of the main angle and the platform's heading
 /// (theta + psi) about their first sample's values. The samples advance u by main_step and v by
 /// heading_step; gamma = -psi = -psi0 - v + u. So K_ab = e^{-j m psi0} / (mt mh) sum_k e^{-j k u_a} sum_l
 /// e^{-j l v_b} S_p((k + m) main_step + (l - m) heading_step). A plan without heading drift (heading_step 0)
@@ -103,8 +104,8 @@ std::pair<Complex, Complex> geometric_power_sums(double x, double n) {
   return {rotation * a, rotation * Complex(0.5 * (n - 1.0) * a, -da)};
 }
 
-bool planned_dwell_channels(const Dwell& d, const ReduceOptions& options, int columns,
-                            const ChannelFunction& evaluate, std::vector<DwellValues>& out) {
+bool planned_dwell_model_terms(const Dwell& d, const ReduceOptions& options, int columns,
+                               const ModelTermsFunction& evaluate, std::vector<DwellValues>& out) {
   if (d.samples == 0 || !d.stretches.empty() || columns < 1) return false;
   const bool spinning = !d.is_static;
   if (spinning && (options.method != ReduceOptions::Method::kHarmonicFit || d.counter.rate_rad_s == 0.0))
@@ -191,7 +192,7 @@ bool planned_dwell_channels(const Dwell& d, const ReduceOptions& options, int co
     return values;
   };
 
-  // The channels on a grid of M x M angles (1 along a joint that does not turn), then the weighted sums
+  // The model terms on a grid of M x M angles (1 along a joint that does not turn), then the weighted sums
   // on it and on its every other point; M doubles until the two agree.
   std::vector<double> f;
   for (int grid = kFirstGrid; grid <= kLastGrid; grid *= 2) {

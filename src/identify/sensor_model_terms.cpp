@@ -1,4 +1,4 @@
-#include "gyrocal/identify/sensor_channels.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -48,10 +48,12 @@ TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOpt
   return out;
 }
 
-std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                     const ReduceOptions& options, const Sensor& sensor,
-                                                     std::size_t max_samples_per_dwell, ChannelRoute route,
-                                                     std::vector<DwellChannelsRoute>* routes) {
+std::vector<PositionModelTerms> reduce_sensor_model_terms(const Reduction& reduction,
+                                                          const CentrifugeModel& model,
+                                                          const ReduceOptions& options, const Sensor& sensor,
+                                                          std::size_t max_samples_per_dwell,
+                                                          ModelTermsRoute route,
+                                                          std::vector<DwellModelTermsRoute>* routes) {
   const DesignRow probe = sensor_design_row(sensor, exact_inputs(model, JointState{}));
   const int columns = 1 + static_cast<int>(probe.size);
   // The design row's known part and regressors are in the output's unit and its powers (g, g^2, g^3): no
@@ -60,14 +62,15 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
   std::vector<std::vector<DwellValues>> per_dwell(reduction.dwells.size());
   // Following dwells: per revolution, its index and the columns' values at each gamma (gamma x column).
   std::vector<std::vector<std::pair<int, Eigen::MatrixXd>>> per_revolution(reduction.dwells.size());
-  std::vector<DwellChannelsRoute> chosen(reduction.dwells.size());
+  std::vector<DwellModelTermsRoute> chosen(reduction.dwells.size());
   parallel_for(reduction.dwells.size(), 0, [&](std::size_t di) {
     const Dwell& d = reduction.dwells[di];
-    // The reducer's operator, the heading's sweep at a counter rate offset included (as the gyro's channels).
+    // The reducer's operator, the heading's sweep at a counter rate offset included (as the gyro's model
+    // terms).
     const double sweep = d.planned_rate_rad_s != 0.0 ? d.planned_counter_rate_offset_rad_s : 0.0;
     DwellAccumulator acc(options, d.gammas_rad, d.is_static, columns, d.planned_duration_s, false, sweep);
     std::vector<double> v(static_cast<std::size_t>(columns));
-    // The joints as identify/channels.cpp takes them: on the dwell's constant-rate lines fitted to the
+    // The joints as identify/model_terms.cpp takes them: on the dwell's constant-rate lines fitted to the
     // encoders, beta as planned; or, where the drive's rate ripples (follows_measured_rate), the arm's
     // measured motion (measured_joints: its angle, rate and angular acceleration at the sample), while the
     // operator's gamma stays the line's. An accelerometer reads the centripetal force, first order in the
@@ -79,8 +82,8 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     // motion).
     const bool exact_requested = options.model_samples_per_revolution == 0 &&
                                  (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
-    if (!follow && exact_requested && route == ChannelRoute::kExact) {
-      const DwellChannelEvaluator evaluate = [&](double main_rad, double counter_rad, double* row_out) {
+    if (!follow && exact_requested && route == ModelTermsRoute::kExact) {
+      const DwellModelTermsEvaluator evaluate = [&](double main_rad, double counter_rad, double* row_out) {
         design_columns(sensor, model, line_joints(d, main_rad, counter_rad), row_out);
       };
       if (reduce_dwell_by_fourier(model, d, options, acc, columns, rate_columns, evaluate, chosen[di])) {
@@ -174,18 +177,18 @@ std::vector<PositionChannels> reduce_sensor_channels(const Reduction& reduction,
     for (int c = 0; c < columns; ++c) per_dwell[di].push_back(acc.finish(c));
   });
   if (routes) *routes = std::move(chosen);
-  std::vector<PositionChannels> out;
+  std::vector<PositionModelTerms> out;
   for (const ReducedPosition& p : reduction.positions) {
     const auto& cols = per_dwell[static_cast<std::size_t>(p.dwell)];
     const auto at = [&](int c) {
       return cols[static_cast<std::size_t>(c)].value[static_cast<std::size_t>(p.gamma_slot)];
     };
-    PositionChannels ch;
+    PositionModelTerms ch;
     ch.sensor_exact.known = at(0);
     ch.sensor_exact.size = probe.size;
     for (std::size_t k = 0; k < probe.size; ++k) ch.sensor_exact.regressors[k] = at(static_cast<int>(k) + 1);
     for (const auto& [index, values] : per_revolution[static_cast<std::size_t>(p.dwell)]) {
-      PositionChannels::PeriodRow pr;
+      PositionModelTerms::PeriodRow pr;
       pr.index = index;
       const auto g = static_cast<Eigen::Index>(p.gamma_slot);
       pr.row.known = values(g, 0);

@@ -20,8 +20,8 @@ enum class Compensation {
   kFull,  ///< omega_I(exact) - omega_I(nominal) from every configured error; exact regressors
 };
 
-/// Reduced model channels at one position.
-struct PositionChannels {
+/// Reduced model terms at one position.
+struct PositionModelTerms {
   double omega_exact_deg_h = 0.0;    ///< omega_I of the exact model, deg/h
   double omega_nominal_deg_h = 0.0;  ///< omega_I of section 5 for a perfect machine, deg/h
   double omega_seed_deg_h = 0.0;     ///< omega_I of section 5 with the seed's k1, k2, dw, deg/h
@@ -31,7 +31,7 @@ struct PositionChannels {
   double omega_S_exact_deg_h = 0.0;
   std::array<double, kNumGyroCoefficients> regressors_exact{};    ///< eq. 6's regressors at the exact f
   std::array<double, kNumGyroCoefficients> regressors_nominal{};  ///< at the nominal f of section 5
-  /// A sensor other than the gyro (identify/sensor_channels.hpp): its design row (known part and the
+  /// A sensor other than the gyro (identify/sensor_model_terms.hpp): its design row (known part and the
   /// regressors of its products) at the exact inputs, reduced by the same operator as its output. The gyro's
   /// fields above are then zero. Size 0 for the gyro.
   DesignRow sensor_exact;
@@ -59,44 +59,44 @@ struct PositionChannels {
 };
 
 /// Most model evaluations per spinning dwell for a prediction (`gyrocal plan`, issue 11, item 9): beyond
-/// ReduceOptions::model_samples_per_revolution * revolutions = this, the channels are evaluated on a stride
-/// longer than a revolution, chosen so that the arm angle advances by 2 pi / 40 .. 2 pi / 10 (mod 2 pi) from
-/// one evaluation to the next: a uniform sampling of gamma (no harmonic up to 9 aliases onto the fit's)
-/// spread over the whole dwell (the drift). The cost of the channels then does not grow with the test's
-/// length; docs/calibration.md states the error.
+/// ReduceOptions::model_samples_per_revolution * revolutions = this, the model terms are evaluated on a
+/// stride longer than a revolution, chosen so that the arm angle advances by 2 pi / 40 .. 2 pi / 10 (mod 2
+/// pi) from one evaluation to the next: a uniform sampling of gamma (no harmonic up to 9 aliases onto the
+/// fit's) spread over the whole dwell (the drift). The cost of the model terms then does not grow with the
+/// test's length; docs/calibration.md states the error.
 inline constexpr std::size_t kMaxModelSamplesPerDwell = 32768;
 
-/// How the channels of a dwell are reduced when every sample is asked for (ReduceOptions::
+/// How the model terms of a dwell are reduced when every sample is asked for (ReduceOptions::
 /// model_samples_per_revolution = 0).
-enum class ChannelRoute {
-  /// The channels as a Fourier series in the two joint angles, summed over the samples in closed form, when
+enum class ModelTermsRoute {
+  /// The model terms as a Fourier series in the two joint angles, summed over the samples in closed form,
+  /// when
   /// the series' check holds (docs/calibration.md, "The model's side of each position"); otherwise every
   /// sample. The default.
   kExact,
   kEverySample,  ///< the model evaluated at every sample (the reference the closed forms are tested against)
 };
 
-/// What was done for one dwell (reduce_model_channels' `routes`).
-struct DwellChannelsRoute {
+/// What was done for one dwell (reduce_model_terms' `routes`).
+struct DwellModelTermsRoute {
   bool fourier = false;  ///< the closed forms were used
   /// The joints followed the dwell's measured motion (Dwell::measured; every sample, no closed form).
   bool measured_rate = false;
   int harmonics = 0;  ///< H of the Fourier series tried last (0: not tried)
-  /// Per channel column (the gyro's: omega exact, nominal, seed, 10 exact and 10 nominal regressors, omega_O,
-  /// omega_S; another sensor's: its design row's known part, then its regressors):
-  /// the sum of |C_nm| over the outer quarter of the band (max(|n|, |m|) > 3H/4), and
-  /// over all of it, in the column's unit.
+  /// Per model term column (the gyro's: omega exact, nominal, seed, 10 exact and 10 nominal regressors,
+  /// omega_O, omega_S; another sensor's: its design row's known part, then its regressors): the sum of |C_nm|
+  /// over the outer quarter of the band (max(|n|, |m|) > 3H/4), and over all of it, in the column's unit.
   std::vector<double> outer_tail, scale;
   /// Per gamma of the dwell: the reduction operator's white-noise gain sum_i w_i^2 (DwellAccumulator::
   /// white_noise_gain); sqrt(samples x gain) bounds the operator's L1 norm sum_i |w_i|.
   std::vector<double> operator_gain;
 };
 
-/// A dwell's channels (`columns` values into v) with the main axis at main_rad and the counter platform at
+/// A dwell's model terms (`columns` values into v) with the main axis at main_rad and the counter platform at
 /// counter_rad, rad, the other joints as the dwell has them (its lines' rates, beta as planned).
-using DwellChannelEvaluator = std::function<void(double main_rad, double counter_rad, double* v)>;
+using DwellModelTermsEvaluator = std::function<void(double main_rad, double counter_rad, double* v)>;
 
-/// The sums the reduction operator takes of a dwell's channels, from their Fourier series in the two joint
+/// The sums the reduction operator takes of a dwell's model terms, from their Fourier series in the two joint
 /// angles summed over its samples in closed form (docs/calibration.md, "The model's side of each position"),
 /// added to `acc` (built with `columns` columns) when the series' check holds for every column; false when it
 /// does not or every sample costs less (`acc` untouched: the caller then takes every sample). The check's
@@ -104,7 +104,7 @@ using DwellChannelEvaluator = std::function<void(double main_rad, double counter
 /// tried: H, the outer band's and the whole series' sums of |C_nm| per column, the operator's gains.
 bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
                              DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
-                             const DwellChannelEvaluator& evaluate, DwellChannelsRoute& route);
+                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route);
 
 /// Below this, in g, what a dwell's constant-rate line misses of the specific force (measured_rate_effect_g)
 /// is not worth following the measured motion: 1e-4 ug, the exactness asked of a noise-free accelerometer
@@ -117,7 +117,7 @@ inline constexpr double kMeasuredRateFloorG = 1e-10;
 /// it by 1.2 mg.
 double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d);
 
-/// The joints the channels are evaluated at for the i-th sample of stretch `stretch` of a record's dwell d
+/// The joints the model terms are evaluated at for the i-th sample of stretch `stretch` of a record's dwell d
 /// that follows its measured motion (d.measured, reduce/measured_rate.hpp): the main axis' angle, rate and
 /// acceleration from the spline; the counter platform turns back what the arm departs from its line (the
 /// heading stays on its line), beta as planned.
@@ -153,24 +153,24 @@ class LeftOutSamples {
   std::size_t next_ = 0;
 };
 
-/// Whether dwell d's channels follow its measured motion (reduce/measured_rate.hpp) rather than its line
+/// Whether dwell d's model terms follow its measured motion (reduce/measured_rate.hpp) rather than its line
 /// (docs/calibration.md, "The rate the channels follow"): the spline departs from the line beyond the
 /// readings' scatter, the encoder resolves the change, and measured_rate_effect_g exceeds
-/// kMeasuredRateFloorG. The gyro's channels (reduce_model_channels) and a sensor's
-/// (identify/sensor_channels.hpp) follow it alike.
+/// kMeasuredRateFloorG. The gyro's model terms (reduce_model_terms) and a sensor's
+/// (identify/sensor_model_terms.hpp) follow it alike.
 bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d);
 
-/// Channels of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0 bounds
-/// the model evaluations of a spinning dwell (above) where a stride is configured; 0 (a calibration)
+/// Model terms of every position of `reduction`, in its order, for `model`. `max_samples_per_dwell` > 0
+/// bounds the model evaluations of a spinning dwell (above) where a stride is configured; 0 (a calibration)
 /// evaluates ReduceOptions::model_samples_per_revolution per revolution, however many revolutions. A dwell
 /// without stretches (a planned one) reduced by the harmonic fit or a static mean, with every sample asked
 /// for (model_samples_per_revolution 0) or a bound, is summed in closed form at a cost independent of its
-/// length (identify/planned_channels.hpp; equal to the every-sample sum to ~1e-11). A record's dwell, with
+/// length (identify/planned_model_terms.hpp; equal to the every-sample sum to ~1e-11). A record's dwell, with
 /// every sample asked for, goes by `route` (above); `routes`, when given, receives per dwell what was done.
-std::vector<PositionChannels> reduce_model_channels(const Reduction& reduction, const CentrifugeModel& model,
-                                                    const ReduceOptions& options,
-                                                    std::size_t max_samples_per_dwell = 0,
-                                                    ChannelRoute route = ChannelRoute::kExact,
-                                                    std::vector<DwellChannelsRoute>* routes = nullptr);
+std::vector<PositionModelTerms> reduce_model_terms(const Reduction& reduction, const CentrifugeModel& model,
+                                                   const ReduceOptions& options,
+                                                   std::size_t max_samples_per_dwell = 0,
+                                                   ModelTermsRoute route = ModelTermsRoute::kExact,
+                                                   std::vector<DwellModelTermsRoute>* routes = nullptr);
 
 }  // namespace gyrocal
