@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -10,6 +11,8 @@
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <Eigen/SVD>
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
@@ -31,7 +34,7 @@ struct SensorCombination {
 
 /// The accelerometer's named degeneracy: at one speed a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position, so
 /// adding c to K2, Kpp, Koo and -(1 + Ar^2) c to K0 changes no output. What remains estimable: K2 - Kpp,
-/// K2 - Koo and K0 + (1 + Ar^2) K2.
+/// K2 - Koo and K0 + (1 + Ar^2) K2. Used under these names only where they are the estimable ones.
 std::vector<SensorCombination> accelerometer_combinations(double ar) {
   const auto at = [](AccelCoefficient c) { return static_cast<std::size_t>(c); };
   std::vector<SensorCombination> out;
@@ -46,6 +49,267 @@ std::vector<SensorCombination> accelerometer_combinations(double ar) {
       {{AccelCoefficient::K0, 1.0}, {AccelCoefficient::K2, 1.0 + ar * ar}});
   out.back().unit = "ug";
   return out;
+}
+
+/// The fit of the whole column space of a (whitened) design: its residuals leave nothing of the data that any
+/// combination of the columns explains, and its degrees of freedom are the rows less that space's rank,
+/// judged on equilibrated columns with the solver's own rounding-level tolerance.
+struct ColumnSpaceFit {
+  Eigen::VectorXd x;  ///< a solution, in the columns' units
+  double chi2 = 0.0;  ///< sum of the squared residuals
+  int dof = 0;        ///< rows - rank
+};
+
+ColumnSpaceFit column_space_fit(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(a.cols());
+  Eigen::MatrixXd s = a;
+  for (Eigen::Index j = 0; j < a.cols(); ++j) {
+    const double norm = a.col(j).norm();
+    if (norm > 0.0) scale[j] = 1.0 / norm;
+    s.col(j) *= scale[j];
+  }
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s);
+  qr.setThreshold(LeastSquaresOptions{}.rank_tolerance);
+  const Eigen::VectorXd xs = qr.solve(b);
+  ColumnSpaceFit out;
+  out.x = scale.cwiseProduct(xs);
+  out.chi2 = (b - s * xs).squaredNorm();
+  out.dof = static_cast<int>(a.rows() - qr.rank());
+  return out;
+}
+
+/// An accelerometer's unidentifiable direction (its products' units) in the coefficients' own: the others in
+/// ug, ug/g^n or urad (a product K1*Kx moves as Kx at K1 fixed), K1 in ppm of itself, so that "+1 K0 +1 Kio
+/// -1 delta_o -1 ppm of K1" reads as what it is: adding 1 ug to K0 and Kio, taking 1 urad from delta_o and 1
+/// ppm from K1 changes no output. Parts below 1e-3 of the largest are left out.
+std::string describe_accelerometer_direction(const Eigen::VectorXd& dir, double k1,
+                                             const std::vector<std::string>& names) {
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  const auto nc = static_cast<Eigen::Index>(kNumAccelCoefficients);
+  Eigen::VectorXd w = dir;
+  for (Eigen::Index j = 0; j < std::min(nc, w.size()); ++j)
+    w[j] = j == scale_at ? dir[j] / k1 * 1e6 : dir[j] / k1;
+  const double largest = w.cwiseAbs().maxCoeff();
+  if (largest > 0.0) w /= largest;
+  std::string out;
+  const auto K = [](AccelCoefficient c) { return static_cast<Eigen::Index>(c); };
+  std::vector<Eigen::Index> order;
+  for (Eigen::Index j = 0; j < w.size(); ++j)
+    if (j != scale_at) order.push_back(j);
+  order.push_back(scale_at);
+  for (Eigen::Index j : order) {
+    if (!(std::abs(w[j]) >= 1e-3)) continue;
+    out += fmt::format("{}{}{:.4g} {}{}", out.empty() ? "" : " ", w[j] < 0 ? '-' : '+', std::abs(w[j]),
+                       j == scale_at ? "ppm of " : "", names[static_cast<std::size_t>(j)]);
+  }
+  // The one-speed direction, as docs/accelerometer.md writes it.
+  if (w.size() >= nc && std::abs(w[K(AccelCoefficient::K2)]) >= 1e-3 &&
+      std::abs(w[K(AccelCoefficient::Kpp)]) >= 1e-3 && std::abs(w[K(AccelCoefficient::Koo)]) >= 1e-3 &&
+      std::abs(w[K(AccelCoefficient::K0)]) >= 1e-3)
+    return fmt::format(
+        "K0, K2, Kpp, Koo: adding c to K2, Kpp and Koo and {:.6g} c to K0 changes no output (at one speed "
+        "a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position; direction {})",
+        w[K(AccelCoefficient::K0)] / w[K(AccelCoefficient::K2)], out);
+  return out;
+}
+
+/// An estimable combination of an accelerometer's products: weights c on the products u (c'u, in output
+/// units per g when it holds K1; otherwise read as c'u / K1 in the unit of its first coefficient).
+struct EstimableCombination {
+  std::string name, unit;
+  Eigen::VectorXd weights;
+};
+
+/// Whether weights c on an accelerometer's products hold its scale K1: K1's weight counts in ppm against the
+/// others' (a product K1*Kx weighs 1e-6 of K1 per ug, ug/g^n or urad), and is kept when it is above 1e-3 of
+/// the largest of them, so that the exact chain's ~1e-11 tilt of a null direction does not make "K0 +
+/// delta_o" a scale.
+bool holds_scale(const Eigen::VectorXd& c) {
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  double others = 0.0;
+  for (Eigen::Index j = 0; j < c.size(); ++j)
+    if (j != scale_at) others = std::max(others, std::abs(c[j]));
+  return std::abs(c[scale_at]) * 1e6 > 1e-3 * others;
+}
+
+/// The name of a combination: "K0 + delta_o", "K2 - 0.5 Kpp", or with K1 "K1 (1 - 1e-6 delta_o)" (weights
+/// below 1e-4 of the largest left out of the name, and a weight within 1e-4 of 1 written as 1: the exact
+/// chain's tilt of the null direction, ~1e-5, is in the value and the weights, not in the name).
+std::string combination_name(const Eigen::VectorXd& c, const std::vector<std::string>& names) {
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  const bool with_scale = holds_scale(c);
+  Eigen::VectorXd w = c;
+  if (with_scale) {
+    w /= c[scale_at];
+    w *= 1e6;
+    w[scale_at] = 0.0;
+  }
+  const double largest = std::max(with_scale ? 1.0 : 0.0, w.cwiseAbs().maxCoeff());
+  std::string terms;
+  for (Eigen::Index j = 0; j < w.size(); ++j) {
+    if (!(std::abs(w[j]) >= 1e-4 * largest)) continue;
+    const double a = std::abs(w[j]);
+    const std::string weight = with_scale                 ? fmt::format("{:.4g}e-6 ", a)
+                               : std::abs(a - 1.0) < 1e-4 ? ""
+                                                          : fmt::format("{:.6g} ", a);
+    if (terms.empty() && !with_scale)
+      terms = fmt::format("{}{}{}", w[j] < 0 ? "-" : "", weight, names[static_cast<std::size_t>(j)]);
+    else
+      terms += fmt::format(" {} {}{}", w[j] < 0 ? '-' : '+', weight, names[static_cast<std::size_t>(j)]);
+  }
+  return with_scale ? fmt::format("{} (1{})", names[static_cast<std::size_t>(scale_at)], terms) : terms;
+}
+
+/// The estimable combinations of the accelerometer's products that are not identifiable on their own
+/// (the first nc unknowns), computed from the null space for any plan: docs/accelerometer.md's one-speed
+/// names where the estimable combination IS the named one, the rest of the estimable space in reduced row
+/// echelon form with K1 first (so that it appears in one combination at most), then the table's order.
+std::vector<EstimableCombination> estimable_combinations(const LeastSquaresSolution& sol,
+                                                         const LeastSquaresOptions& lso, double ar,
+                                                         Eigen::Index nc) {
+  std::vector<EstimableCombination> out;
+  const Eigen::Index n = sol.null_space.rows();
+  const Eigen::MatrixXd& ns = sol.scaled_null_space;
+  const Eigen::VectorXd& d = sol.column_scales;
+  std::vector<Eigen::Index> unidentified;
+  for (Eigen::Index j = 0; j < nc; ++j)
+    if (!sol.identifiable[static_cast<std::size_t>(j)]) unidentified.push_back(j);
+  const auto nj = static_cast<Eigen::Index>(unidentified.size());
+  if (nj == 0) return out;
+  Eigen::MatrixXd null_j(nj, ns.cols());
+  for (Eigen::Index a = 0; a < nj; ++a) null_j.row(a) = ns.row(unidentified[static_cast<std::size_t>(a)]);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd_j(null_j, Eigen::ComputeFullU);
+  Eigen::Index rank_j = 0;
+  for (Eigen::Index k = 0; k < svd_j.singularValues().size(); ++k)
+    if (svd_j.singularValues()[k] > 1e-6) ++rank_j;
+  const Eigen::Index estimable_dim = nj - rank_j;
+  if (estimable_dim <= 0) return out;
+  std::vector<std::string> names;
+  for (Eigen::Index j = 0; j < n; ++j)
+    names.push_back(j < nc ? std::string(kAccelerometerParameters[static_cast<std::size_t>(j)].name)
+                           : sol.names[static_cast<std::size_t>(j)]);
+
+  std::vector<Eigen::VectorXd> chosen;  // accepted combinations, equilibrated coordinates
+  const auto in_span = [&chosen](const Eigen::VectorXd& z) {
+    if (chosen.empty()) return false;
+    Eigen::MatrixXd basis(z.size(), static_cast<Eigen::Index>(chosen.size()));
+    for (std::size_t k = 0; k < chosen.size(); ++k) basis.col(static_cast<Eigen::Index>(k)) = chosen[k];
+    const Eigen::VectorXd fit = basis * basis.colPivHouseholderQr().solve(z);
+    return (z - fit).norm() <= 1e-3 * z.norm();
+  };
+  LeastSquaresOptions loose = lso;
+  loose.estimable_tolerance = std::max(loose.estimable_tolerance, 1e-6);
+  const auto add = [&](std::string name, std::string unit, const Eigen::VectorXd& scaled) {
+    // Exactly estimable: its (tiny) part along the unidentifiable directions removed.
+    const Eigen::VectorXd kept = scaled - ns * (ns.transpose() * scaled);
+    const Eigen::VectorXd c = kept.cwiseQuotient(d);
+    if (!evaluate_combination(sol, c, loose).identifiable) return;
+    if (name.empty()) name = combination_name(c, names);
+    out.push_back({std::move(name), std::move(unit), c});
+    chosen.push_back(kept);
+  };
+  for (const SensorCombination& named : accelerometer_combinations(ar)) {
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+    bool touches_unidentified = false;
+    for (Eigen::Index j = 0; j < nc; ++j) {
+      c[j] = named.weights[static_cast<std::size_t>(j)];
+      touches_unidentified |= c[j] != 0.0 && !sol.identifiable[static_cast<std::size_t>(j)];
+    }
+    if (!touches_unidentified) continue;
+    const Eigen::VectorXd scaled = c.cwiseProduct(d);
+    if ((ns.transpose() * scaled).norm() <= 1e-4 * scaled.norm() && !in_span(scaled))
+      add(named.name, named.unit, scaled);
+  }
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(estimable_dim, n);
+  for (Eigen::Index k = 0; k < estimable_dim; ++k)
+    for (Eigen::Index a = 0; a < nj; ++a)
+      basis(k, unidentified[static_cast<std::size_t>(a)]) = svd_j.matrixU()(a, rank_j + k);
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  std::vector<Eigen::Index> order = {scale_at};
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (j != scale_at) order.push_back(j);
+  const Eigen::MatrixXd rows = reduced_row_echelon(basis, order, 1e-4);
+  for (Eigen::Index k = 0; k < rows.rows() && static_cast<Eigen::Index>(chosen.size()) < estimable_dim; ++k) {
+    const Eigen::VectorXd z = rows.row(k).transpose();
+    if (in_span(z)) continue;
+    Eigen::Index pivot = 0;
+    for (Eigen::Index j : order)
+      if (std::abs(z[j]) >= 0.5) {
+        pivot = j;
+        break;
+      }
+    // In parameter units with the pivot's weight 1: c = z / D, scaled back so that c[pivot] = 1.
+    add({}, std::string(kAccelerometerParameters[static_cast<std::size_t>(pivot)].unit), z * d[pivot]);
+  }
+  return out;
+}
+
+/// The least squares of a plan whose nominal design (`nominal`, unweighted, the unknowns' columns; `extra`
+/// the further columns as they are) has exact null directions: the directions the plan cannot separate.
+/// The exact chain separates them only through the machine's small errors (a singular value ~1e-5 of the
+/// largest), which the solver's rank tolerance truncates; its minimum-norm estimate then drops the truth's
+/// whole (large) part along them, and that part leaks into every coefficient the tilted direction touches
+/// (K2 28 for 15 at beta = 0 and 90 deg) and into chi2 (a correct record refused). Here the fit is the
+/// exact design's whole one (rank tolerance at rounding level: unbiased when the model holds, its
+/// covariance honest, chi2 on every degree of freedom the positions leave) and what is unidentifiable is
+/// the nominal null directions, with any exact one. Empty when the nominal design has no null direction,
+/// or when the exact design has more weak directions than the nominal nulls explain (those stay truncated
+/// by the caller's solve).
+std::optional<LeastSquaresSolution> solve_with_plan_nulls(const LeastSquaresProblem& problem,
+                                                          const LeastSquaresOptions& lso,
+                                                          const Eigen::MatrixXd& nominal,
+                                                          const Eigen::MatrixXd& extra) {
+  const Eigen::Index n = problem.design.cols();
+  if (nominal.rows() != problem.design.rows() || nominal.cols() + extra.cols() != n) return std::nullopt;
+  Eigen::MatrixXd x(nominal.rows(), n);
+  x << nominal, extra;
+  Eigen::VectorXd norms(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    norms[j] = x.col(j).norm();
+    if (!(norms[j] > 0.0)) norms[j] = 1.0;
+    x.col(j) /= norms[j];
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(x, Eigen::ComputeFullV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  Eigen::Index rank = 0;
+  while (rank < sv.size() && sv[rank] > 1e-10 * sv[0]) ++rank;
+  const Eigen::Index k = n - rank;
+  if (k == 0) return std::nullopt;
+  LeastSquaresOptions whole = lso;
+  whole.rank_tolerance = LeastSquaresOptions{}.rank_tolerance;
+  LeastSquaresSolution full = solve_least_squares(problem, whole);
+  Eigen::Index weak = 0;
+  for (Eigen::Index i = 0; i < full.singular_values.size(); ++i)
+    if (!(full.singular_values[i] > lso.rank_tolerance * full.singular_values[0])) ++weak;
+  if (weak > k) return std::nullopt;
+  // The nominal null directions in the solution's equilibrated coordinates, with its own null space.
+  Eigen::MatrixXd z(n, k + full.scaled_null_space.cols());
+  for (Eigen::Index c = 0; c < k; ++c)
+    z.col(c) = svd.matrixV().col(rank + c).cwiseQuotient(norms).cwiseQuotient(full.column_scales);
+  z.rightCols(full.scaled_null_space.cols()) = full.scaled_null_space;
+  for (Eigen::Index c = 0; c < z.cols(); ++c) z.col(c).normalize();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> basis(z, Eigen::ComputeThinU);
+  Eigen::Index dim = 0;
+  while (dim < basis.singularValues().size() && basis.singularValues()[dim] > 1e-6) ++dim;
+  Eigen::MatrixXd q = basis.matrixU().leftCols(dim);
+  full.scaled_null_space = q;
+  full.null_space = q.array().colwise() * full.column_scales.array();
+  for (Eigen::Index c = 0; c < dim; ++c) {
+    full.null_space.col(c).normalize();
+    Eigen::Index at = 0;
+    full.null_space.col(c).cwiseAbs().maxCoeff(&at);
+    if (full.null_space(at, c) < 0.0) {
+      full.null_space.col(c) *= -1.0;
+      full.scaled_null_space.col(c) *= -1.0;
+    }
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const bool alone = q.row(j).norm() <= lso.estimable_tolerance;
+    full.identifiable[static_cast<std::size_t>(j)] = alone;
+    if (!alone) full.std[j] = full.std_from_residuals[j] = std::numeric_limits<double>::infinity();
+  }
+  full.rank = static_cast<int>(n - dim);
+  return full;
 }
 
 }  // namespace
@@ -69,7 +333,7 @@ Sensor sensor_of(SensorKind kind) {
 /// products.
 void sensor_least_squares(const Reduction& reduction, const std::vector<PositionChannels>& channels,
                           const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
-                          ErrorColumnsSolution* extra_solution) {
+                          ErrorColumnsSolution* extra_solution, const CentrifugeModel* model) {
   const Sensor sensor = sensor_of(options.sensor);
   const std::vector<std::string_view> unknown_names =
       std::visit([](const auto& s) { return s.unknown_names(); }, sensor);
@@ -148,7 +412,25 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
                   limits::kOutputMagnitude, limits::kAccelerometerCoefficient));
   problem.weights = Eigen::VectorXd::Ones(m);
   problem.names = names;
-  const LeastSquaresSolution sol = solve_least_squares(problem, lso);
+  const bool accelerometer = options.sensor == SensorKind::kAccelerometer;
+  const SensorRegressors regressors = [&sensor, nc](const Eigen::Vector3d& f) {
+    GyroInputs in;
+    in.specific_force_g = f;
+    const DesignRow row = std::visit([&](const auto& s) { return s.design_row(in); }, sensor);
+    Eigen::VectorXd x(nc);
+    for (Eigen::Index j = 0; j < nc; ++j) x[j] = row.regressors[static_cast<std::size_t>(j)];
+    return x;
+  };
+  LeastSquaresSolution sol = solve_least_squares(problem, lso);
+  bool plan_nulls = false;
+  if (accelerometer && model != nullptr) {
+    std::optional<LeastSquaresSolution> exact = solve_with_plan_nulls(
+        problem, lso, nominal_sensor_design(reduction.positions, *model, regressors), extra.columns);
+    if (exact) {
+      sol = std::move(*exact);
+      plan_nulls = true;
+    }
+  }
   r.rank = sol.rank;
   r.unknowns = static_cast<int>(n);
   r.condition_number = sol.effective_condition_number;
@@ -167,14 +449,49 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   // Student factor of its own linear function of the positions, J's row by a central difference of
   // from_products (exact to rounding for the ratios it takes).
   const Eigen::VectorXd u = sol.estimate.head(nc);
-  const Eigen::MatrixXd cu = sandwich.topLeftCorner(nc, nc);
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  // What remains estimable of an accelerometer's coefficients that a plan leaves unidentifiable, and among
+  // it the scale every ratio is divided by (docs/calibration.md, "An accelerometer's plan"): K1 itself when
+  // it is identifiable; otherwise the estimable combination that holds K1 ("K1 (1 - 1e-6 delta_o)" for beta
+  // = 0 and 90 deg), never the minimum-norm K1, which the null direction moves by its whole size.
+  const std::vector<EstimableCombination> estimable = accelerometer && sol.null_space.cols() > 0
+                                                          ? estimable_combinations(sol, lso, r.g_level, nc)
+                                                          : std::vector<EstimableCombination>{};
+  Eigen::VectorXd scale = Eigen::VectorXd::Zero(nc);
+  std::string scale_name;
+  if (accelerometer) {
+    scale[scale_at] = 1.0;
+    if (!sol.identifiable[static_cast<std::size_t>(scale_at)])
+      for (const EstimableCombination& c : estimable)
+        if (holds_scale(c.weights.head(nc))) {
+          scale = c.weights.head(nc) / c.weights[scale_at];
+          scale_name = c.name;
+          break;
+        }
+  }
+  // The step back takes the products with K1's place holding the scale s'u (T u), so that a ratio is
+  // identifiable with its product whenever the scale is estimable; K1 itself stays as identifiable as it is.
+  Eigen::MatrixXd to_scaled = Eigen::MatrixXd::Identity(nc, nc);
+  if (!scale_name.empty()) to_scaled.row(scale_at) = scale.transpose();
+  const Eigen::MatrixXd cu = to_scaled * sandwich.topLeftCorner(nc, nc) * to_scaled.transpose();
   std::vector<bool> identifiable(static_cast<std::size_t>(nc));
   for (Eigen::Index j = 0; j < nc; ++j)
     identifiable[static_cast<std::size_t>(j)] = sol.identifiable[static_cast<std::size_t>(j)];
+  if (!scale_name.empty()) identifiable[static_cast<std::size_t>(scale_at)] = true;
   const auto step_back = [&](const Eigen::VectorXd& products) {
-    return std::visit([&](const auto& s) { return s.from_products(products, cu, identifiable); }, sensor);
+    ParameterEstimates out = std::visit(
+        [&](const auto& s) { return s.from_products(to_scaled * products, cu, identifiable); }, sensor);
+    if (!scale_name.empty()) out.identifiable[static_cast<std::size_t>(scale_at)] = false;
+    return out;
   };
   const ParameterEstimates pe = step_back(u);
+  if (!scale_name.empty())
+    r.warnings.push_back(fmt::format(
+        "K1 is not identifiable from this plan: the other coefficients are stated as their products divided "
+        "by the estimable scale {} = {:.9g} (not by K1), so each is off by that scale's factor against K1 "
+        "(1e-4 per 100 ug, ug/g^n or urad of the coefficients it holds; docs/calibration.md, \"An "
+        "accelerometer's plan\").",
+        scale_name, scale.dot(u)));
   const auto np = pe.values.size();
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(np, n);
   for (Eigen::Index j = 0; j < nc; ++j) {
@@ -219,71 +536,73 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
                  student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
     }
   }
-  const Eigen::VectorXd residuals = observations - design * sol.estimate;
+  // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
+  // data's part along it (the truth's component there times the design's small singular value, or any part
+  // a near-dependency of the exact chain still carries) would stay in the residuals and read as a misfit of
+  // a correct record. The residuals are those of the whole column space instead, and chi2 has as many
+  // degrees of freedom as the positions less that space's rank.
+  Eigen::VectorXd fitted = sol.estimate;
+  if (sol.null_space.cols() > 0 && !plan_nulls) {
+    const ColumnSpaceFit full = column_space_fit(problem.design, problem.observations);
+    fitted = full.x;
+    r.chi2 = full.chi2;
+    r.dof = full.dof;
+  }
+  const Eigen::VectorXd residuals = observations - design * fitted;
   r.residuals_deg_h.assign(residuals.data(), residuals.data() + residuals.size());
   for (const std::string& w : sol.warnings) {
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
       continue;
+    if (sol.null_space.cols() > 0 && !plan_nulls && w.rfind("chi2 = ", 0) == 0)
+      continue;  // the truncated fit's
     r.warnings.push_back("least squares: " + w);
   }
   if (sol.null_space.cols() == 0) return;
-  // The unidentifiable directions in the coefficients' names (a product K1*Kx moves as Kx at K1 fixed).
   std::vector<std::string> coefficient_names;
   for (Eigen::Index j = 0; j < nc; ++j)
     coefficient_names.emplace_back(table[static_cast<std::size_t>(j)].name);
   coefficient_names.insert(coefficient_names.end(), extra.names.begin(), extra.names.end());
+  const double k1v = accelerometer ? scale.dot(u) : 1.0;
   std::string listed;
   for (Eigen::Index d = 0; d < sol.null_space.cols(); ++d) {
-    Eigen::VectorXd dir = sol.null_space.col(d);
-    const double largest = dir.cwiseAbs().maxCoeff();
-    for (Eigen::Index i = 0; i < dir.size(); ++i)
-      if (std::abs(dir[i]) < 1e-3 * largest) dir[i] = 0.0;
-    // The accelerometer's one-speed direction, written as docs/accelerometer.md writes it.
-    const auto K = [](AccelCoefficient c) { return static_cast<Eigen::Index>(c); };
-    std::string text;
-    if (options.sensor == SensorKind::kAccelerometer && dir[K(AccelCoefficient::K2)] != 0.0 &&
-        dir[K(AccelCoefficient::Kpp)] != 0.0 && dir[K(AccelCoefficient::Koo)] != 0.0 &&
-        dir[K(AccelCoefficient::K0)] != 0.0) {
-      const double s = 1.0 / dir[K(AccelCoefficient::K2)];
-      text = fmt::format(
-          "K0, K2, Kpp, Koo: adding c to K2, Kpp and Koo and {:.6g} c to K0 changes no output (at one speed "
-          "a_i^2 + a_p^2 + a_o^2 = 1 + Ar^2 at every position; direction {})",
-          dir[K(AccelCoefficient::K0)] * s, describe_combination(dir, coefficient_names));
-    } else {
-      text = describe_combination(dir, coefficient_names);
-    }
+    const std::string text =
+        accelerometer ? describe_accelerometer_direction(sol.null_space.col(d), k1v, coefficient_names)
+                      : describe_combination(sol.null_space.col(d), coefficient_names);
     r.unidentifiable.push_back(text);
     listed += fmt::format("{}({}) {}", d ? "; " : "", d + 1, text);
   }
-  // What remains estimable, by name, with its value and std (delta method as the coefficients').
-  if (options.sensor == SensorKind::kAccelerometer) {
-    const Eigen::Index k1 = static_cast<Eigen::Index>(AccelCoefficient::K1);
-    for (const SensorCombination& c : accelerometer_combinations(r.g_level)) {
-      Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
-      for (Eigen::Index j = 0; j < nc; ++j) g[j] = c.weights[static_cast<std::size_t>(j)];
-      const IdentifiableCombination ic = evaluate_combination(sol, g, lso, c.name);
-      if (!ic.identifiable || !sol.identifiable[static_cast<std::size_t>(k1)]) continue;
-      // c'K = (g'u) / K1: J = g / K1 - (g'u) / K1^2 e_K1.
-      const double k1v = u[k1];
-      Eigen::VectorXd jrow = g / k1v;
-      jrow[k1] -= ic.value / (k1v * k1v);
+  // What remains estimable of the coefficients that are not identifiable on their own, by name, with its
+  // value and std (delta method as the coefficients').
+  if (accelerometer) {
+    for (const EstimableCombination& c : estimable) {
+      const IdentifiableCombination ic = evaluate_combination(sol, c.weights, lso, c.name);
+      if (!ic.identifiable) continue;
       NamedEstimate ne;
       ne.name = c.name;
       ne.unit = c.unit;
-      ne.value = ic.value / k1v;
+      Eigen::VectorXd jrow = c.weights;
+      if (holds_scale(c.weights.head(nc))) {
+        ne.value = ic.value;  // K1 (1 + ...): a scale, in output units per g
+      } else {
+        // c'K = (c'u) / S with S = s'u the scale: J = c / S - (c'u) / S^2 s.
+        jrow = c.weights / k1v;
+        jrow.head(nc) -= ic.value / (k1v * k1v) * scale;
+        ne.value = ic.value / k1v;
+      }
       ne.std = std::sqrt(jrow.dot(sandwich * jrow)) * student(jrow, c.name);
-      ne.coefficients = c.weights;
+      ne.coefficients.assign(c.weights.data(), c.weights.data() + nc);
       r.combinations.push_back(std::move(ne));
     }
+  }
+  std::string advice;
+  if (model != nullptr) {
+    advice =
+        sensor_identifiability_advice(sol.null_space.topRows(nc), reduction.positions, *model, regressors);
   }
   const auto k = sol.null_space.cols();
   r.warnings.push_back(fmt::format(
       "{} direction{} of the coefficients cannot be identified from this plan: {}.{}", k, k > 1 ? "s" : "",
-      listed,
-      options.sensor == SensorKind::kAccelerometer
-          ? " A second non-zero speed or a static set (the main axis stopped, the platform indexed to each "
-            "gamma) separates them (docs/accelerometer.md)."
-          : ""));
+      listed, advice.empty() ? "" : " " + advice + " (docs/calibration.md, \"Identifiability\")"));
 }
 
 }  // namespace gyrocal::identify_detail
