@@ -244,21 +244,30 @@ std::vector<EstimableCombination> estimable_combinations(const LeastSquaresSolut
   return out;
 }
 
-/// The least squares of a plan whose nominal design (`nominal`, unweighted, the unknowns' columns; `extra`
-/// the further columns as they are) has exact null directions: the directions the plan cannot separate.
-/// The exact chain separates them only through the machine's small errors (a singular value ~1e-5 of the
-/// largest), which the solver's rank tolerance truncates; its minimum-norm estimate then drops the truth's
-/// whole (large) part along them, and that part leaks into every coefficient the tilted direction touches
-/// (K2 28 for 15 at beta = 0 and 90 deg) and into chi2 (a correct record refused). Here the fit is the
-/// exact design's whole one (rank tolerance at rounding level: unbiased when the model holds, its
-/// covariance honest, chi2 on every degree of freedom the positions leave) and what is unidentifiable is
-/// the nominal null directions, with any exact one. Empty when the nominal design has no null direction,
-/// or when the exact design has more weak directions than the nominal nulls explain (those stay truncated
-/// by the caller's solve).
-std::optional<LeastSquaresSolution> solve_with_plan_nulls(const LeastSquaresProblem& problem,
-                                                          const LeastSquaresOptions& lso,
-                                                          const Eigen::MatrixXd& nominal,
-                                                          const Eigen::MatrixXd& extra) {
+/// An accelerometer's least squares when its plan's nominal design (`nominal`, unweighted, the products'
+/// columns; `extra` the further columns as they are) has exact null directions: the directions the plan
+/// cannot separate (docs/calibration.md, "An accelerometer's plan"). `truncated` is the solver's solution at
+/// the caller's rank rule.
+///
+/// The exact chain separates such a direction only through the machine's small errors (a singular value
+/// ~1e-5 of the largest), which the rank rule truncates; the solver then puts the estimate at the
+/// minimum-norm point along it in equilibrated coordinates, where K1 is far from any sensor's (K1 0.53 for
+/// 1: the direction moves K1 by 1 ppm per ug of K0), and the machine's tilt of the direction carries that
+/// distance into every coefficient it touches (K2 18.5 +- 0.04 for 15 at beta = 0 and 90 deg) and into chi2
+/// (a correct record refused). Fitting the exact design's whole space instead would lean on the machine's
+/// errors being known to a few percent and give combinations a sigma of ~1000 ug where the tilt is ~1e-10.
+/// So the estimate stays truncated (what the data determine, with their covariance) and is moved along the
+/// truncated directions, which the data do not see, to the point where the products other than K1 (K1 Kx:
+/// ug, ug/g^n, urad times K1) are smallest: within the size of the flagged coefficients of the truth, so that
+/// the tilt (~1e-4) leaves a bias of ~1e-4 of them (0.0006 ug/g^2 on K2 here). What is unidentifiable is
+/// then the nominal null directions, with any truncated direction they do not explain (an ill-conditioned
+/// plan on top of a partial one); chi2 is that of the moved estimate on the truncated fit's degrees of
+/// freedom. Empty when the nominal design has no null direction.
+std::optional<LeastSquaresSolution> with_plan_nulls(const LeastSquaresProblem& problem,
+                                                    const LeastSquaresOptions& lso,
+                                                    const LeastSquaresSolution& truncated,
+                                                    const Eigen::MatrixXd& nominal,
+                                                    const Eigen::MatrixXd& extra, Eigen::Index nc) {
   const Eigen::Index n = problem.design.cols();
   if (nominal.rows() != problem.design.rows() || nominal.cols() + extra.cols() != n) return std::nullopt;
   Eigen::MatrixXd x(nominal.rows(), n);
@@ -275,41 +284,61 @@ std::optional<LeastSquaresSolution> solve_with_plan_nulls(const LeastSquaresProb
   while (rank < sv.size() && sv[rank] > 1e-10 * sv[0]) ++rank;
   const Eigen::Index k = n - rank;
   if (k == 0) return std::nullopt;
-  LeastSquaresOptions whole = lso;
-  whole.rank_tolerance = LeastSquaresOptions{}.rank_tolerance;
-  LeastSquaresSolution full = solve_least_squares(problem, whole);
-  Eigen::Index weak = 0;
-  for (Eigen::Index i = 0; i < full.singular_values.size(); ++i)
-    if (!(full.singular_values[i] > lso.rank_tolerance * full.singular_values[0])) ++weak;
-  if (weak > k) return std::nullopt;
-  // The nominal null directions in the solution's equilibrated coordinates, with its own null space.
-  Eigen::MatrixXd z(n, k + full.scaled_null_space.cols());
-  for (Eigen::Index c = 0; c < k; ++c)
-    z.col(c) = svd.matrixV().col(rank + c).cwiseQuotient(norms).cwiseQuotient(full.column_scales);
-  z.rightCols(full.scaled_null_space.cols()) = full.scaled_null_space;
-  for (Eigen::Index c = 0; c < z.cols(); ++c) z.col(c).normalize();
-  const Eigen::JacobiSVD<Eigen::MatrixXd> basis(z, Eigen::ComputeThinU);
-  Eigen::Index dim = 0;
-  while (dim < basis.singularValues().size() && basis.singularValues()[dim] > 1e-6) ++dim;
-  Eigen::MatrixXd q = basis.matrixU().leftCols(dim);
-  full.scaled_null_space = q;
-  full.null_space = q.array().colwise() * full.column_scales.array();
+  LeastSquaresSolution out = truncated;
+  // The estimate moved along the truncated directions V (parameter units) by a: min |P (x + V a)| with P
+  // the products other than K1's (the machine errors and K1 left free).
+  const Eigen::MatrixXd& v = truncated.null_space;
+  if (v.cols() > 0) {
+    Eigen::MatrixXd pv = Eigen::MatrixXd::Zero(nc, v.cols());
+    Eigen::VectorXd px = Eigen::VectorXd::Zero(nc);
+    const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+    for (Eigen::Index j = 0; j < nc; ++j) {
+      if (j == scale_at) continue;
+      pv.row(j) = v.row(j);
+      px[j] = truncated.estimate[j];
+    }
+    const Eigen::VectorXd a = pv.completeOrthogonalDecomposition().solve(-px);
+    out.estimate = truncated.estimate + v * a;
+    out.residuals = problem.observations - problem.design * out.estimate;
+    out.chi2 = out.residuals.squaredNorm();
+    out.residual_sigma = out.dof > 0 ? std::sqrt(out.chi2 / out.dof) : 0.0;
+  }
+  // The nominal null directions in the solution's equilibrated coordinates, with any truncated direction
+  // that lies more than 10 % outside their span.
+  Eigen::MatrixXd z(n, k);
+  for (Eigen::Index c = 0; c < k; ++c) {
+    z.col(c) = svd.matrixV().col(rank + c).cwiseQuotient(norms).cwiseQuotient(truncated.column_scales);
+    z.col(c).normalize();
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr_nominal(z);
+  const Eigen::MatrixXd q_nominal = qr_nominal.householderQ() * Eigen::MatrixXd::Identity(n, k);
+  std::vector<Eigen::VectorXd> basis;
+  for (Eigen::Index c = 0; c < k; ++c) basis.push_back(q_nominal.col(c));
+  for (Eigen::Index c = 0; c < truncated.scaled_null_space.cols(); ++c) {
+    Eigen::VectorXd w = truncated.scaled_null_space.col(c);
+    for (const Eigen::VectorXd& b : basis) w -= b.dot(w) * b;
+    if (w.norm() > 0.1) basis.push_back(w.normalized());
+  }
+  const auto dim = static_cast<Eigen::Index>(basis.size());
+  out.scaled_null_space.resize(n, dim);
+  for (Eigen::Index c = 0; c < dim; ++c) out.scaled_null_space.col(c) = basis[static_cast<std::size_t>(c)];
+  out.null_space = out.scaled_null_space.array().colwise() * truncated.column_scales.array();
   for (Eigen::Index c = 0; c < dim; ++c) {
-    full.null_space.col(c).normalize();
+    out.null_space.col(c).normalize();
     Eigen::Index at = 0;
-    full.null_space.col(c).cwiseAbs().maxCoeff(&at);
-    if (full.null_space(at, c) < 0.0) {
-      full.null_space.col(c) *= -1.0;
-      full.scaled_null_space.col(c) *= -1.0;
+    out.null_space.col(c).cwiseAbs().maxCoeff(&at);
+    if (out.null_space(at, c) < 0.0) {
+      out.null_space.col(c) *= -1.0;
+      out.scaled_null_space.col(c) *= -1.0;
     }
   }
   for (Eigen::Index j = 0; j < n; ++j) {
-    const bool alone = q.row(j).norm() <= lso.estimable_tolerance;
-    full.identifiable[static_cast<std::size_t>(j)] = alone;
-    if (!alone) full.std[j] = full.std_from_residuals[j] = std::numeric_limits<double>::infinity();
+    const bool alone = out.scaled_null_space.row(j).norm() <= lso.estimable_tolerance;
+    out.identifiable[static_cast<std::size_t>(j)] = alone;
+    if (!alone) out.std[j] = out.std_from_residuals[j] = std::numeric_limits<double>::infinity();
   }
-  full.rank = static_cast<int>(n - dim);
-  return full;
+  out.rank = static_cast<int>(n - dim);
+  return out;
 }
 
 }  // namespace
@@ -424,10 +453,10 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   LeastSquaresSolution sol = solve_least_squares(problem, lso);
   bool plan_nulls = false;
   if (accelerometer && model != nullptr) {
-    std::optional<LeastSquaresSolution> exact = solve_with_plan_nulls(
-        problem, lso, nominal_sensor_design(reduction.positions, *model, regressors), extra.columns);
-    if (exact) {
-      sol = std::move(*exact);
+    std::optional<LeastSquaresSolution> moved = with_plan_nulls(
+        problem, lso, sol, nominal_sensor_design(reduction.positions, *model, regressors), extra.columns, nc);
+    if (moved) {
+      sol = std::move(*moved);
       plan_nulls = true;
     }
   }
@@ -553,8 +582,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   for (const std::string& w : sol.warnings) {
     if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
       continue;
-    if (sol.null_space.cols() > 0 && !plan_nulls && w.rfind("chi2 = ", 0) == 0)
-      continue;  // the truncated fit's
+    if (sol.null_space.cols() > 0 && w.rfind("chi2 = ", 0) == 0) continue;  // the truncated fit's
     r.warnings.push_back("least squares: " + w);
   }
   if (sol.null_space.cols() == 0) return;
