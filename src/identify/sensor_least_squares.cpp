@@ -45,7 +45,7 @@ std::vector<SensorCombination> accelerometer_combinations(double ar) {
   };
   add("K2 - Kpp", {{AccelCoefficient::K2, 1.0}, {AccelCoefficient::Kpp, -1.0}});
   add("K2 - Koo", {{AccelCoefficient::K2, 1.0}, {AccelCoefficient::Koo, -1.0}});
-  add(fmt::format("K0 + {:.6g} K2", 1.0 + ar * ar),
+  add(ar * ar < 1e-6 ? std::string("K0 + K2") : fmt::format("K0 + {:.6g} K2", 1.0 + ar * ar),
       {{AccelCoefficient::K0, 1.0}, {AccelCoefficient::K2, 1.0 + ar * ar}});
   out.back().unit = "ug";
   return out;
@@ -121,15 +121,17 @@ struct EstimableCombination {
 };
 
 /// Whether weights c on an accelerometer's products hold its scale K1: K1's weight counts in ppm against the
-/// others' (a product K1*Kx weighs 1e-6 of K1 per ug, ug/g^n or urad), and is kept when it is above 1e-3 of
-/// the largest of them, so that the exact chain's ~1e-11 tilt of a null direction does not make "K0 +
-/// delta_o" a scale.
+/// others' (a product K1*Kx weighs 1e-6 of K1 per ug, ug/g^n or urad: "K1 (1 - 1e-6 delta_o)" is 1e6 against
+/// 1), and the combination holds the scale when it is at least half the largest of them. The part a
+/// combination keeps of K1 after the null directions are projected out of it (1e-8 for "K0 + K2" on a static
+/// plan, whose K1 column is a million times the others) is not a scale: divided by it, delta_o read 0.03 for
+/// -200 urad.
 bool holds_scale(const Eigen::VectorXd& c) {
   const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
   double others = 0.0;
   for (Eigen::Index j = 0; j < c.size(); ++j)
     if (j != scale_at) others = std::max(others, std::abs(c[j]));
-  return std::abs(c[scale_at]) * 1e6 > 1e-3 * others;
+  return std::abs(c[scale_at]) * 1e6 >= 0.5 * others;
 }
 
 /// The name of a combination: "K0 + delta_o", "K2 - 0.5 Kpp", or with K1 "K1 (1 - 1e-6 delta_o)" (weights
@@ -200,9 +202,14 @@ std::vector<EstimableCombination> estimable_combinations(const LeastSquaresSolut
   LeastSquaresOptions loose = lso;
   loose.estimable_tolerance = std::max(loose.estimable_tolerance, 1e-6);
   const auto add = [&](std::string name, std::string unit, const Eigen::VectorXd& scaled) {
-    // Exactly estimable: its (tiny) part along the unidentifiable directions removed.
+    // Exactly estimable: its (tiny) part along the unidentifiable directions removed. A removal that changes
+    // a weight by more than 1e-6 of the largest in the products' own units is not tiny: equilibration
+    // weighs K1's column a million times the others', so a 1e-4 part in its coordinates put 0.84 K1 into a
+    // static plan's "K0 + K2".
     const Eigen::VectorXd kept = scaled - ns * (ns.transpose() * scaled);
     const Eigen::VectorXd c = kept.cwiseQuotient(d);
+    const Eigen::VectorXd asked = scaled.cwiseQuotient(d);
+    if ((c - asked).cwiseAbs().maxCoeff() > 1e-6 * asked.cwiseAbs().maxCoeff()) return;
     if (!evaluate_combination(sol, c, loose).identifiable) return;
     if (name.empty()) name = combination_name(c, names);
     out.push_back({std::move(name), std::move(unit), c});
@@ -244,30 +251,43 @@ std::vector<EstimableCombination> estimable_combinations(const LeastSquaresSolut
   return out;
 }
 
+/// An accelerometer's least squares on a plan with null directions (with_plan_nulls): the solution, and the
+/// factor F of the covariance its estimate takes from where it is put along the directions the data do not
+/// bound (parameter units, F F' added to the data's own; kept as a factor so that a combination across such
+/// a direction is computed as |F' c|, without the cancellation of its ~1e20 entries).
+struct PlanNullsSolution {
+  LeastSquaresSolution solution;
+  Eigen::MatrixXd placement_factor;
+};
+
 /// An accelerometer's least squares when its plan's nominal design (`nominal`, unweighted, the products'
 /// columns; `extra` the further columns as they are) has exact null directions: the directions the plan
 /// cannot separate (docs/calibration.md, "An accelerometer's plan"). `truncated` is the solver's solution at
 /// the caller's rank rule.
 ///
-/// The exact chain separates such a direction only through the machine's small errors (a singular value
-/// ~1e-5 of the largest), which the rank rule truncates; the solver then puts the estimate at the
-/// minimum-norm point along it in equilibrated coordinates, where K1 is far from any sensor's (K1 0.53 for
-/// 1: the direction moves K1 by 1 ppm per ug of K0), and the machine's tilt of the direction carries that
-/// distance into every coefficient it touches (K2 18.5 +- 0.04 for 15 at beta = 0 and 90 deg) and into chi2
-/// (a correct record refused). Fitting the exact design's whole space instead would lean on the machine's
-/// errors being known to a few percent and give combinations a sigma of ~1000 ug where the tilt is ~1e-10.
-/// So the estimate stays truncated (what the data determine, with their covariance) and is moved along the
-/// truncated directions, which the data do not see, to the point where the products other than K1 (K1 Kx:
-/// ug, ug/g^n, urad times K1) are smallest: within the size of the flagged coefficients of the truth, so that
-/// the tilt (~1e-4) leaves a bias of ~1e-4 of them (0.0006 ug/g^2 on K2 here). What is unidentifiable is
-/// then the nominal null directions, with any truncated direction they do not explain (an ill-conditioned
-/// plan on top of a partial one); chi2 is that of the moved estimate on the truncated fit's degrees of
-/// freedom. Empty when the nominal design has no null direction.
-std::optional<LeastSquaresSolution> with_plan_nulls(const LeastSquaresProblem& problem,
-                                                    const LeastSquaresOptions& lso,
-                                                    const LeastSquaresSolution& truncated,
-                                                    const Eigen::MatrixXd& nominal,
-                                                    const Eigen::MatrixXd& extra, Eigen::Index nc) {
+/// The exact chain separates such a direction only through the machine's small errors, by a singular value
+/// of ~1e-5 of the largest (spinning) down to ~1e-10; the rank rule truncates it and the solver puts the
+/// estimate at the minimum-norm point along it in equilibrated coordinates, where K1 is far from any
+/// sensor's (0.53 for 1: the direction moves K1 by 1 ppm per ug of K0), and the machine's tilt of the
+/// direction carries that distance into every coefficient it touches (K2 18.5 +- 0.04 for 15 at beta = 0 and
+/// 90 deg) and into chi2 (a correct record refused). Each truncated direction k (singular value s_k) is
+/// placed instead by what bounds it better:
+/// - the data, when 1/s_k (its std in equilibrated coordinates) is smaller than the placement's: its full
+///   least-squares coordinate, its variance 1/s_k^2 through the data's own covariance (static holds at two
+///   beta see some of their directions this way);
+/// - else the placement: the point where the products other than K1 (K1 Kx: ug, ug/g^n, urad times K1) are
+///   smallest along the placed directions, within a radius R of the truth's, where R is three times the
+///   largest of them there plus 100 ug (times K1): the coordinate's std is R over the largest product one
+///   unit along the direction moves, a variance that enters every coefficient the tilt touches (a few 1e-3
+///   ug/g^2 on K2 at beta = 0 and 90 deg) instead of a 1/s_k that made the combinations' sigma ~1000 ug.
+/// What is unidentifiable is the nominal null directions, with any truncated direction more than 10 % outside
+/// their span; chi2 is that of the placed estimate on the positions less the rank less the directions the
+/// data placed. Empty when the nominal design has no null direction.
+std::optional<PlanNullsSolution> with_plan_nulls(const LeastSquaresProblem& problem,
+                                                 const LeastSquaresOptions& lso,
+                                                 const LeastSquaresSolution& truncated,
+                                                 const Eigen::MatrixXd& nominal, const Eigen::MatrixXd& extra,
+                                                 Eigen::Index nc) {
   const Eigen::Index n = problem.design.cols();
   if (nominal.rows() != problem.design.rows() || nominal.cols() + extra.cols() != n) return std::nullopt;
   Eigen::MatrixXd x(nominal.rows(), n);
@@ -284,23 +304,72 @@ std::optional<LeastSquaresSolution> with_plan_nulls(const LeastSquaresProblem& p
   while (rank < sv.size() && sv[rank] > 1e-10 * sv[0]) ++rank;
   const Eigen::Index k = n - rank;
   if (k == 0) return std::nullopt;
-  LeastSquaresSolution out = truncated;
-  // The estimate moved along the truncated directions V (parameter units) by a: min |P (x + V a)| with P
-  // the products other than K1's (the machine errors and K1 left free).
-  const Eigen::MatrixXd& v = truncated.null_space;
-  if (v.cols() > 0) {
-    Eigen::MatrixXd pv = Eigen::MatrixXd::Zero(nc, v.cols());
-    Eigen::VectorXd px = Eigen::VectorXd::Zero(nc);
+  PlanNullsSolution result{truncated, Eigen::MatrixXd::Zero(n, 0)};
+  LeastSquaresSolution& out = result.solution;
+  // The truncated directions: the solver's right singular vectors (equilibrated), the smallest last.
+  const Eigen::VectorXd& d = truncated.column_scales;
+  const Eigen::MatrixXd& vs = truncated.scaled_null_space;
+  const Eigen::Index t = vs.cols();
+  if (t > 0) {
     const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
-    for (Eigen::Index j = 0; j < nc; ++j) {
-      if (j == scale_at) continue;
-      pv.row(j) = v.row(j);
-      px[j] = truncated.estimate[j];
+    const Eigen::MatrixXd w = d.asDiagonal() * vs;         // the directions in parameter units
+    const auto products = [&](const Eigen::MatrixXd& m) {  // the rows of the products other than K1's
+      Eigen::MatrixXd p = m.topRows(nc);
+      p.row(scale_at).setZero();
+      return p;
+    };
+    const auto place = [&](const Eigen::VectorXd& base, const std::vector<Eigen::Index>& free) {
+      Eigen::MatrixXd pw(nc, static_cast<Eigen::Index>(free.size()));
+      for (std::size_t c = 0; c < free.size(); ++c)
+        pw.col(static_cast<Eigen::Index>(c)) = products(w.col(free[c]));
+      const Eigen::VectorXd a = pw.completeOrthogonalDecomposition().solve(-products(base));
+      Eigen::VectorXd placed = base;
+      for (std::size_t c = 0; c < free.size(); ++c)
+        placed += a[static_cast<Eigen::Index>(c)] * w.col(free[c]);
+      return placed;
+    };
+    std::vector<Eigen::Index> all(static_cast<std::size_t>(t));
+    for (Eigen::Index c = 0; c < t; ++c) all[static_cast<std::size_t>(c)] = c;
+    const Eigen::VectorXd anchored = place(truncated.estimate, all);
+    const double radius =
+        3.0 * products(anchored).cwiseAbs().maxCoeff() + 100.0 * std::abs(anchored[scale_at]);
+    const Eigen::MatrixXd a_s = problem.design * d.asDiagonal();
+    Eigen::VectorXd base = truncated.estimate;
+    std::vector<Eigen::Index> placed;
+    std::vector<double> placed_std;
+    int by_data = 0;
+    for (Eigen::Index c = 0; c < t; ++c) {
+      const double s_k = truncated.singular_values[n - t + c];
+      const double moves = products(w.col(c)).cwiseAbs().maxCoeff();
+      const double std_data = s_k > 0.0 ? 1.0 / s_k : std::numeric_limits<double>::infinity();
+      const double std_placed = moves > 0.0 ? radius / moves : std::numeric_limits<double>::infinity();
+      // A direction the exact design does not see at all (s_k = 0: a regressor exactly zero) is placed.
+      if (s_k > 0.0 && std_data <= std_placed) {
+        // The data's full least-squares coordinate along it, and its variance through the data.
+        const Eigen::VectorXd along = a_s * vs.col(c);
+        base +=
+            along.dot(problem.observations - problem.design * truncated.estimate) / (s_k * s_k) * w.col(c);
+        out.covariance += w.col(c) * w.col(c).transpose() / (s_k * s_k);
+        Eigen::MatrixXd factor(n, out.covariance_factor.cols() + 1);
+        factor << out.covariance_factor, w.col(c) / s_k;
+        out.covariance_factor = factor;
+        ++by_data;
+      } else {
+        placed.push_back(c);
+        placed_std.push_back(std_placed);
+      }
     }
-    const Eigen::VectorXd a = pv.completeOrthogonalDecomposition().solve(-px);
-    out.estimate = truncated.estimate + v * a;
+    out.estimate = placed.empty() ? base : place(base, placed);
+    // A placed direction that moves no product but K1's (or a further column's) is bounded by nothing: it
+    // stays unidentifiable, and the combinations stated are those without a part along it.
+    for (std::size_t c = 0; c < placed.size(); ++c)
+      if (std::isfinite(placed_std[c])) {
+        result.placement_factor.conservativeResize(n, result.placement_factor.cols() + 1);
+        result.placement_factor.rightCols(1) = placed_std[c] * w.col(placed[c]);
+      }
     out.residuals = problem.observations - problem.design * out.estimate;
     out.chi2 = out.residuals.squaredNorm();
+    out.dof = truncated.dof - by_data;
     out.residual_sigma = out.dof > 0 ? std::sqrt(out.chi2 / out.dof) : 0.0;
   }
   // The nominal null directions in the solution's equilibrated coordinates, with any truncated direction
@@ -338,7 +407,7 @@ std::optional<LeastSquaresSolution> with_plan_nulls(const LeastSquaresProblem& p
     if (!alone) out.std[j] = out.std_from_residuals[j] = std::numeric_limits<double>::infinity();
   }
   out.rank = static_cast<int>(n - dim);
-  return out;
+  return result;
 }
 
 }  // namespace
@@ -452,11 +521,13 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   };
   LeastSquaresSolution sol = solve_least_squares(problem, lso);
   bool plan_nulls = false;
+  Eigen::MatrixXd placement_factor;  // where a plan's null directions were placed (with_plan_nulls)
   if (accelerometer && model != nullptr) {
-    std::optional<LeastSquaresSolution> moved = with_plan_nulls(
+    std::optional<PlanNullsSolution> placed = with_plan_nulls(
         problem, lso, sol, nominal_sensor_design(reduction.positions, *model, regressors), extra.columns, nc);
-    if (moved) {
-      sol = std::move(*moved);
+    if (placed) {
+      sol = std::move(placed->solution);
+      placement_factor = std::move(placed->placement_factor);
       plan_nulls = true;
     }
   }
@@ -467,10 +538,26 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   r.dof = sol.dof;
   const Eigen::MatrixXd gain =
       sol.covariance * problem.design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
-  const Eigen::MatrixXd sandwich = gain * covariance * gain.transpose();
+  Eigen::MatrixXd sandwich = gain * covariance * gain.transpose();
+  if (placement_factor.cols() > 0) sandwich += placement_factor * placement_factor.transpose();
+  // gain' c and c' sandwich c through the covariance's factor (the solver's, with the directions the data
+  // placed), each product taken vector-first: on a plan with null directions the covariance holds entries
+  // of ~1e20 along them, and c' (G C G') c for a c across them cancels to a negative number.
+  const Eigen::MatrixXd& cov_factor = sol.covariance_factor;
+  const auto gain_t = [&](const Eigen::VectorXd& c) -> Eigen::VectorXd {
+    const Eigen::VectorXd cov_c = cov_factor * (cov_factor.transpose() * c);
+    return llt.matrixL().transpose().solve(problem.design * cov_c);
+  };
+  const auto variance = [&](const Eigen::VectorXd& c) {
+    const Eigen::VectorXd g = gain_t(c);
+    double v = g.dot(covariance * g);
+    if (placement_factor.cols() > 0) v += (placement_factor.transpose() * c).squaredNorm();
+    return v;
+  };
   const auto student = [&](const Eigen::VectorXd& c, const std::string& name) {
     double nu = 0.0;
-    const double factor = student_factor(reduction, covariance, gain.transpose() * c, &nu);
+    const double factor = student_factor(reduction, covariance,
+                                         plan_nulls ? gain_t(c) : Eigen::VectorXd(gain.transpose() * c), &nu);
     warn_few_dof(nu, name, r);
     return factor;
   };
@@ -544,7 +631,8 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     e.identifiable = pe.identifiable[static_cast<std::size_t>(k)];
     if (e.identifiable) {
       e.value = pe.values[k];
-      e.std = std::sqrt(pe.covariance(k, k)) * student(jacobian.row(k).transpose(), e.name);
+      const double var = plan_nulls ? variance(jacobian.row(k).transpose()) : pe.covariance(k, k);
+      e.std = std::sqrt(var) * student(jacobian.row(k).transpose(), e.name);
     }
     r.sensor_coefficients.push_back(std::move(e));
   }
@@ -561,8 +649,9 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
       if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
       e.identifiable[static_cast<std::size_t>(j)] = true;
       e.value[j] = sol.estimate[nc + j];
-      e.std[j] = std::sqrt(sandwich(nc + j, nc + j)) *
-                 student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
+      e.std[j] =
+          std::sqrt(plan_nulls ? variance(Eigen::VectorXd::Unit(n, nc + j)) : sandwich(nc + j, nc + j)) *
+          student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
     }
   }
   // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
@@ -602,9 +691,12 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   // What remains estimable of the coefficients that are not identifiable on their own, by name, with its
   // value and std (delta method as the coefficients').
   if (accelerometer) {
+    // Without K1 and without an estimable scale (every position with a_i = 0: static holds at beta = 0
+    // and 180 deg), a combination of the other products has no divisor: it is not stated in their units.
+    const bool no_scale = !sol.identifiable[static_cast<std::size_t>(scale_at)] && scale_name.empty();
     for (const EstimableCombination& c : estimable) {
       const IdentifiableCombination ic = evaluate_combination(sol, c.weights, lso, c.name);
-      if (!ic.identifiable) continue;
+      if (!ic.identifiable || (no_scale && !holds_scale(c.weights.head(nc)))) continue;
       NamedEstimate ne;
       ne.name = c.name;
       ne.unit = c.unit;
@@ -617,7 +709,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
         jrow.head(nc) -= ic.value / (k1v * k1v) * scale;
         ne.value = ic.value / k1v;
       }
-      ne.std = std::sqrt(jrow.dot(sandwich * jrow)) * student(jrow, c.name);
+      ne.std = std::sqrt(plan_nulls ? variance(jrow) : jrow.dot(sandwich * jrow)) * student(jrow, c.name);
       ne.coefficients.assign(c.weights.data(), c.weights.data() + nc);
       r.combinations.push_back(std::move(ne));
     }
