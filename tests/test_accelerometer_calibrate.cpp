@@ -23,6 +23,7 @@
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/cli_run.hpp"
+#include "support/sanitized.hpp"
 #include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
@@ -33,9 +34,7 @@ using testing::simulate_and_reduce;
 /// The sanitizer build (scripts/test --sanitize) checks memory and undefined behaviour; the statistics are
 /// held by the Release run. Its z-score tests take 40 seeds with a band as wide in units of the sample std's
 /// own spread.
-bool sanitized() {
-  return std::getenv("GYROCAL_SANITIZED") != nullptr;
-}
+using testing::sanitized;
 
 /// A small two-speed accelerometer test: static holds at four gamma, 6 and 12 rad/s, four beta, the default
 /// truth of [accelerometer], the default machine's wobbles plus a lever arm and a main-axis runout. Few

@@ -20,11 +20,13 @@
 #include "gyrocal/identify/sensor_channels.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/sanitized.hpp"
 #include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
 
+using testing::sanitized;
 using testing::simulate_and_reduce;
 
 using K = AccelCoefficient;
@@ -191,27 +193,55 @@ std::vector<Stated> stated_with_truth(const CalibrationResult& r, const Scenario
   return out;
 }
 
+/// `two_beta` with static holds only (the main axis never turns): gravity alone, at every beta listed and
+/// eight gamma.
+Scenario static_only(std::vector<double> betas_deg) {
+  Scenario s = two_beta(0.0, 90.0);
+  s.test.rates_rad_s = {0.0};
+  s.test.gamma_rad.clear();  // eight platform indices per beta: more positions than the eleven unknowns
+  for (int k = 0; k < 8; ++k) s.test.gamma_rad.push_back(k * kPi / 4);
+  s.test.beta_rad.clear();
+  for (double b : betas_deg) s.test.beta_rad.push_back(b * kDegToRad);
+  return s;
+}
+
 TEST(AccelerometerIdentifiability, PartialBetaSetsStateHonestUncertaintiesOverSeeds) {
   // Over 40 records of each partial beta set, every coefficient and combination stated is unbiased and its
   // std honest: the rms of z = (value - truth) / std within [0.55, 1.45] and its mean within +-0.55 (each
-  // +-3.5 times the spread of 40 standard normal z's: 1/sqrt(80) and 1/sqrt(40)). Before the whole-space fit
-  // the beta = 0/90 set gave K2 18.5 +- 0.04 for 15 (z = 82).
-  constexpr int kSeeds = 40;
-  for (const auto& [b0, b1] : {std::pair{0.0, 90.0}, std::pair{90.0, 270.0}, std::pair{0.0, 180.0}}) {
-    const Scenario s = two_beta(b0, b1);
+  // +-3.5 times the spread of 40 standard normal z's: 1/sqrt(80) and 1/sqrt(40)). Before the estimate was
+  // placed along the null directions the beta = 0/90 set gave K2 18.5 +- 0.04 for 15 (z = 82). Static holds
+  // alone at the four quarter beta read delta_o 0.03 +- 0.29 for -200 urad when a combination holding a
+  // 1e-8 part of K1 was taken for the scale.
+  // Under the sanitizers 20 records, the bands as wide in units of their statistics' own spread.
+  const int seeds = sanitized() ? 20 : 40;
+  const double rms_band = 3.5 / std::sqrt(2.0 * seeds),
+               mean_band = 3.5 / std::sqrt(static_cast<double>(seeds));
+  std::vector<std::pair<std::string, Scenario>> plans = {
+      {"beta 0/90", two_beta(0.0, 90.0)},
+      {"beta 90/270", two_beta(90.0, 270.0)},
+      {"beta 0/180", two_beta(0.0, 180.0)},
+      {"static beta 0/90", static_only({0.0, 90.0})},
+      {"static beta 90/270", static_only({90.0, 270.0})},
+      {"static four beta", static_only({0, 90, 180, 270})}};
+  for (const auto& [label, s] : plans) {
     std::map<std::string, std::vector<double>> z;
-    for (int seed = 1; seed <= kSeeds; ++seed) {
+    for (int seed = 1; seed <= seeds; ++seed) {
       const CalibrationResult r = calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed)));
       for (const Stated& q : stated_with_truth(r, s)) z[q.name].push_back((q.value - q.truth) / q.std);
     }
+    EXPECT_FALSE(z.empty()) << label;
     for (const auto& [name, zs] : z) {
-      ASSERT_EQ(zs.size(), static_cast<std::size_t>(kSeeds)) << name;
+      ASSERT_EQ(zs.size(), static_cast<std::size_t>(seeds)) << label << " " << name;
       double sum = 0.0, squares = 0.0;
       for (double v : zs) sum += v, squares += v * v;
-      const double mean = sum / kSeeds, rms = std::sqrt(squares / kSeeds);
-      EXPECT_LT(std::abs(mean), 0.55) << "beta " << b0 << "/" << b1 << " " << name << " mean z " << mean;
-      EXPECT_GT(rms, 0.55) << "beta " << b0 << "/" << b1 << " " << name << " rms z " << rms;
-      EXPECT_LT(rms, 1.45) << "beta " << b0 << "/" << b1 << " " << name << " rms z " << rms;
+      const double mean = sum / seeds, rms = std::sqrt(squares / seeds);
+      EXPECT_LT(std::abs(mean), mean_band) << label << " " << name << " mean z " << mean;
+      // Static holds alone: what the placement bounds (three times the flagged coefficients' size) dominates
+      // some stds, a bound rather than a scatter (rms z 0.04 to 0.13 there): only its upper side is checked.
+      if (label.rfind("static", 0) != 0) {
+        EXPECT_GT(rms, 1.0 - rms_band) << label << " " << name << " rms z " << rms;
+      }
+      EXPECT_LT(rms, 1.0 + rms_band) << label << " " << name << " rms z " << rms;
     }
   }
 }
