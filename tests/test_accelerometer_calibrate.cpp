@@ -23,16 +23,18 @@
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/cli_run.hpp"
+#include "support/sanitized.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
 
+using testing::simulate_and_reduce;
+
 /// The sanitizer build (scripts/test --sanitize) checks memory and undefined behaviour; the statistics are
 /// held by the Release run. Its z-score tests take 40 seeds with a band as wide in units of the sample std's
 /// own spread.
-bool sanitized() {
-  return std::getenv("GYROCAL_SANITIZED") != nullptr;
-}
+using testing::sanitized;
 
 /// A small two-speed accelerometer test: static holds at four gamma, 6 and 12 rad/s, four beta, the default
 /// truth of [accelerometer], the default machine's wobbles plus a lever arm and a main-axis runout. Few
@@ -54,16 +56,6 @@ Scenario accelerometer_scenario(bool noisy) {
   s.errors.main_runout_x_m.terms = {{1, 2e-6, 0.3}};
   s.errors.main_runout_y_m.terms = {{1, 1e-6, 1.1}};
   return s;
-}
-
-/// Simulates `truth` with `seed` and reduces the record as `gyrocal calibrate` does for an accelerometer.
-Reduction simulate_and_reduce(const Scenario& truth, std::uint64_t seed, const ReduceOptions& ro = {}) {
-  const TestSpec plan = reduction_plan(truth.test, SensorKind::kAccelerometer, ro);
-  Reducer reducer(plan, ro, "simulated", truth.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(truth, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  return reducer.finish();
 }
 
 CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,

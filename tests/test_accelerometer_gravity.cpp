@@ -22,9 +22,12 @@
 #include "gyrocal/model/machine_errors.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
+
+using testing::simulate_and_reduce;
 
 /// A small accelerometer test that identifies all eleven coefficients: static holds, 6 and 12 rad/s, the four
 /// quarter beta, the default truth and machine errors of [accelerometer] and [centrifuge.errors], few
@@ -41,16 +44,6 @@ Scenario small_test() {
   s.test.settle_s = 2.0;
   s.test.static_hold_s = 2.0;
   return s;
-}
-
-Reduction simulate_and_reduce(const Scenario& truth, std::uint64_t seed) {
-  const ReduceOptions ro;
-  Reducer reducer(reduction_plan(truth.test, SensorKind::kAccelerometer, ro), ro, "simulated",
-                  truth.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(truth, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  return reducer.finish();
 }
 
 CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,

@@ -20,13 +20,12 @@
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
+#include "support/sanitized.hpp"
 
 namespace gyrocal {
 namespace {
 
-bool sanitized() {
-  return std::getenv("GYROCAL_SANITIZED") != nullptr;
-}
+using testing::sanitized;
 
 /// A small accelerometer test (a static set at four gamma, 6 and 12 rad/s, four beta; 8 revolutions at
 /// 50 Hz), the default truth and machine, white noise `noise_ug_rt_hz`: a record in a few milliseconds.

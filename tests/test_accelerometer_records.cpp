@@ -25,6 +25,7 @@
 #include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "support/cli_run.hpp"
 #include "support/rig_record.hpp"
+#include "support/sanitized.hpp"
 
 namespace gyrocal {
 namespace {
@@ -309,9 +310,7 @@ TEST(AccelerometerRigRecord, ARigsRecordInMillivoltsPerGReadsBackInG) {
   // (The platform's moves between holds and the rest before the test are steady runs that give no dwell.)
 }
 
-bool sanitized() {
-  return std::getenv("GYROCAL_SANITIZED") != nullptr;
-}
+using testing::sanitized;
 
 /// A static accelerometer's output (its input axis up: 1 g) with `noise`, in output units of `k1` per g, at
 /// fs, written as "time,output" rows after `head`.

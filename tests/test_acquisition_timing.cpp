@@ -25,9 +25,12 @@
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "support/cli_run.hpp"
+#include "support/simulated_pipeline.hpp"
 
 namespace gyrocal {
 namespace {
+
+using testing::simulate_and_reduce;
 
 /// 3 counts of a 2^20-count counter encoder, arcsec: the probe's counter zero (issue 28).
 constexpr double kThreeCountsArcsec = 3.0 * 360.0 * 3600.0 / 1048576.0;
@@ -47,17 +50,6 @@ Scenario accelerometer_scenario(bool noisy) {
   s.test.settle_s = 2.0;
   s.test.static_hold_s = 2.0;
   return s;
-}
-
-/// Simulates `truth` with `seed` and reduces the record as `gyrocal calibrate` does for its sensor.
-Reduction simulate_and_reduce(const Scenario& truth, std::uint64_t seed) {
-  const ReduceOptions ro;
-  const TestSpec plan = reduction_plan(truth.test, truth.sensor_kind, ro);
-  Reducer reducer(plan, ro, "simulated", truth.centrifuge.rate_rad_s);
-  SimulationOptions so;
-  so.seed = seed;
-  simulate(truth, so, [&](const RecordSample& sample) { reducer.push(sample); });
-  return reducer.finish();
 }
 
 /// The calibration of `reduction` with the configuration `config` (its machine and delay), estimating

@@ -84,7 +84,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
                             CalibrationResult& r, const ErrorColumns& extra,
                             ErrorColumnsSolution* extra_solution) {
   if (options.sensor != SensorKind::kGyro) {
-    sensor_least_squares(reduction, model_terms, options, r, extra, extra_solution);
+    sensor_least_squares(reduction, model_terms, options, r, extra, extra_solution, &model);
     return;
   }
   const auto m = static_cast<Eigen::Index>(reduction.positions.size());

@@ -214,7 +214,7 @@ std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& ca
   if (!alone.empty()) return fmt::format("Adding {} would identify {}.", join(alone, " or "), them);
   for (std::size_t a = 0; a < candidates.size(); ++a)
     for (std::size_t b = a + 1; b < candidates.size(); ++b) {
-      MatrixXd both(candidates[a].rows.rows() + candidates[b].rows.rows(), kNumGyroCoefficients);
+      MatrixXd both(candidates[a].rows.rows() + candidates[b].rows.rows(), candidates[a].rows.cols());
       both << candidates[a].rows, candidates[b].rows;
       if (directions_identified(both, v) == k)
         return fmt::format("Adding {} together with {} would identify {}.", candidates[a].text,
@@ -228,7 +228,82 @@ std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& ca
   return "No other speed, static set or quarter angle of this machine would identify " + them + ".";
 }
 
+/// Rows of a sensor's nominal design (its regressors at the nominal specific force, sensor axes on the
+/// mount's first, second and third axes) at every (rate, beta, gamma) of the three lists.
+MatrixXd nominal_sensor_rows(const CentrifugeModel& model, const std::vector<double>& rates,
+                             const std::vector<double>& betas, const std::vector<double>& gammas,
+                             const SensorRegressors& regressors) {
+  std::vector<VectorXd> rows;
+  for (double w : rates)
+    for (double b : betas)
+      for (double g : gammas) {
+        const NominalInputs in = nominal_inputs(model.site(), model.geometry().radius_m, w,
+                                                model.geometry().heading_rad, b, g, SeedErrorTerms{});
+        rows.push_back(regressors(Eigen::Vector3d(in.a_I_g, in.a_O_g, in.a_S_g)));
+      }
+  MatrixXd x(static_cast<Index>(rows.size()), rows.empty() ? 0 : rows.front().size());
+  for (std::size_t i = 0; i < rows.size(); ++i) x.row(static_cast<Index>(i)) = rows[i].transpose();
+  return x;
+}
+
 }  // namespace
+
+Eigen::MatrixXd nominal_sensor_design(const std::vector<ReducedPosition>& positions,
+                                      const CentrifugeModel& model, const SensorRegressors& regressors) {
+  MatrixXd x;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const ReducedPosition& p = positions[i];
+    const MatrixXd row = nominal_sensor_rows(model, {p.rate_rad_s}, {p.beta_rad}, {p.gamma_rad}, regressors);
+    if (i == 0) x.resize(static_cast<Index>(positions.size()), row.cols());
+    x.row(static_cast<Index>(i)) = row.row(0);
+  }
+  return x;
+}
+
+std::string sensor_identifiability_advice(const Eigen::MatrixXd& directions,
+                                          const std::vector<ReducedPosition>& positions,
+                                          const CentrifugeModel& model, const SensorRegressors& regressors) {
+  if (directions.cols() == 0) return {};
+  std::vector<double> rates, betas, gammas;
+  for (const ReducedPosition& p : positions) {
+    add_unique(rates, p.rate_rad_s);
+    add_unique(betas, p.beta_rad);
+    add_unique(gammas, p.gamma_rad);
+  }
+  double spin = 0.0;
+  for (double w : rates) spin = std::max(spin, std::abs(w));
+  const bool is_static = std::find(rates.begin(), rates.end(), 0.0) != rates.end();
+  std::vector<Candidate> candidates;
+  // Each quarter beta the plan lacks, alone: the reversal of a beta it has (beta + 180 deg) first.
+  std::vector<Candidate> reversals, others;
+  for (const double deg : {0.0, 90.0, 180.0, 270.0}) {
+    if (has_angle(betas, deg)) continue;
+    const double opposite = std::fmod(deg + 180.0, 360.0);
+    Candidate c{has_angle(betas, opposite)
+                    ? fmt::format("beta = {:g} deg (the reversal of beta = {:g} deg)", deg, opposite)
+                    : fmt::format("beta = {:g} deg", deg),
+                nominal_sensor_rows(model, rates, {deg * kDegToRad}, gammas, regressors)};
+    (has_angle(betas, opposite) ? reversals : others).push_back(std::move(c));
+  }
+  for (Candidate& c : reversals) candidates.push_back(std::move(c));
+  for (Candidate& c : others) candidates.push_back(std::move(c));
+  if (spin > 0.0 && std::count_if(rates.begin(), rates.end(), [](double w) { return w != 0.0; }) < 2) {
+    candidates.push_back({fmt::format("a second speed (another spinning rate, e.g. {:.3g} rad/s)", spin / 2),
+                          nominal_sensor_rows(model, {spin / 2}, betas, gammas, regressors)});
+  } else if (spin == 0.0) {
+    const double w = model.geometry().rate_rad_s != 0.0 ? model.geometry().rate_rad_s : 1.0;
+    candidates.push_back({fmt::format("a spinning rate (the main axis turning, e.g. {:.3g} rad/s)", w),
+                          nominal_sensor_rows(model, {w}, betas, gammas, regressors)});
+  }
+  if (!is_static)
+    candidates.push_back({"a static set (the main axis stopped, the platform indexed to each gamma)",
+                          nominal_sensor_rows(model, {0.0}, betas, gammas, regressors)});
+  if (!(has_angle(gammas, 0) && has_angle(gammas, 90) && has_angle(gammas, 180) && has_angle(gammas, 270)))
+    candidates.push_back(
+        {"gamma at 0, 90, 180 and 270 deg",
+         nominal_sensor_rows(model, rates, betas, {0.0, kPi / 2, kPi, 3 * kPi / 2}, regressors)});
+  return advice_for_drift(directions, candidates);
+}
 
 Eigen::MatrixXd reduced_row_echelon(Eigen::MatrixXd a, const std::vector<Eigen::Index>& order,
                                     double tolerance) {

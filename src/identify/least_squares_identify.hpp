@@ -41,10 +41,12 @@ std::vector<PositionModelTerms> model_terms_for(const Reduction& reduction, cons
 
 /// A sensor's least squares (sensor_least_squares.cpp): the products u of its design rows, then its
 /// coefficients by from_products and the delta method. Extra columns (a self-calibration's machine errors)
-/// follow the products; their solution goes to *extra_solution when given.
+/// follow the products; their solution goes to *extra_solution when given. With `model` (the machine the
+/// record was taken on), a plan's unidentifiable directions come with the extra data that would identify
+/// them.
 void sensor_least_squares(const Reduction& reduction, const std::vector<PositionModelTerms>& model_terms,
                           const CalibrationOptions& options, CalibrationResult& r, const ErrorColumns& extra,
-                          ErrorColumnsSolution* extra_solution);
+                          ErrorColumnsSolution* extra_solution, const CentrifugeModel* model = nullptr);
 
 /// Least squares of the options' sensor into `r` (gyro_least_squares.cpp): the gyro's route, or
 /// sensor_least_squares for any other sensor.

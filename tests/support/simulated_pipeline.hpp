@@ -8,6 +8,7 @@
 
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/identify/model_terms.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -18,10 +19,12 @@ struct Pipeline {
   std::vector<PositionModelTerms> model_terms;
 };
 
-/// Simulates the scenario's test with `seed` (none: the scenario's test.seed) and reduces it with `ro`.
+/// Simulates the scenario's test with `seed` (none: the scenario's test.seed) and reduces it with `ro` on the
+/// plan its sensor's record is reduced with (reduction_plan: the test itself for a gyro; an accelerometer's
+/// spinning dwells at their harmonic content), as `gyrocal calibrate` reduces it.
 inline Reduction simulate_and_reduce(const Scenario& s, std::optional<std::uint64_t> seed,
                                      const ReduceOptions& ro = {}) {
-  Reducer reducer(s.test, ro, "simulated", s.centrifuge.rate_rad_s);
+  Reducer reducer(reduction_plan(s.test, s.sensor_kind, ro), ro, "simulated", s.centrifuge.rate_rad_s);
   SimulationOptions so;
   so.seed = seed;
   simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });

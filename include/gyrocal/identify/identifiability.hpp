@@ -4,6 +4,7 @@
 // direction in a canonical form, the estimable combinations (docs/physics.md section 8's names only where the
 // estimable one IS the named one) and which kind of extra data would identify the rest. docs/calibration.md,
 // "Identifiability".
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,27 @@ CoefficientFit fit_coefficients(const Eigen::MatrixXd& regressors, const Eigen::
                                 const std::vector<ReducedPosition>& positions, const CentrifugeModel& model,
                                 const IdentifiabilityOptions& options,
                                 const std::vector<std::string>& names = {});
+
+/// A sensor's regressors (its design row's entries, in its unknowns' order) at a specific force in g along
+/// its first, second and third axes.
+using SensorRegressors = std::function<Eigen::VectorXd(const Eigen::Vector3d&)>;
+
+/// A sensor's nominal design: one row per position (its regressors at the nominal specific force of its
+/// planned rate, beta and gamma on `model`'s geometry and site, with none of the machine's errors), in its
+/// unknowns' order. Its exact null directions are what the plan itself cannot separate, whatever small part
+/// of them the machine's errors make visible in the exact chain (docs/calibration.md, "An accelerometer's
+/// plan").
+Eigen::MatrixXd nominal_sensor_design(const std::vector<ReducedPosition>& positions,
+                                      const CentrifugeModel& model, const SensorRegressors& regressors);
+
+/// Which extra data would identify a sensor's unidentifiable directions (columns of `directions`, in its
+/// unknowns' units): each is tried on the nominal design of the plan actually run (`positions`) on `model`'s
+/// machine: a quarter beta the plan lacks (the reversal of one it has named so), a second speed, a static
+/// set, the quarter gammas, alone, then in pairs. One sentence ("Adding beta = 180 deg (the reversal of beta
+/// = 0 deg) would identify it."); empty when there is no direction.
+std::string sensor_identifiability_advice(const Eigen::MatrixXd& directions,
+                                          const std::vector<ReducedPosition>& positions,
+                                          const CentrifugeModel& model, const SensorRegressors& regressors);
 
 /// Rows brought to reduced row echelon form with pivots taken in `order` (column indices); each pivot is 1.
 /// A column whose largest remaining entry is at most `tolerance` times the largest entry of `rows` gives no
