@@ -233,6 +233,20 @@ TEST(AccelerometerIdentifiability, PartialBetaSetsStateHonestUncertaintiesOverSe
   }
 }
 
+TEST(AccelerometerIdentifiability, AQuietSensorsRatiosCarryTheScalesBound) {
+  // 0.2 ug/sqrt(Hz) at beta = 0 and 90: the ratios divided by S = K1 (1 - 1e-6 delta_o) are off by 2e-4 of
+  // their value (delta_p 299.94 for 300), far beyond the noise's std (0.004 urad): the bound on S's part
+  // that is not K1 must be in their std (before: z = -15).
+  Scenario s = two_beta(0.0, 90.0);
+  s.accelerometer.noise.velocity_random_walk_ug_rt_hz = 0.2;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const CalibrationResult r = calibrate(s, simulate_and_reduce(s, seed));
+    for (const Stated& q : stated_with_truth(r, s))
+      EXPECT_LT(std::abs(q.value - q.truth), 4.5 * q.std)
+          << "seed " << seed << " " << q.name << " " << q.value << " +- " << q.std << " for " << q.truth;
+  }
+}
+
 TEST(AccelerometerIdentifiability, FourBetaStaysFullRankAndOneSpeedKeepsItsNames) {
   // The reference plan: nothing flagged, no combination; one speed: docs/accelerometer.md's names.
   Scenario s = two_beta(0.0, 90.0);
