@@ -176,12 +176,7 @@ PlanValues plan_values(const std::vector<ReducedPosition>& positions) {
 /// speed, a static set, or the missing quarter angles, alone or in pairs.
 std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& positions,
                        const CentrifugeModel& model) {
-  const PlanValues plan = plan_values(positions);
-  const std::vector<double>& rates = plan.rates;
-  const std::vector<double>& betas = plan.betas;
-  const std::vector<double>& gammas = plan.gammas;
-  const double spin = plan.spin;
-  const bool is_static = plan.is_static;
+  const auto [rates, betas, gammas, spin, is_static] = plan_values(positions);
   std::vector<Candidate> candidates;
   if (spin > 0.0) {
     candidates.push_back({fmt::format("a second speed (another spinning rate, e.g. {:.3g} rad/s)", spin / 2),
@@ -281,12 +276,7 @@ std::string sensor_identifiability_advice(const Eigen::MatrixXd& directions,
                                           const std::vector<ReducedPosition>& positions,
                                           const CentrifugeModel& model, const SensorRegressors& regressors) {
   if (directions.cols() == 0) return {};
-  const PlanValues plan = plan_values(positions);
-  const std::vector<double>& rates = plan.rates;
-  const std::vector<double>& betas = plan.betas;
-  const std::vector<double>& gammas = plan.gammas;
-  const double spin = plan.spin;
-  const bool is_static = plan.is_static;
+  const auto [rates, betas, gammas, spin, is_static] = plan_values(positions);
   std::vector<Candidate> candidates;
   // Each quarter beta the plan lacks, alone: the reversal of a beta it has (beta + 180 deg) first.
   std::vector<Candidate> reversals, others;
