@@ -18,6 +18,7 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/limits.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/sensor/accelerometer.hpp"
 #include "support/cli_run.hpp"
 
@@ -111,6 +112,35 @@ TEST(AccelerometerWords, InitCommentsNameTheAccelerometersAxesAndTheGyrosStayThe
   EXPECT_NE(g.out.find("gyro mounting misalignment about I, O, S"), std::string::npos);
   EXPECT_NE(g.out.find("gyro and encoder sampling rate"), std::string::npos);
   EXPECT_EQ(g.out.find("output_unit"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(AccelerometerWords, APartialPlansScaleCombinationIsInK1sUnit) {
+  // beta = 0 and 90 only: K1 is not identifiable, K1 (1 - 1e-6 delta_o) is. Read through output_scale_per_g =
+  // 2.5 (V), it is 2.5 (1 + 200e-6) = 2.5005 V/g, as K1 would be (before: 1.0002 "g/g").
+  const auto dir = test::fresh_test_folder("awords");
+  Scenario s = small_accelerometer(2.5);
+  s.test.beta_rad = {0.0, kPi / 2};
+  s.errors.radius_error_m = 0.0;
+  const std::string truth = write_file(dir, "truth.toml", scenario_to_toml(s));
+  ASSERT_EQ(test::run_cli("simulate --config " + truth + " --out " + (dir / "a.csv").string(), dir).status,
+            0);
+  const std::string config = write_file(
+      dir, "rig.toml", scenario_to_toml(s) + "\n[record]\noutput_scale_per_g = 2.5\noutput_unit = \"V\"\n");
+  const test::CliOutcome cal = test::run_cli("calibrate " + (dir / "a.csv").string() + " --config " + config +
+                                                 " --json " + (dir / "a.json").string(),
+                                             dir);
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir / "a.json"));
+  bool found = false;
+  for (const nlohmann::json& c : j.at("combinations")) {
+    if (c.at("name") != "K1 (1 - 1e-6 delta_o)") continue;
+    found = true;
+    EXPECT_EQ(c.at("unit"), "V/g");
+    EXPECT_NEAR(c.at("value").get<double>(), 2.5 * (1.0 + 200e-6), 1e-8);
+  }
+  EXPECT_TRUE(found) << j.at("combinations").dump();
+  EXPECT_FALSE(j.at("coefficients").at("K1").at("identifiable").get<bool>());
   std::filesystem::remove_all(dir);
 }
 

@@ -185,6 +185,13 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
     c.value *= scale;
     c.std *= std::abs(scale);
   }
+  // So does an estimable combination that holds K1 where K1 is not identifiable: named "K1 (1 + ...)"
+  // (identify/sensor_least_squares.cpp), in output units per g.
+  for (NamedEstimate& c : result.combinations) {
+    if (c.name.rfind("K1 (", 0) != 0) continue;
+    c.value *= scale;
+    c.std *= std::abs(scale);
+  }
   return result;
 }
 

@@ -152,19 +152,31 @@ struct Candidate {
 
 std::string advice_for_drift(const MatrixXd& v, const std::vector<Candidate>& candidates);
 
+/// The distinct rates, beta and gamma a plan ran (rad/s, rad), its largest |rate| and whether it has a
+/// static set: what the advice tries extra data beside.
+struct PlanValues {
+  std::vector<double> rates, betas, gammas;
+  double spin = 0.0;
+  bool is_static = false;
+};
+
+PlanValues plan_values(const std::vector<ReducedPosition>& positions) {
+  PlanValues out;
+  for (const ReducedPosition& p : positions) {
+    add_unique(out.rates, p.rate_rad_s);
+    add_unique(out.betas, p.beta_rad);
+    add_unique(out.gammas, p.gamma_rad);
+  }
+  for (double w : out.rates) out.spin = std::max(out.spin, std::abs(w));
+  out.is_static = std::find(out.rates.begin(), out.rates.end(), 0.0) != out.rates.end();
+  return out;
+}
+
 /// Which extra data would identify the directions v (parameter units), derived from the plan run: another
 /// speed, a static set, or the missing quarter angles, alone or in pairs.
 std::string advice_for(const MatrixXd& v, const std::vector<ReducedPosition>& positions,
                        const CentrifugeModel& model) {
-  std::vector<double> rates, betas, gammas;
-  for (const ReducedPosition& p : positions) {
-    add_unique(rates, p.rate_rad_s);
-    add_unique(betas, p.beta_rad);
-    add_unique(gammas, p.gamma_rad);
-  }
-  double spin = 0.0;
-  for (double w : rates) spin = std::max(spin, std::abs(w));
-  const bool is_static = std::find(rates.begin(), rates.end(), 0.0) != rates.end();
+  const auto [rates, betas, gammas, spin, is_static] = plan_values(positions);
   std::vector<Candidate> candidates;
   if (spin > 0.0) {
     candidates.push_back({fmt::format("a second speed (another spinning rate, e.g. {:.3g} rad/s)", spin / 2),
@@ -264,15 +276,7 @@ std::string sensor_identifiability_advice(const Eigen::MatrixXd& directions,
                                           const std::vector<ReducedPosition>& positions,
                                           const CentrifugeModel& model, const SensorRegressors& regressors) {
   if (directions.cols() == 0) return {};
-  std::vector<double> rates, betas, gammas;
-  for (const ReducedPosition& p : positions) {
-    add_unique(rates, p.rate_rad_s);
-    add_unique(betas, p.beta_rad);
-    add_unique(gammas, p.gamma_rad);
-  }
-  double spin = 0.0;
-  for (double w : rates) spin = std::max(spin, std::abs(w));
-  const bool is_static = std::find(rates.begin(), rates.end(), 0.0) != rates.end();
+  const auto [rates, betas, gammas, spin, is_static] = plan_values(positions);
   std::vector<Candidate> candidates;
   // Each quarter beta the plan lacks, alone: the reversal of a beta it has (beta + 180 deg) first.
   std::vector<Candidate> reversals, others;

@@ -21,8 +21,9 @@ namespace {
 // ---------------------------------------------------------------------------------------------------------
 // Self-calibration (docs/physics.md section 12; docs/self_calibration.md).
 
-/// A reduced output's change below this (deg/h) for an error's typical magnitude at every position means the
-/// plan does not excite the error: it is the rounding level of the reduced model terms (~1e-10 deg/h).
+/// A reduced output's change below this (deg/h for a gyro, g for an accelerometer: the output's unit as
+/// identified) for an error's typical magnitude at every position means the plan does not excite the error:
+/// it is the rounding level of the reduced model terms (~1e-10 deg/h; 1e-9 g is 0.001 ug).
 constexpr double kMinErrorEffectDegH = 1e-9;
 /// An estimated error whose predicted standard uncertainty exceeds this multiple of its typical magnitude is
 /// not identifiable: the data bound it no better than a hundred times the size such an error has (the same
@@ -237,9 +238,10 @@ CalibrationResult self_calibrate(const Reduction& reduction,
         all_columns.col(static_cast<Eigen::Index>(j)).cwiseAbs().maxCoeff() * typical_in_unit(j);
     if (effect < kMinErrorEffectDegH) {
       estimates[j].reason = fmt::format(
-          "not excited: {} {} of it changes the reduced output by less than {:g} deg/h at every position of "
+          "not excited: {} {} of it changes the reduced output by less than {:g} {} at every position of "
           "this plan.",
-          typical_in_unit(j), estimates[j].unit, kMinErrorEffectDegH);
+          typical_in_unit(j), estimates[j].unit, kMinErrorEffectDegH,
+          options.sensor == SensorKind::kGyro ? "deg/h" : "g (the output read in g)");
       estimates[j].reason += error_advice(ps[j], reduction);
     }
   }

@@ -577,7 +577,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   std::string scale_name;
   if (accelerometer) {
     scale[scale_at] = 1.0;
-    if (!sol.identifiable[static_cast<std::size_t>(scale_at)])
+    if (plan_nulls && !sol.identifiable[static_cast<std::size_t>(scale_at)])
       for (const EstimableCombination& c : estimable)
         if (holds_scale(c.weights.head(nc))) {
           scale = c.weights.head(nc) / c.weights[scale_at];
@@ -601,13 +601,25 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     return out;
   };
   const ParameterEstimates pe = step_back(u);
-  if (!scale_name.empty())
+  // S = K1 (1 + sum_j s_j K_j) differs from K1 by a relative sum_j s_j K_j over coefficients the plan cannot
+  // give: each |K_j| is bounded as with_plan_nulls bounds them, and that relative bound enters the std of
+  // every ratio and combination divided by S (a quiet sensor's delta_p
+  // read 299.94 +- 0.004 urad for 300 without it: -1e-6 delta_o of its value).
+  double scale_relative = 0.0;
+  if (!scale_name.empty()) {
+    // Each K_j of the scale bounded as the placement bounds the products (three times its placed size plus
+    // 100 ug, ug/g^n or urad, in products' units).
+    for (Eigen::Index j = 0; j < nc; ++j)
+      if (j != scale_at)
+        scale_relative += std::abs(scale[j]) * (3.0 * std::abs(u[j]) + 100.0 * std::abs(u[scale_at]));
+    scale_relative /= std::abs(scale.dot(u));
     r.warnings.push_back(fmt::format(
         "K1 is not identifiable from this plan: the other coefficients are stated as their products divided "
-        "by the estimable scale {} = {:.9g} (not by K1), so each is off by that scale's factor against K1 "
-        "(1e-4 per 100 ug, ug/g^n or urad of the coefficients it holds; docs/calibration.md, \"An "
-        "accelerometer's plan\").",
-        scale_name, scale.dot(u)));
+        "by the estimable scale {} (not by K1); the part of it that is not K1 is bounded by the size of the "
+        "coefficients the plan cannot give, {:.2g} relative, and that bound is in each std "
+        "(docs/calibration.md, \"An accelerometer's plan\").",
+        scale_name, scale_relative));
+  }
   const auto np = pe.values.size();
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(np, n);
   for (Eigen::Index j = 0; j < nc; ++j) {
@@ -631,7 +643,10 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     e.identifiable = pe.identifiable[static_cast<std::size_t>(k)];
     if (e.identifiable) {
       e.value = pe.values[k];
-      const double var = plan_nulls ? variance(jacobian.row(k).transpose()) : pe.covariance(k, k);
+      // A ratio to the estimable scale: its relative bound too (scale_relative, 0 when K1 is identifiable).
+      const double bound = k == scale_at ? 0.0 : pe.values[k] * scale_relative;
+      const double var =
+          (plan_nulls ? variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
       e.std = std::sqrt(var) * student(jacobian.row(k).transpose(), e.name);
     }
     r.sensor_coefficients.push_back(std::move(e));
@@ -702,14 +717,18 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
       ne.unit = c.unit;
       Eigen::VectorXd jrow = c.weights;
       if (holds_scale(c.weights.head(nc))) {
-        ne.value = ic.value;  // K1 (1 + ...): a scale, in output units per g
+        // K1 (1 + ...): a scale, in K1's unit (calibrate multiplies it by [record] output_scale_per_g as K1).
+        ne.value = ic.value;
+        ne.unit = scale_factor_unit(options.output_unit);
       } else {
         // c'K = (c'u) / S with S = s'u the scale: J = c / S - (c'u) / S^2 s.
         jrow = c.weights / k1v;
         jrow.head(nc) -= ic.value / (k1v * k1v) * scale;
         ne.value = ic.value / k1v;
       }
-      ne.std = std::sqrt(plan_nulls ? variance(jrow) : jrow.dot(sandwich * jrow)) * student(jrow, c.name);
+      const double bound = holds_scale(c.weights.head(nc)) ? 0.0 : ne.value * scale_relative;
+      ne.std = std::sqrt((plan_nulls ? variance(jrow) : jrow.dot(sandwich * jrow)) + bound * bound) *
+               student(jrow, c.name);
       ne.coefficients.assign(c.weights.data(), c.weights.data() + nc);
       r.combinations.push_back(std::move(ne));
     }
