@@ -4,30 +4,28 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
-#include <Eigen/Cholesky>
 
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/identifiability.hpp"
 #include "gyrocal/identify/unknowns.hpp"
+#include "gyrocal/sensor/gyro_sensor.hpp"
 
 #include "fit_refusals.hpp"
-#include "position_covariance.hpp"
+#include "weighted_positions.hpp"
 
 namespace gyrocal::identify_detail {
 namespace {
 
-/// docs/physics.md section 15: the misalignments' unknowns carry (1 + e) dO and (1 + e) dS; the factor is
-/// divided out here. Then what the plan makes of the rate errors is said, not assumed: dO is excited only by
-/// the Earth rate's horizontal part, e without counter rate offsets only by the Earth rate.
+/// docs/physics.md section 15: what the plan makes of the rate errors is said, not assumed: dO is excited
+/// only by the Earth rate's horizontal part, e without counter rate offsets only by the Earth rate.
 void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
   CoefficientEstimate& e = r.rate_terms[0];
   CoefficientEstimate& d_o = r.rate_terms[1];
   CoefficientEstimate& d_s = r.rate_terms[2];
-  const double e_ppm = e.identifiable ? e.value : 0.0;
-  rate_terms_from_solution(e_ppm, d_o.value, d_s.value, d_o.std, d_s.std);
   bool offsets = false, positive = false, negative = false;
   for (const ReducedPosition& p : reduction.positions) {
     offsets |= p.counter_rate_offset_rad_s != 0.0;
@@ -95,8 +93,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   const auto n = nc + extra.columns.cols();
   std::vector<std::string> names = unknowns.names;
   names.insert(names.end(), extra.names.begin(), extra.names.end());
-  // Generalised least squares: the positions of one dwell are correlated, so rows and observations are
-  // whitened by the Cholesky factor of their covariance and solved with unit (known) weights.
+  // The gyro's design rows: its model terms under the compensation asked for (identify/unknowns.hpp).
   Eigen::MatrixXd design(m, n);
   Eigen::VectorXd observations(m);
   for (Eigen::Index i = 0; i < m; ++i) {
@@ -108,16 +105,12 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     observations[i] = p.mean - ch.omega_deg_h(options.compensation);
   }
   check_finite(reduction, design, observations, model_terms, options.compensation);
-  refuse_repeated_positions(reduction);
-  const Eigen::MatrixXd covariance = position_covariance(reduction, options.min_std_err);
-  // The weights come from the covariance with one level for the whole record (the levels pooled over the
-  // dwells by their degrees of freedom); the uncertainties from each dwell's own level (a sandwich). A few
-  // revolutions measure a dwell's level poorly, and weights that follow those errors favour the dwells whose
-  // noise was underestimated: z-scores of 1.2..1.4 at 3..6 revolutions (docs/calibration.md, "Degrees of
-  // freedom").
-  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, options.min_std_err);
-  const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
-  if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
+  const WeightedPositions w = weigh_positions(
+      reduction, std::move(design), std::move(observations), names, options.min_std_err, options.reduce,
+      "deg/h",
+      fmt::format("an output is at most {:g} deg/h, limits::kOutputMagnitude; [gyro] dF ... dOS at most {:g} "
+                  "deg/h per g^n, limits::kGyroCoefficient",
+                  limits::kOutputMagnitude, limits::kGyroCoefficient));
   IdentifiabilityOptions io;
   io.least_squares = options.least_squares;
   io.least_squares.rank_tolerance =
@@ -126,38 +119,45 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
       std::max(io.least_squares.estimable_tolerance, options.estimable_tolerance);
   io.min_regressor_level = options.min_regressor_level;
   io.named_tolerance = options.estimable_tolerance;
-  const Eigen::MatrixXd whitened_design = llt.matrixL().solve(design);
-  const Eigen::VectorXd whitened_observations = llt.matrixL().solve(observations);
-  refuse_overflowing_weighting(
-      reduction, observations, whitened_observations, "deg/h",
-      fmt::format("an output is at most {:g} deg/h, limits::kOutputMagnitude; [gyro] dF ... dOS at most {:g} "
-                  "deg/h per g^n, limits::kGyroCoefficient",
-                  limits::kOutputMagnitude, limits::kGyroCoefficient));
-  const CoefficientFit fit = fit_coefficients(design.leftCols(nc), whitened_design, whitened_observations,
-                                              r.g_level, reduction.positions, model, io, names);
+  // What the plan leaves unidentifiable, in the gyro's own terms: docs/physics.md section 8's named
+  // combinations and the extra positions that would separate them (identify/identifiability.hpp).
+  const CoefficientFit fit =
+      fit_coefficients(w.design.leftCols(nc), w.whitened.design, w.whitened.observations, r.g_level,
+                       reduction.positions, model, io, names);
   const LeastSquaresSolution& sol = fit.solution;
   r.rank = sol.rank;
   r.unknowns = static_cast<int>(n);
   r.condition_number = sol.effective_condition_number;
   r.chi2 = sol.chi2;
   r.dof = sol.dof;
-  // The estimate is G y with G = cov X~' L^-1 (X~ = L^-1 X, whitened): a combination c'x is the linear
-  // function (G'c)'y of the positions, whose standard uncertainty is widened for the degrees of freedom of
-  // their measured covariance.
-  const Eigen::MatrixXd gain =
-      sol.covariance * whitened_design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
-  const auto sandwich_std = [&](const Eigen::VectorXd& c, const std::string& name) {
-    const Eigen::VectorXd g = gain.transpose() * c;
-    double nu = 0.0;
-    const double factor = student_factor(reduction, covariance, g, &nu);
-    warn_few_dof(nu, name, r);
-    return std::sqrt(g.dot(covariance * g)) * factor;
-  };
+  const PositionSandwich sandwich(reduction, w, sol);
+  // The step back from the products to the coefficients (Gyro::from_products, the delta method on the
+  // sandwich, correlations kept): the identity for the drift coefficients; with drift+rate the misalignments'
+  // unknowns carry (1 + e) dO and (1 + e) dS, and the factor is divided out (docs/physics.md section 15).
+  // Where the plan cannot give e, the factor is taken as 1 (e = 0, no variance), as the gyro model's
+  // misalignments are then stated with the unknowns' values.
+  Gyro gyro;
+  gyro.model = options.gyro_model;
+  Eigen::VectorXd u = sol.estimate.head(nc);
+  Eigen::MatrixXd cu = sandwich.covariance().topLeftCorner(nc, nc);
+  std::vector<bool> identifiable(sol.identifiable.begin(), sol.identifiable.begin() + nc);
+  const auto at_e = static_cast<Eigen::Index>(kNumGyroCoefficients);
+  const bool e_assumed = options.gyro_model == GyroModel::kDriftRate && !identifiable[kNumGyroCoefficients];
+  if (e_assumed) {
+    u[at_e] = 0.0;
+    cu.row(at_e).setZero();
+    cu.col(at_e).setZero();
+    identifiable[kNumGyroCoefficients] = true;
+  }
+  ParameterEstimates pe = gyro.from_products(u, cu, identifiable);
+  if (e_assumed) pe.identifiable[kNumGyroCoefficients] = false;
   for (std::size_t c = 0; c < unknowns.size(); ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
-    if (!sol.identifiable[c]) continue;
+    if (!pe.identifiable[c]) continue;
+    Eigen::VectorXd jrow = Eigen::VectorXd::Zero(n);
+    jrow.head(nc) = pe.jacobian.row(ci).transpose();
     const CoefficientEstimate estimate = {
-        sol.estimate[ci], sandwich_std(Eigen::VectorXd::Unit(n, ci), sol.names[c]), true, {}};
+        pe.values[ci], std::sqrt(pe.covariance(ci, ci)) * sandwich.student(jrow, sol.names[c], r), true, {}};
     if (c < kNumGyroCoefficients)
       r.coefficients[c] = estimate;
     else
@@ -169,33 +169,35 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
     e.std = e.value;
     e.identifiable.assign(static_cast<std::size_t>(k), false);
-    e.covariance = gain * covariance * gain.transpose();
+    e.covariance = sandwich.covariance();
     e.null_space = sol.null_space;
     e.names = sol.names;
     for (Eigen::Index j = 0; j < k; ++j) {
       if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
       e.identifiable[static_cast<std::size_t>(j)] = true;
       e.value[j] = sol.estimate[nc + j];
-      e.std[j] = sandwich_std(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
+      e.std[j] =
+          sandwich.std_of(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)], r);
     }
   }
   if (options.gyro_model == GyroModel::kDriftRate) state_rate_terms(reduction, r);
   // Residuals in deg/h, not in whitened units.
-  const Eigen::VectorXd residuals = observations - design * sol.estimate;
+  const Eigen::VectorXd residuals = w.observations - w.design * sol.estimate;
   r.residuals.clear();
   for (Eigen::Index i = 0; i < m; ++i) r.residuals.push_back(residuals[i]);
-  for (const std::string& w : sol.warnings) {
+  for (const std::string& warning : sol.warnings) {
     // Identifiability is said once, below, in the coefficients' terms.
-    if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
+    if (warning.rfind("Unidentifiable direction", 0) == 0 ||
+        warning.rfind("Not identifiable on their own", 0) == 0)
       continue;
-    r.warnings.push_back("least squares: " + w);
+    r.warnings.push_back("least squares: " + warning);
   }
   if (fit.directions.empty()) return;
   r.unidentifiable = fit.direction_texts;
   r.combinations = fit.combinations;
   // Each combination's uncertainty, like the coefficients', from each dwell's own level (the sandwich).
   for (NamedEstimate& c : r.combinations)
-    c.std = sandwich_std(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), c.name);
+    c.std = sandwich.std_of(Eigen::Map<const Eigen::VectorXd>(c.coefficients.data(), n), c.name, r);
   std::string listed;
   for (std::size_t k = 0; k < fit.direction_texts.size(); ++k)
     listed += fmt::format("{}({}) {}", k ? "; " : "", k + 1, fit.direction_texts[k]);

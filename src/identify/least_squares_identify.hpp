@@ -1,10 +1,12 @@
 #pragma once
-// The two least-squares routes of identification (docs/physics.md section 9): the gyro's
-// (gyro_least_squares.cpp: its 25-column model terms, the unknowns of identify/unknowns.hpp) and a
-// sensor's through its design rows (sensor_least_squares.cpp: the products, then the coefficients by the
-// delta method). Both are generalised least squares on the dwells' covariance with the record's pooled level
-// and a sandwich for the uncertainties; a self-calibration's machine-error columns follow the sensor's
-// unknowns. Internal to src/identify.
+// The two least-squares routes of identification (docs/physics.md section 9), both on the one weighted core
+// of weighted_positions.hpp (generalised least squares on the dwells' covariance with the record's pooled
+// level, a sandwich and Student's factor for the uncertainties) and both stepping back from their products to
+// their coefficients by the sensor's from_products (the delta method, correlations kept): the gyro's
+// (gyro_least_squares.cpp: its model terms under a compensation, the unknowns of identify/unknowns.hpp, the
+// named combinations of docs/physics.md section 8) and any other sensor's (sensor_least_squares.cpp: its
+// design rows, a plan's null directions placed). A self-calibration's machine-error columns follow the
+// sensor's unknowns. Internal to src/identify.
 #include <string>
 #include <vector>
 

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
@@ -20,7 +19,7 @@
 
 #include "fit_refusals.hpp"
 #include "misfit_rule.hpp"
-#include "position_covariance.hpp"
+#include "weighted_positions.hpp"
 
 namespace gyrocal::identify_detail {
 namespace {
@@ -471,7 +470,6 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
                       "machine errors are too large to evaluate.",
                       describe_position(reduction, static_cast<std::size_t>(i))));
   }
-  refuse_repeated_positions(reduction);
   // Values at fewer gammas than the harmonic content (the window mean at [test] gamma_deg): at 0, 90, 180
   // and 270 deg cos^3 = cos, so the third harmonic folds onto the first and K3 is confounded with the scale
   // at each g-level, and the radius with them (docs/accelerometer.md, "Keep the third harmonic").
@@ -493,23 +491,15 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   const double floor = options.min_std_err * (options.sensor == SensorKind::kAccelerometer
                                                   ? accelerometer_output_per_g(reduction, model_terms)
                                                   : 1.0);
-  const Eigen::MatrixXd covariance = position_covariance(reduction, floor);
-  const Eigen::MatrixXd weighting = pooled_position_covariance(reduction, floor);
-  const Eigen::LLT<Eigen::MatrixXd> llt(weighting);
-  if (llt.info() != Eigen::Success) refuse_covariance(reduction, options.reduce);
-  LeastSquaresOptions lso = options.least_squares;
-  lso.rank_tolerance = std::max(lso.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
-  lso.estimable_tolerance = std::max(lso.estimable_tolerance, options.estimable_tolerance);
-  LeastSquaresProblem problem;
-  problem.design = llt.matrixL().solve(design);
-  problem.observations = llt.matrixL().solve(observations);
-  refuse_overflowing_weighting(
-      reduction, observations, problem.observations, "g",
+  const WeightedPositions w = weigh_positions(
+      reduction, std::move(design), std::move(observations), names, floor, options.reduce, "g",
       fmt::format("an output is at most {:g} g, limits::kOutputMagnitude; K0 and K2 ... Koo at most {:g} ug "
                   "per g^n, limits::kAccelerometerCoefficient",
                   limits::kOutputMagnitude, limits::kAccelerometerCoefficient));
-  problem.weights = Eigen::VectorXd::Ones(m);
-  problem.names = names;
+  const LeastSquaresProblem& problem = w.whitened;
+  LeastSquaresOptions lso = options.least_squares;
+  lso.rank_tolerance = std::max(lso.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  lso.estimable_tolerance = std::max(lso.estimable_tolerance, options.estimable_tolerance);
   const bool accelerometer = options.sensor == SensorKind::kAccelerometer;
   const SensorRegressors regressors = [&sensor, nc](const Eigen::Vector3d& f) {
     SensorInputs in;
@@ -536,31 +526,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   r.condition_number = sol.effective_condition_number;
   r.chi2 = sol.chi2;
   r.dof = sol.dof;
-  const Eigen::MatrixXd gain =
-      sol.covariance * problem.design.transpose() * llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
-  Eigen::MatrixXd sandwich = gain * covariance * gain.transpose();
-  if (placement_factor.cols() > 0) sandwich += placement_factor * placement_factor.transpose();
-  // gain' c and c' sandwich c through the covariance's factor (the solver's, with the directions the data
-  // placed), each product taken vector-first: on a plan with null directions the covariance holds entries
-  // of ~1e20 along them, and c' (G C G') c for a c across them cancels to a negative number.
-  const Eigen::MatrixXd& cov_factor = sol.covariance_factor;
-  const auto gain_t = [&](const Eigen::VectorXd& c) -> Eigen::VectorXd {
-    const Eigen::VectorXd cov_c = cov_factor * (cov_factor.transpose() * c);
-    return llt.matrixL().transpose().solve(problem.design * cov_c);
-  };
-  const auto variance = [&](const Eigen::VectorXd& c) {
-    const Eigen::VectorXd g = gain_t(c);
-    double v = g.dot(covariance * g);
-    if (placement_factor.cols() > 0) v += (placement_factor.transpose() * c).squaredNorm();
-    return v;
-  };
-  const auto student = [&](const Eigen::VectorXd& c, const std::string& name) {
-    double nu = 0.0;
-    const double factor = student_factor(reduction, covariance,
-                                         plan_nulls ? gain_t(c) : Eigen::VectorXd(gain.transpose() * c), &nu);
-    warn_few_dof(nu, name, r);
-    return factor;
-  };
+  const PositionSandwich sandwich(reduction, w, sol, std::move(placement_factor), plan_nulls);
   // The products, then the coefficients (delta method): each coefficient's std is sqrt(J C J') widened by the
   // Student factor of its own linear function of the positions, J's row by a central difference of
   // from_products (exact to rounding for the ratios it takes).
@@ -589,7 +555,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
   // identifiable with its product whenever the scale is estimable; K1 itself stays as identifiable as it is.
   Eigen::MatrixXd to_scaled = Eigen::MatrixXd::Identity(nc, nc);
   if (!scale_name.empty()) to_scaled.row(scale_at) = scale.transpose();
-  const Eigen::MatrixXd cu = to_scaled * sandwich.topLeftCorner(nc, nc) * to_scaled.transpose();
+  const Eigen::MatrixXd cu = to_scaled * sandwich.covariance().topLeftCorner(nc, nc) * to_scaled.transpose();
   std::vector<bool> identifiable(static_cast<std::size_t>(nc));
   for (Eigen::Index j = 0; j < nc; ++j)
     identifiable[static_cast<std::size_t>(j)] = sol.identifiable[static_cast<std::size_t>(j)];
@@ -646,8 +612,8 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
       // A ratio to the estimable scale: its relative bound too (scale_relative, 0 when K1 is identifiable).
       const double bound = k == scale_at ? 0.0 : pe.values[k] * scale_relative;
       const double var =
-          (plan_nulls ? variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
-      e.std = std::sqrt(var) * student(jacobian.row(k).transpose(), e.name);
+          (plan_nulls ? sandwich.variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
+      e.std = std::sqrt(var) * sandwich.student(jacobian.row(k).transpose(), e.name, r);
     }
     r.sensor_coefficients.push_back(std::move(e));
   }
@@ -657,7 +623,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
     e.std = e.value;
     e.identifiable.assign(static_cast<std::size_t>(k), false);
-    e.covariance = sandwich;
+    e.covariance = sandwich.covariance();
     e.null_space = sol.null_space;
     e.names = sol.names;
     for (Eigen::Index j = 0; j < k; ++j) {
@@ -665,8 +631,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
       e.identifiable[static_cast<std::size_t>(j)] = true;
       e.value[j] = sol.estimate[nc + j];
       e.std[j] =
-          std::sqrt(plan_nulls ? variance(Eigen::VectorXd::Unit(n, nc + j)) : sandwich(nc + j, nc + j)) *
-          student(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)]);
+          sandwich.std_of(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)], r);
     }
   }
   // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
@@ -681,13 +646,14 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     r.chi2 = full.chi2;
     r.dof = full.dof;
   }
-  const Eigen::VectorXd residuals = observations - design * fitted;
+  const Eigen::VectorXd residuals = w.observations - w.design * fitted;
   r.residuals.assign(residuals.data(), residuals.data() + residuals.size());
-  for (const std::string& w : sol.warnings) {
-    if (w.rfind("Unidentifiable direction", 0) == 0 || w.rfind("Not identifiable on their own", 0) == 0)
+  for (const std::string& warning : sol.warnings) {
+    if (warning.rfind("Unidentifiable direction", 0) == 0 ||
+        warning.rfind("Not identifiable on their own", 0) == 0)
       continue;
-    if (sol.null_space.cols() > 0 && w.rfind("chi2 = ", 0) == 0) continue;  // the truncated fit's
-    r.warnings.push_back("least squares: " + w);
+    if (sol.null_space.cols() > 0 && warning.rfind("chi2 = ", 0) == 0) continue;  // the truncated fit's
+    r.warnings.push_back("least squares: " + warning);
   }
   if (sol.null_space.cols() == 0) return;
   std::vector<std::string> coefficient_names;
@@ -727,8 +693,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
         ne.value = ic.value / k1v;
       }
       const double bound = holds_scale(c.weights.head(nc)) ? 0.0 : ne.value * scale_relative;
-      ne.std = std::sqrt((plan_nulls ? variance(jrow) : jrow.dot(sandwich * jrow)) + bound * bound) *
-               student(jrow, c.name);
+      ne.std = std::sqrt(sandwich.variance(jrow) + bound * bound) * sandwich.student(jrow, c.name, r);
       ne.coefficients.assign(c.weights.data(), c.weights.data() + nc);
       r.combinations.push_back(std::move(ne));
     }

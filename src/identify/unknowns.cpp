@@ -33,15 +33,6 @@ std::vector<double> design_row(const PositionModelTerms& ch, Compensation compen
   return row;
 }
 
-void rate_terms_from_solution(double e_ppm, double& misalignment_O_arcsec, double& misalignment_S_arcsec,
-                              double& std_O_arcsec, double& std_S_arcsec) {
-  const double scale = 1.0 + e_ppm * 1e-6;
-  misalignment_O_arcsec /= scale;
-  misalignment_S_arcsec /= scale;
-  std_O_arcsec /= scale;
-  std_S_arcsec /= scale;
-}
-
 std::string to_string(GyroModel m) {
   return m == GyroModel::kDrift ? "drift" : "drift+rate";
 }

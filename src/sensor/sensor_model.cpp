@@ -11,6 +11,7 @@ ParameterEstimates propagate(Eigen::VectorXd values, const Eigen::MatrixXd& jaco
   ParameterEstimates e;
   e.values = std::move(values);
   e.covariance = jacobian * product_covariance * jacobian.transpose();
+  e.jacobian = jacobian;
   e.identifiable = std::move(identifiable);
   e.std.resize(e.values.size());
   for (Eigen::Index k = 0; k < e.values.size(); ++k) {

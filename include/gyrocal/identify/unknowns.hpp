@@ -27,14 +27,10 @@ Unknowns least_squares_unknowns(GyroModel gyro_model);
 /// One design row at a reduced position (deg/h per unit of each unknown): eq. 6's regressors of the
 /// compensation, then with drift+rate omega_I * 1e-6 (per ppm of e), omega_O and omega_S * 1 arcsec in rad
 /// (per arcsec of the misalignments; docs/physics.md section 15). The misalignments' columns carry (1 + e)
-/// dO and (1 + e) dS, so that the model is linear: rate_terms_from_solution() divides the (1 + e) out.
+/// dO and (1 + e) dS, so that the model is linear: Gyro::from_products divides the (1 + e) out (the delta
+/// method, correlations kept).
 std::vector<double> design_row(const PositionModelTerms& model_terms, Compensation compensation,
                                const Unknowns& unknowns);
-
-/// The identified rate errors from the solved unknowns x (size of unknowns): e, then dO = x_O / (1 + e) and
-/// dS = x_S / (1 + e) (the products e dO, e dS exact, not dropped). Their standard uncertainties scale alike.
-void rate_terms_from_solution(double e_ppm, double& misalignment_O_arcsec, double& misalignment_S_arcsec,
-                              double& std_O_arcsec, double& std_S_arcsec);
 
 /// "drift" or "drift+rate", as on the command line; parse refuses anything else (Error naming it).
 std::string to_string(GyroModel m);

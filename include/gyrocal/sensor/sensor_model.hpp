@@ -50,6 +50,7 @@ struct DesignRow {
 struct ParameterEstimates {
   Eigen::VectorXd values;          ///< in the table's units
   Eigen::MatrixXd covariance;      ///< delta method: J C_u J'; meaningful for identifiable entries
+  Eigen::MatrixXd jacobian;        ///< J = d(values)/du, parameters x products
   Eigen::VectorXd std;             ///< sqrt of the diagonal; +inf where not identifiable
   std::vector<bool> identifiable;  ///< the parameter follows from identifiable products only
 };
