@@ -53,7 +53,7 @@ std::map<std::string, double> simulated_calibration(const Scenario& truth, const
   const CalibrationResult c =
       identify(r, reduce_sensor_model_terms(r, model, o.reduce, told.sensor()), model, o);
   std::map<std::string, double> out;
-  for (const SensorCoefficientEstimate& e : c.sensor_coefficients)
+  for (const CoefficientEstimate& e : c.coefficients)
     if (e.identifiable) out[e.name] = e.value;
   return out;
 }

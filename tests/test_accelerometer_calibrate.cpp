@@ -97,10 +97,10 @@ TEST(AccelerometerCalibration, SpinningDwellsKeepTheirWholeHarmonicContent) {
 TEST(AccelerometerCalibration, NoiseFreeRecordGivesTheElevenCoefficients) {
   const Scenario s = accelerometer_scenario(false);
   const CalibrationResult r = calibrate(s, simulate_and_reduce(s, 1));
-  ASSERT_EQ(r.sensor_coefficients.size(), kNumAccelCoefficients);
+  ASSERT_EQ(r.coefficients.size(), kNumAccelCoefficients);
   EXPECT_EQ(r.rank, 11);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+    const CoefficientEstimate& c = r.coefficients[k];
     EXPECT_EQ(c.name, kAccelerometerParameters[k].name);
     ASSERT_TRUE(c.identifiable) << c.name;
     EXPECT_NEAR(c.value, truth_of(s, k), k == 1 ? 1e-9 : 1e-4) << c.name;
@@ -110,8 +110,8 @@ TEST(AccelerometerCalibration, NoiseFreeRecordGivesTheElevenCoefficients) {
   scaled.accelerometer.coefficients[AccelCoefficient::K1] = 2.5;
   const CalibrationResult r2 = calibrate(scaled, simulate_and_reduce(scaled, 1));
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r2.sensor_coefficients[k].value, truth_of(scaled, k), k == 1 ? 1e-9 : 1e-4)
-        << r2.sensor_coefficients[k].name;
+    EXPECT_NEAR(r2.coefficients[k].value, truth_of(scaled, k), k == 1 ? 1e-9 : 1e-4)
+        << r2.coefficients[k].name;
 }
 
 TEST(AccelerometerCalibration, NoisyZScoresHaveUnitSpread) {
@@ -128,7 +128,7 @@ TEST(AccelerometerCalibration, NoisyZScoresHaveUnitSpread) {
   for (int seed = 1; seed <= seeds; ++seed) {
     const CalibrationResult r = calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed)));
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-      const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+      const CoefficientEstimate& c = r.coefficients[k];
       ASSERT_TRUE(c.identifiable) << c.name;
       z[k].push_back((c.value - truth_of(s, k)) / c.std);
     }
@@ -154,7 +154,7 @@ TEST(AccelerometerCalibration, OneSpeedNamesK0K2KppKooUnidentifiable) {
   s.test.rates_rad_s = {12.0};
   s.centrifuge.rate_rad_s = 12.0;
   const CalibrationResult r = calibrate(s, simulate_and_reduce(s, 3));
-  const auto& c = r.sensor_coefficients;
+  const auto& c = r.coefficients;
   for (AccelCoefficient k :
        {AccelCoefficient::K0, AccelCoefficient::K2, AccelCoefficient::Kpp, AccelCoefficient::Koo})
     EXPECT_FALSE(c[static_cast<std::size_t>(k)].identifiable) << c[static_cast<std::size_t>(k)].name;
@@ -192,8 +192,8 @@ TEST(AccelerometerCalibration, EstimatesTheRadiusErrorAndStretch) {
   EXPECT_NEAR(r.machine_errors[0].value, 30e-6, 1e-10);
   EXPECT_NEAR(r.machine_errors[1].value, 2e-7, 1e-12);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.sensor_coefficients[k].value, truth_of(truth, k), k == 1 ? 1e-9 : 1e-4)
-        << r.sensor_coefficients[k].name;
+    EXPECT_NEAR(r.coefficients[k].value, truth_of(truth, k), k == 1 ? 1e-9 : 1e-4)
+        << r.coefficients[k].name;
   // Noisy: the radius error within a few of its std (about 2 um on this short test).
   Scenario noisy = truth;
   noisy.accelerometer.noise = Accelerometer::default_noise();
@@ -248,12 +248,12 @@ TEST(AccelerometerPlan, PredictsTheStdOfARecordsCalibrationAndNamesTheOneSpeedDi
   o.sensor = SensorKind::kAccelerometer;
   const CalibrationResult plan = predict_calibration(s, o);
   const CalibrationResult record = calibrate(s, simulate_and_reduce(s, 11));
-  ASSERT_EQ(plan.sensor_coefficients.size(), kNumAccelCoefficients);
+  ASSERT_EQ(plan.coefficients.size(), kNumAccelCoefficients);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& p = plan.sensor_coefficients[k];
+    const CoefficientEstimate& p = plan.coefficients[k];
     ASSERT_TRUE(p.identifiable) << p.name;
     EXPECT_NEAR(p.value, truth_of(s, k), k == 1 ? 1e-9 : 1e-4) << p.name;
-    EXPECT_NEAR(p.std / record.sensor_coefficients[k].std, 1.0, 0.25) << p.name;
+    EXPECT_NEAR(p.std / record.coefficients[k].std, 1.0, 0.25) << p.name;
   }
   // One speed: the four named, as calibrate names them.
   Scenario one = s;
@@ -262,7 +262,7 @@ TEST(AccelerometerPlan, PredictsTheStdOfARecordsCalibrationAndNamesTheOneSpeedDi
   const CalibrationResult p1 = predict_calibration(one, o);
   for (AccelCoefficient k :
        {AccelCoefficient::K0, AccelCoefficient::K2, AccelCoefficient::Kpp, AccelCoefficient::Koo})
-    EXPECT_FALSE(p1.sensor_coefficients[static_cast<std::size_t>(k)].identifiable);
+    EXPECT_FALSE(p1.coefficients[static_cast<std::size_t>(k)].identifiable);
   ASSERT_EQ(p1.unidentifiable.size(), 1u);
   EXPECT_NE(p1.unidentifiable[0].find("K0, K2, Kpp, Koo"), std::string::npos);
   // Values at four gamma (the window mean): the aliasing of K3 onto the scale is said.
@@ -293,7 +293,7 @@ TEST(AccelerometerPlan, CountsTheBiasInstabilityAsTheSimulatedRecordsScatterShow
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const CalibrationResult r = calibrate(s, simulate_and_reduce(s, static_cast<std::uint64_t>(seed)));
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-      const double e = r.sensor_coefficients[k].value - truth_of(s, k);
+      const double e = r.coefficients[k].value - truth_of(s, k);
       sum[k] += e;
       sum2[k] += e * e;
     }
@@ -301,12 +301,12 @@ TEST(AccelerometerPlan, CountsTheBiasInstabilityAsTheSimulatedRecordsScatterShow
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
     const double mean = sum[k] / kSeeds;
     const double spread = std::sqrt((sum2[k] - kSeeds * mean * mean) / (kSeeds - 1));
-    const SensorCoefficientEstimate& p = plan.sensor_coefficients[k];
+    const CoefficientEstimate& p = plan.coefficients[k];
     EXPECT_NEAR(spread / p.std, 1.0, 0.45) << p.name << ": spread " << spread << ", plan " << p.std
-                                           << ", white only " << plan_white.sensor_coefficients[k].std;
+                                           << ", white only " << plan_white.coefficients[k].std;
   }
   const std::size_t k0 = static_cast<std::size_t>(AccelCoefficient::K0);
-  EXPECT_GT(plan.sensor_coefficients[k0].std, 2.0 * plan_white.sensor_coefficients[k0].std);
+  EXPECT_GT(plan.coefficients[k0].std, 2.0 * plan_white.coefficients[k0].std);
 }
 
 TEST(AccelerometerCalibration, TheGyrosRoutesAreRefusedNamingTheOption) {

@@ -64,7 +64,7 @@ CalibrationResult plan(const Scenario& s) {
 
 std::set<std::string> flagged(const CalibrationResult& r) {
   std::set<std::string> out;
-  for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+  for (const CoefficientEstimate& c : r.coefficients)
     if (!c.identifiable) out.insert(c.name);
   return out;
 }
@@ -119,8 +119,8 @@ void check_partial_beta_set(const Scenario& s, const std::set<std::string>& expe
     EXPECT_LT(std::abs(c.value - truth_of(c, s)), 4.5 * c.std)
         << c.name << " " << c.value << " +- " << c.std << ", truth " << truth_of(c, s);
   }
-  for (std::size_t k = 0; k < r.sensor_coefficients.size(); ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+  for (std::size_t k = 0; k < r.coefficients.size(); ++k) {
+    const CoefficientEstimate& c = r.coefficients[k];
     if (!c.identifiable) continue;
     const double t = s.accelerometer.coefficients.values[k];
     EXPECT_LT(std::abs(c.value - t), 4.5 * c.std)
@@ -173,8 +173,8 @@ struct Stated {
 
 std::vector<Stated> stated_with_truth(const CalibrationResult& r, const Scenario& s) {
   std::vector<Stated> out;
-  for (std::size_t k = 0; k < r.sensor_coefficients.size(); ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+  for (std::size_t k = 0; k < r.coefficients.size(); ++k) {
+    const CoefficientEstimate& c = r.coefficients[k];
     if (c.identifiable) out.push_back({c.name, c.value, c.std, s.accelerometer.coefficients.values[k]});
   }
   for (const NamedEstimate& c : r.combinations) out.push_back({c.name, c.value, c.std, truth_of(c, s)});

@@ -79,8 +79,8 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
   try {
     out.result = identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.sensor()), model, o);
     // K1 in the record's units, as calibrate_record states it.
-    out.result.sensor_coefficients[1].value *= scale;
-    out.result.sensor_coefficients[1].std *= std::abs(scale);
+    out.result.coefficients[1].value *= scale;
+    out.result.coefficients[1].std *= std::abs(scale);
   } catch (const Error& e) {
     out.refused = true;
     out.message = e.what();
@@ -103,7 +103,7 @@ std::string warnings_of(const CalibrationResult& r) {
 double worst_z(const Scenario& truth, const CalibrationResult& r, double k1_factor = 1.0) {
   double worst = 0.0;
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+    const CoefficientEstimate& c = r.coefficients[k];
     const double t = truth.accelerometer.coefficients.values[k] * (k == 1 ? k1_factor : 1.0);
     worst = std::max(worst, std::abs(c.value - t) / c.std);
   }
@@ -163,14 +163,14 @@ TEST(AccelerometerMisfit, TheVerdictAndTheStdDoNotDependOnTheUnitTheOutputIsRead
       EXPECT_NEAR(other.result.misfit.p_value, in_g.result.misfit.p_value, 1e-6);
       EXPECT_NEAR(other.result.misfit.scale, in_g.result.misfit.scale, 1e-6);
       for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-        const SensorCoefficientEstimate& a = in_g.result.sensor_coefficients[k];
-        const SensorCoefficientEstimate& b = other.result.sensor_coefficients[k];
+        const CoefficientEstimate& a = in_g.result.coefficients[k];
+        const CoefficientEstimate& b = other.result.coefficients[k];
         EXPECT_NEAR((b.std / std::abs(b.value)) / (a.std / std::abs(a.value)), 1.0, 1e-6) << a.name;
         if (k != 1) {
           EXPECT_NEAR(b.value, a.value, 1e-6 * a.std) << a.name;
         }
       }
-      EXPECT_NEAR(other.result.sensor_coefficients[1].value / in_g.result.sensor_coefficients[1].value,
+      EXPECT_NEAR(other.result.coefficients[1].value / in_g.result.coefficients[1].value,
                   volts_per_g, 1e-9 * volts_per_g);
     }
   }
@@ -352,8 +352,8 @@ TEST(AccelerometerPlausibility, AUnitAndAnInvertedChannelAreWarnedAboutAndChange
     for (const std::string& part : c.says) EXPECT_TRUE(has(w, part)) << c.name << ": " << w;
     // Every coefficient but K1 is a ratio to K1: the unit and the sign change none.
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-      const SensorCoefficientEstimate& a = upright.result.sensor_coefficients[k];
-      const SensorCoefficientEstimate& b = out.result.sensor_coefficients[k];
+      const CoefficientEstimate& a = upright.result.coefficients[k];
+      const CoefficientEstimate& b = out.result.coefficients[k];
       if (k == 1) {
         EXPECT_NEAR(b.value, c.factor * a.value, 1e-9 * std::abs(c.factor)) << c.name;
       } else {

@@ -125,15 +125,15 @@ TEST_F(AccelerometerRig, NoiseFreeRecordGivesAllElevenAndK1InTheRigsMillivoltsPe
   const fs::path path = dir_ / "rig.csv";
   write_rig_record(path, s, exactly_modelled(counts), 1, counts);
   const CalibrationResult r = calibrate_rig(path, s, counts);
-  ASSERT_EQ(r.sensor_coefficients.size(), kNumAccelCoefficients);
+  ASSERT_EQ(r.coefficients.size(), kNumAccelCoefficients);
   EXPECT_EQ(r.rank, 11);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+    const CoefficientEstimate& c = r.coefficients[k];
     ASSERT_TRUE(c.identifiable) << c.name;
     std::printf("%s: %.12g (truth %.12g)\n", c.name.c_str(), c.value, s.accelerometer.coefficients.values[k]);
     EXPECT_NEAR(c.value, s.accelerometer.coefficients.values[k], noise_free_tolerance(k)) << c.name;
   }
-  EXPECT_NEAR(r.sensor_coefficients[1].value, kTrueMilliVoltPerG, 1e-9 * kTrueMilliVoltPerG);
+  EXPECT_NEAR(r.coefficients[1].value, kTrueMilliVoltPerG, 1e-9 * kTrueMilliVoltPerG);
 
   // The radius error from the sensor: the truth's arm 30 um long, the configuration's nominal; through the
   // command line (calibrate --estimate radius_error --json).
@@ -192,7 +192,7 @@ ZScores z_scores(const fs::path& dir, double ripple, int seeds) {
     write_rig_record(path, truth, imp, static_cast<std::uint64_t>(seed), counts);
     const CalibrationResult r = calibrate_rig(path, config, counts, {"radius_error"});
     for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-      const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+      const CoefficientEstimate& c = r.coefficients[k];
       EXPECT_TRUE(c.identifiable) << c.name;
       out.z[k].push_back((c.value - truth.accelerometer.coefficients.values[k]) / c.std);
       out.std[k].push_back(c.std);
@@ -249,7 +249,7 @@ void expect_rippled_record_recovered(const fs::path& dir, const Scenario& s, dou
     EXPECT_NEAR(clean.machine_errors[0].value, 30e-6, 1e-9);
   }
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = clean.sensor_coefficients[k];
+    const CoefficientEstimate& c = clean.coefficients[k];
     ASSERT_TRUE(c.identifiable) << c.name;
     std::printf("noise-free rippled, %d revolutions at %g Hz, %s: error %.3g (std %.3g)\n",
                 s.test.revolutions, s.test.sample_rate_hz, c.name.c_str(),

@@ -69,9 +69,9 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
 /// Each accelerometer coefficient within `z_max` of its standard uncertainty of the truth.
 void expect_coefficients_within(const CalibrationResult& r, const Scenario& truth, double z_max,
                                 const std::string& what) {
-  ASSERT_EQ(r.sensor_coefficients.size(), kNumAccelCoefficients);
+  ASSERT_EQ(r.coefficients.size(), kNumAccelCoefficients);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
+    const CoefficientEstimate& c = r.coefficients[k];
     ASSERT_TRUE(c.identifiable) << what << " " << c.name;
     const double z = (c.value - truth.accelerometer.coefficients.values[k]) / c.std;
     EXPECT_LT(std::abs(z), z_max) << what << " " << c.name << " " << c.value << " +- " << c.std;
@@ -152,23 +152,23 @@ TEST(AcquisitionTiming, ANoiseFreeDelayedRecordGivesTheDelayAndTheCoefficients) 
   EXPECT_EQ(e.unit, "s");
   EXPECT_NEAR(e.value, 20e-6, 1e-12);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.sensor_coefficients[k].value, truth.accelerometer.coefficients.values[k],
+    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k],
                 k == 1 ? 1e-9 : 1e-4)
-        << r.sensor_coefficients[k].name;
+        << r.coefficients[k].name;
   // The delay given as known gives the same.
   Scenario known = config;
   known.errors.output_delay_s = 20e-6;
   const CalibrationResult k = calibrate(known, reduction);
   for (std::size_t c = 0; c < kNumAccelCoefficients; ++c)
-    EXPECT_NEAR(k.sensor_coefficients[c].value, truth.accelerometer.coefficients.values[c],
+    EXPECT_NEAR(k.coefficients[c].value, truth.accelerometer.coefficients.values[c],
                 c == 1 ? 1e-9 : 1e-4)
-        << k.sensor_coefficients[c].name;
+        << k.coefficients[c].name;
   // Unknown and not estimated, it moves the quadrature's coefficients by far more than that.
   const CalibrationResult ignored = calibrate(config, reduction);
   double largest = 0.0;
   for (std::size_t c = 0; c < kNumAccelCoefficients; ++c)
     largest = std::max(
-        largest, std::abs(ignored.sensor_coefficients[c].value - truth.accelerometer.coefficients.values[c]));
+        largest, std::abs(ignored.coefficients[c].value - truth.accelerometer.coefficients.values[c]));
   EXPECT_GT(largest, 1.0);
 }
 
@@ -200,9 +200,9 @@ TEST(AcquisitionTiming, AKnownDelayGivesTheCoefficientsOfARecordWithoutOne) {
   const Scenario plain = accelerometer_scenario(true);
   const CalibrationResult a = calibrate(delayed, simulate_and_reduce(delayed, 7));
   const CalibrationResult b = calibrate(plain, simulate_and_reduce(plain, 7));
-  ASSERT_EQ(a.sensor_coefficients.size(), kNumAccelCoefficients);
+  ASSERT_EQ(a.coefficients.size(), kNumAccelCoefficients);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k) {
-    const SensorCoefficientEstimate &x = a.sensor_coefficients[k], &y = b.sensor_coefficients[k];
+    const CoefficientEstimate &x = a.coefficients[k], &y = b.coefficients[k];
     EXPECT_LT(std::abs(x.value - y.value), 0.01 * y.std) << x.name << " " << x.value << " " << y.value;
     EXPECT_NEAR(x.std, y.std, 1e-3 * y.std) << x.name;
   }
@@ -247,9 +247,9 @@ TEST(AcquisitionTiming, ACounterEncoderZeroOffByThreeCountsIsEstimated) {
   EXPECT_EQ(e.unit, "arcsec");
   EXPECT_NEAR(e.value, -kThreeCountsArcsec, 1e-6);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.sensor_coefficients[k].value, truth.accelerometer.coefficients.values[k],
+    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k],
                 k == 1 ? 1e-9 : 1e-4)
-        << r.sensor_coefficients[k].name;
+        << r.coefficients[k].name;
   // Noisy, with the delay estimated beside it: both within 3 std, the coefficients within 4.5.
   Scenario noisy = truth;
   noisy.accelerometer.noise = Accelerometer::default_noise();

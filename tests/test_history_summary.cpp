@@ -318,7 +318,7 @@ CalibrationResult calibrate_accelerometer(const Scenario& config, const Scenario
 /// The run a history keeps of a calibration result: its coefficients, filled by hand.
 history::Run run_of(const CalibrationResult& r, std::int64_t id, const std::string& date) {
   history::Run run = make_run(id, date, {}, {}, "accelerometer");
-  for (const SensorCoefficientEstimate& c : r.sensor_coefficients) {
+  for (const CoefficientEstimate& c : r.coefficients) {
     CoefficientValue v{"accelerometer", c.name, std::nullopt, std::nullopt, c.unit, c.identifiable};
     if (c.identifiable) v.value = c.value, v.std = c.std;
     run.coefficients.push_back(v);

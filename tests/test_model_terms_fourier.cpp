@@ -215,13 +215,13 @@ TEST(FourierChannels, AnAccelerometersDesignRowsEqualTheEverySampleOnesWithinThe
   o.sensor = SensorKind::kAccelerometer;
   const CalibrationResult cf = identify(r, fourier, s.model(), o);
   const CalibrationResult ce = identify(r, every, s.model(), o);
-  ASSERT_EQ(cf.sensor_coefficients.size(), s.accelerometer.coefficients.values.size());
-  ASSERT_EQ(ce.sensor_coefficients.size(), cf.sensor_coefficients.size());
-  for (std::size_t k = 0; k < cf.sensor_coefficients.size(); ++k) {
-    const double x = cf.sensor_coefficients[k].value;
-    EXPECT_NEAR(x, ce.sensor_coefficients[k].value, k == 1 ? 1e-12 : 1e-6) << cf.sensor_coefficients[k].name;
+  ASSERT_EQ(cf.coefficients.size(), s.accelerometer.coefficients.values.size());
+  ASSERT_EQ(ce.coefficients.size(), cf.coefficients.size());
+  for (std::size_t k = 0; k < cf.coefficients.size(); ++k) {
+    const double x = cf.coefficients[k].value;
+    EXPECT_NEAR(x, ce.coefficients[k].value, k == 1 ? 1e-12 : 1e-6) << cf.coefficients[k].name;
     EXPECT_NEAR(x, s.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4)
-        << cf.sensor_coefficients[k].name;
+        << cf.coefficients[k].name;
   }
 }
 

@@ -207,14 +207,14 @@ TEST(RatePlatformCalibrate, NoiseFreeRecoversScaleFactorMisalignmentsAndTheDrift
     ASSERT_TRUE(r.coefficients[k].identifiable) << kCoefficientNames[k];
     EXPECT_NEAR(r.coefficients[k].value, s.gyro.values[k], 1e-7) << kCoefficientNames[k];
   }
-  ASSERT_TRUE(r.rate_terms[0].identifiable);
-  ASSERT_TRUE(r.rate_terms[2].identifiable);
-  EXPECT_NEAR(r.rate_terms[0].value, 150.0, 1e-3);
-  EXPECT_NEAR(r.rate_terms[2].value, 40.0, 1e-3);
+  ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable);
+  ASSERT_TRUE(r.coefficients[kNumGyroCoefficients + 2].identifiable);
+  EXPECT_NEAR(r.coefficients[kNumGyroCoefficients].value, 150.0, 1e-3);
+  EXPECT_NEAR(r.coefficients[kNumGyroCoefficients + 2].value, 40.0, 1e-3);
   // dO: only the Earth rate's horizontal part reaches it; noise-free it still comes out, within far less than
   // the ~10 arcsec a noisy record leaves it.
-  if (r.rate_terms[1].identifiable) {
-    EXPECT_NEAR(r.rate_terms[1].value, -25.0, 0.1);
+  if (r.coefficients[kNumGyroCoefficients + 1].identifiable) {
+    EXPECT_NEAR(r.coefficients[kNumGyroCoefficients + 1].value, -25.0, 0.1);
   }
   EXPECT_TRUE(has_warning(r, "input_axis_misalignment_O_arcsec"));
   // The drift model alone cannot explain the scale factor: its residuals are far beyond the scatter at the
@@ -252,9 +252,9 @@ TEST(RatePlatformCalibrate, UncertaintiesOfScaleFactorAndMisalignmentTowardSAreH
     CalibrationOptions o;
     o.gyro_model = GyroModel::kDriftRate;
     const CalibrationResult r = identify(reducer.finish(), model_terms, s.model(), o);
-    ASSERT_TRUE(r.rate_terms[0].identifiable && r.rate_terms[2].identifiable);
-    z_e.push_back((r.rate_terms[0].value - 150.0) / r.rate_terms[0].std);
-    z_s.push_back((r.rate_terms[2].value - 40.0) / r.rate_terms[2].std);
+    ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable && r.coefficients[kNumGyroCoefficients + 2].identifiable);
+    z_e.push_back((r.coefficients[kNumGyroCoefficients].value - 150.0) / r.coefficients[kNumGyroCoefficients].std);
+    z_s.push_back((r.coefficients[kNumGyroCoefficients + 2].value - 40.0) / r.coefficients[kNumGyroCoefficients + 2].std);
   }
   for (const auto& [name, z] : {std::make_pair("e", z_e), std::make_pair("dS", z_s)}) {
     double mean = 0, var = 0;
@@ -281,8 +281,8 @@ TEST(RatePlatformCalibrate, ARateTableAloneGivesTheScaleFactorAndTheBias) {
   s.test.settle_s = 1.0;
   const Pipeline p = run(s);
   const CalibrationResult r = identify_with(s, p, GyroModel::kDriftRate);
-  ASSERT_TRUE(r.rate_terms[0].identifiable);
-  EXPECT_NEAR(r.rate_terms[0].value, 150.0, 1e-3);
+  ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable);
+  EXPECT_NEAR(r.coefficients[kNumGyroCoefficients].value, 150.0, 1e-3);
   // At 1 g with I vertical, dF and dII only appear together (a_I^2 = 1): the bias comes as dF + dII (and dSS,
   // dOO where the machine's tilts leave them unexcited), whose truth is the combination applied to the truth.
   const auto& dF = r.coefficients[static_cast<std::size_t>(Coefficient::dF)];
@@ -324,15 +324,15 @@ TEST(RatePlatformPlan, PlanStatesThePredictedUncertaintyOfTheScaleFactorWithAndW
   const CalibrationResult with = predict_calibration(s, o);
   s.test.counter_rate_offsets_rad_s = {0.0};
   const CalibrationResult without = predict_calibration(s, o);
-  ASSERT_TRUE(with.rate_terms[0].identifiable);
+  ASSERT_TRUE(with.coefficients[kNumGyroCoefficients].identifiable);
   // Offsets of 0.25 rad/s put 0.25 rad/s on I or S, the Earth rate at most 7e-5 rad/s: e's uncertainty
   // shrinks by orders of magnitude (more than 100 here), and plan says why it is large without them.
-  EXPECT_GT(without.rate_terms[0].std, 100.0 * with.rate_terms[0].std);
+  EXPECT_GT(without.coefficients[kNumGyroCoefficients].std, 100.0 * with.coefficients[kNumGyroCoefficients].std);
   EXPECT_TRUE(has_warning(without, "barely identifiable"));
   EXPECT_FALSE(has_warning(with, "barely identifiable"));
   // dO is weak either way, and said so with its uncertainty.
   EXPECT_TRUE(has_warning(with, "input_axis_misalignment_O_arcsec"));
-  EXPECT_GT(with.rate_terms[1].std, 100.0 * with.rate_terms[2].std);
+  EXPECT_GT(with.coefficients[kNumGyroCoefficients + 1].std, 100.0 * with.coefficients[kNumGyroCoefficients + 2].std);
 }
 
 TEST(RatePlatformCalibrate, ClosedFormUsesTheSixteenPositionsAtOffsetZeroAndSaysWhatItLeftOut) {

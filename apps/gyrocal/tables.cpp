@@ -48,20 +48,15 @@ std::string format_value_std(double value, double std_dev) {
 std::string result_table(const CalibrationResult& r) {
   std::string out = r.BriefReport() + "\n\n";
   out += fmt::format("{:<16} {:>30}  {}\n", "coefficient", "estimate ± std", "unit");
-  // A sensor other than the gyro: its table (an accelerometer's K0 .. delta_o).
-  for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
-    out +=
-        fmt::format("{:<16} {:>30}  {}\n", c.name, value_std(c.identifiable ? c.value : NAN, c.std), c.unit);
-  for (std::size_t k = 0; k < kNumGyroCoefficients && r.sensor == SensorKind::kGyro; ++k)
-    out += fmt::format("{:<16} {:>30}  {}\n", kCoefficientNames[k],
-                       value_std(r.coefficients[k].value, r.coefficients[k].std), kCoefficientUnits[k]);
-  if (r.gyro_model == GyroModel::kDriftRate) {  // docs/physics.md section 15
-    out += "\nrate errors (gyro model drift+rate)\n";
-    for (std::size_t k = 0; k < kNumRateTerms; ++k)
-      out += fmt::format(
-          "{:<34} {:>30}  {}\n", kRateTermNames[k],
-          value_std(r.rate_terms[k].identifiable ? r.rate_terms[k].value : NAN, r.rate_terms[k].std),
-          kRateTermUnits[k]);
+  // The sensor's table (the gyro's dF .. dOS, an accelerometer's K0 .. delta_o); the gyro's rate errors of
+  // drift+rate under their own heading (docs/physics.md section 15).
+  const bool rate_errors = r.sensor == SensorKind::kGyro && r.gyro_model == GyroModel::kDriftRate;
+  for (std::size_t k = 0; k < r.coefficients.size(); ++k) {
+    const CoefficientEstimate& c = r.coefficients[k];
+    if (rate_errors && k == kNumGyroCoefficients) out += "\nrate errors (gyro model drift+rate)\n";
+    const int width = rate_errors && k >= kNumGyroCoefficients ? 34 : 16;
+    out += fmt::format("{:<{}} {:>30}  {}\n", c.name, width, value_std(c.identifiable ? c.value : NAN, c.std),
+                       c.unit);
   }
   if (!r.combinations.empty()) {
     out += "\nidentifiable combinations\n";
@@ -145,7 +140,7 @@ std::string sensor_comparison_table(const std::vector<std::string>& labels,
                        k < truth.size() ? truth[k] : NAN);
     for (const CalibrationResult& r : results) {
       std::string cell = "—";
-      for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+      for (const CoefficientEstimate& c : r.coefficients)
         if (c.name == parameters[k].name && c.identifiable) cell = format_value_std(c.value, c.std);
       out += fmt::format("{:>{}}", cell, kWidth);
     }

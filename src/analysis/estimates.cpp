@@ -1,5 +1,6 @@
 #include "gyrocal/analysis/estimates.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -17,40 +18,30 @@ std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Sc
   std::vector<double> table_truth;
   if (r.sensor == SensorKind::kGyro) {
     table_truth.assign(truth.gyro.values.begin(), truth.gyro.values.end());
-    for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
-      if (r.coefficients[k].identifiable)
-        out.push_back({std::string(kCoefficientNames[k]), std::string(kCoefficientUnits[k]),
-                       r.coefficients[k].value, r.coefficients[k].std, truth.gyro.values[k]});
-    // docs/physics.md section 15: the rate errors, in ppm and arcsec, where the plan identifies them.
-    if (r.gyro_model == GyroModel::kDriftRate) {
-      const double rate_truths[kNumRateTerms] = {truth.gyro_rate.scale_factor_error_ppm,
-                                                 truth.gyro_rate.input_axis_misalignment_O_arcsec,
-                                                 truth.gyro_rate.input_axis_misalignment_S_arcsec};
-      for (std::size_t k = 0; k < kNumRateTerms; ++k)
-        if (r.rate_terms[k].identifiable)
-          out.push_back({std::string(kRateTermNames[k]), std::string(kRateTermUnits[k]),
-                         r.rate_terms[k].value, r.rate_terms[k].std, rate_truths[k]});
-    }
-    if (r.method == Method::kClosedForm) {
-      // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
-      const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
-                                                        {"dO_1g", Coefficient::dO},
-                                                        {"dS_1g", Coefficient::dS},
-                                                        {"dIS_b", Coefficient::dIS}};
-      for (const NamedEstimate& e : r.alternatives)
-        for (const auto& [n, c] : of)
-          if (e.name == n) out.push_back({e.name, e.unit, e.value, e.std, truth.gyro[c]});
-    }
+    // docs/physics.md section 15: the rate errors, in ppm and arcsec, where the gyro model identifies them.
+    for (double v : {truth.gyro_rate.scale_factor_error_ppm, truth.gyro_rate.input_axis_misalignment_O_arcsec,
+                     truth.gyro_rate.input_axis_misalignment_S_arcsec})
+      table_truth.push_back(v);
   } else {
-    // A sensor other than the gyro: its table (CalibrationResult::sensor_coefficients) and its truth.
     const Sensor sensor = truth.sensor();
     if (const auto* a = std::get_if<Accelerometer>(&sensor))
       table_truth.assign(a->coefficients.values.begin(), a->coefficients.values.end());
-    table_truth.resize(r.sensor_coefficients.size(), 0.0);
-    for (std::size_t k = 0; k < r.sensor_coefficients.size(); ++k) {
-      const SensorCoefficientEstimate& c = r.sensor_coefficients[k];
-      if (c.identifiable) out.push_back({c.name, c.unit, c.value, c.std, table_truth[k]});
-    }
+  }
+  // The sensor's identifiable coefficients, by its table (CalibrationResult::coefficients), with their truth.
+  table_truth.resize(std::max(table_truth.size(), r.coefficients.size()), 0.0);
+  for (std::size_t k = 0; k < r.coefficients.size(); ++k) {
+    const CoefficientEstimate& c = r.coefficients[k];
+    if (c.identifiable) out.push_back({c.name, c.unit, c.value, c.std, table_truth[k]});
+  }
+  if (r.sensor == SensorKind::kGyro && r.method == Method::kClosedForm) {
+    // The 1 g forms estimate the same coefficients as the primary ones (docs/physics.md section 8).
+    const std::pair<const char*, Coefficient> of[] = {{"dI_1g", Coefficient::dI},
+                                                      {"dO_1g", Coefficient::dO},
+                                                      {"dS_1g", Coefficient::dS},
+                                                      {"dIS_b", Coefficient::dIS}};
+    for (const NamedEstimate& e : r.alternatives)
+      for (const auto& [n, c] : of)
+        if (e.name == n) out.push_back({e.name, e.unit, e.value, e.std, truth.gyro[c]});
   }
   for (const NamedEstimate& e : r.combinations) {
     double t = 0.0;

@@ -169,19 +169,20 @@ MonteCarloModel prepare_monte_carlo(const Scenario& scenario, const MonteCarloOp
   };
   const CalibrationResult configured = identify_at(Eigen::VectorXd::Zero(np));
   m.bias = estimate_errors(configured, scenario, m.names, &m.units, &m.truth, &m.stated_std);
-  // docs/physics.md section 15: a rate error the plan cannot identify has no distribution; it is said why.
-  if (configured.gyro_model == GyroModel::kDriftRate)
-    for (std::size_t k = 0; k < kNumRateTerms; ++k)
-      if (!configured.rate_terms[k].identifiable)
-        m.not_identifiable.emplace_back(std::string(kRateTermNames[k]), configured.rate_terms[k].reason);
-  // An accelerometer's coefficient the plan cannot identify (one speed: K0, K2, Kpp, Koo) has no
-  // distribution; the combinations that remain are among the estimates.
-  for (const SensorCoefficientEstimate& c : configured.sensor_coefficients)
-    if (!c.identifiable)
+  // A coefficient the plan cannot identify has no distribution; it is said why: the gyro's rate errors carry
+  // their reason (docs/physics.md section 15), an accelerometer's (one speed: K0, K2, Kpp, Koo) the
+  // combinations that remain, which are among the estimates. A gyro's drift coefficient is named through
+  // its combinations.
+  for (const CoefficientEstimate& c : configured.coefficients) {
+    if (c.identifiable) continue;
+    if (!c.reason.empty())
+      m.not_identifiable.emplace_back(c.name, c.reason);
+    else if (configured.sensor != SensorKind::kGyro)
       m.not_identifiable.emplace_back(
           c.name,
           "the plan does not identify it; the combinations that remain are estimated "
           "(docs/accelerometer.md, \"Test design\").");
+  }
   // Compensation "self" (docs/self_calibration.md): a machine error the plan cannot estimate stays at zero in
   // every trial, and its effect moves the estimates (their mean error); it is named with the reason, never
   // left to a mean error nobody explains.

@@ -591,16 +591,12 @@ void count_whole_noise(CalibrationResult& result, const Reduction& r,
   std::vector<double*> stds;
   std::vector<double> base;
   std::vector<std::function<double(const CalibrationResult&)>> value_of;
-  for (std::size_t c = 0; c < kNumGyroCoefficients && result.sensor == SensorKind::kGyro; ++c)
+  // The sensor's coefficients (the gyro's dF .. dOS and with drift+rate its rate errors, an accelerometer's
+  // K0 .. delta_o).
+  for (std::size_t c = 0; c < result.coefficients.size(); ++c)
     if (result.coefficients[c].identifiable) {
       stds.push_back(&result.coefficients[c].std);
       value_of.push_back([c](const CalibrationResult& e) { return e.coefficients[c].value; });
-    }
-  // A sensor other than the gyro: its coefficients (an accelerometer's K0 .. delta_o).
-  for (std::size_t c = 0; c < result.sensor_coefficients.size(); ++c)
-    if (result.sensor_coefficients[c].identifiable) {
-      stds.push_back(&result.sensor_coefficients[c].std);
-      value_of.push_back([c](const CalibrationResult& e) { return e.sensor_coefficients[c].value; });
     }
   for (auto* list : {&result.combinations, &result.alternatives})
     for (NamedEstimate& est : *list) {

@@ -212,7 +212,7 @@ SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const Sensi
     result.least_squares_noise_std[e.name] = e.std;
     result.units[e.name] = e.unit;
   }
-  for (const SensorCoefficientEstimate& c : runs[0][1].sensor_coefficients)
+  for (const CoefficientEstimate& c : runs[0][1].coefficients)
     if (!c.identifiable)
       result.not_identifiable[c.name] =
           "the plan does not identify it; the combinations that remain are studied (docs/accelerometer.md, "
@@ -330,12 +330,12 @@ SensitivityResult sensitivity_study(const Scenario& scenario, const SensitivityO
     for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
       result.units[std::string(kCoefficientNames[k])] = std::string(kCoefficientUnits[k]);
     if (result.gyro_model == GyroModel::kDriftRate)
-      for (std::size_t k = 0; k < kNumRateTerms; ++k) {
+      for (std::size_t k = 0; k < kNumRateTerms; ++k)
         result.units[std::string(kRateTermNames[k])] = std::string(kRateTermUnits[k]);
-        // What the plan cannot identify is said with its reason (least squares' base case).
-        if (m == 1 && !r0.rate_terms[k].identifiable)
-          result.not_identifiable[std::string(kRateTermNames[k])] = r0.rate_terms[k].reason;
-      }
+    // What the plan cannot identify of the gyro's rate errors is said with its reason (least squares' base
+    // case).
+    for (const CoefficientEstimate& c : r0.coefficients)
+      if (m == 1 && !c.identifiable && !c.reason.empty()) result.not_identifiable[c.name] = c.reason;
     for (const NamedEstimate& e : r0.alternatives) result.units[e.name] = e.unit;
     for (const NamedEstimate& e : r0.combinations) result.units[e.name] = e.unit;
   }

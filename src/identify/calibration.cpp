@@ -7,6 +7,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
@@ -76,6 +78,7 @@ CalibrationResult identify(const Reduction& record_reduction,
   r.compensation = options.compensation;
   r.gyro_model = options.gyro_model;
   r.sensor = options.sensor;
+  r.coefficients = unestimated_coefficients(options);
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
   r.data_quality.rows_read = reduction.samples_read;
@@ -180,8 +183,8 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
   // output_scale_per_g (output units per g) has its scale factor in those units: K1 = scale x the fitted
   // ratio (docs/contract.md); the other coefficients are ratios to K1 and do not change.
   const double scale = output_scale_per_g(layout);
-  for (SensorCoefficientEstimate& c : result.sensor_coefficients) {
-    if (c.name != "K1") continue;
+  for (CoefficientEstimate& c : result.coefficients) {
+    if (options.sensor != SensorKind::kAccelerometer || c.name != "K1") continue;
     c.value *= scale;
     c.std *= std::abs(scale);
   }
@@ -193,6 +196,25 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
     c.std *= std::abs(scale);
   }
   return result;
+}
+
+const CoefficientEstimate* CalibrationResult::coefficient(std::string_view name) const {
+  for (const CoefficientEstimate& c : coefficients)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+std::vector<CoefficientEstimate> unestimated_coefficients(const CalibrationOptions& options) {
+  const Sensor sensor = identify_detail::sensor_of(options);
+  std::vector<CoefficientEstimate> out;
+  for (const SensorParameter& p : std::visit([](const auto& s) { return s.parameters(); }, sensor)) {
+    if (!p.identified) continue;
+    CoefficientEstimate c;
+    c.name = std::string(p.name);
+    c.unit = std::string(p.unit);
+    out.push_back(std::move(c));
+  }
+  return out;
 }
 
 std::string CalibrationResult::BriefReport() const {

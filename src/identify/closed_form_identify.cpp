@@ -80,9 +80,15 @@ void closed_form_identify(const Reduction& reduction, const std::vector<Position
     warn_few_dof(nu, f.name, r);
     return f.std(se) * factor;
   };
+  if (r.coefficients.size() < kNumGyroCoefficients) r.coefficients = unestimated_coefficients(options);
   for (const LinearForm& f : cf.primary) {
     for (std::size_t c = 0; c < kNumGyroCoefficients; ++c)
-      if (kCoefficientNames[c] == f.name) r.coefficients[c] = {f.value(w), std_of(f), true, {}};
+      if (kCoefficientNames[c] == f.name) {
+        CoefficientEstimate& e = r.coefficients[c];
+        e.value = f.value(w);
+        e.std = std_of(f);
+        e.identifiable = true;
+      }
   }
   for (const LinearForm& f : cf.alternatives)
     r.alternatives.push_back({f.name, f.unit, f.value(w), std_of(f), {}});

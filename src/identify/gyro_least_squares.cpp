@@ -23,9 +23,9 @@ namespace {
 /// docs/physics.md section 15: what the plan makes of the rate errors is said, not assumed: dO is excited
 /// only by the Earth rate's horizontal part, e without counter rate offsets only by the Earth rate.
 void state_rate_terms(const Reduction& reduction, CalibrationResult& r) {
-  CoefficientEstimate& e = r.rate_terms[0];
-  CoefficientEstimate& d_o = r.rate_terms[1];
-  CoefficientEstimate& d_s = r.rate_terms[2];
+  CoefficientEstimate& e = r.coefficients.at(kNumGyroCoefficients);
+  CoefficientEstimate& d_o = r.coefficients.at(kNumGyroCoefficients + 1);
+  CoefficientEstimate& d_s = r.coefficients.at(kNumGyroCoefficients + 2);
   bool offsets = false, positive = false, negative = false;
   for (const ReducedPosition& p : reduction.positions) {
     offsets |= p.counter_rate_offset_rad_s != 0.0;
@@ -151,17 +151,20 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   }
   ParameterEstimates pe = gyro.from_products(u, cu, identifiable);
   if (e_assumed) pe.identifiable[kNumGyroCoefficients] = false;
+  // The products as solved, 0 where not identifiable (what a self-calibration takes the errors' columns at).
+  r.products.assign(static_cast<std::size_t>(nc), 0.0);
+  for (Eigen::Index c = 0; c < nc; ++c)
+    if (sol.identifiable[static_cast<std::size_t>(c)]) r.products[static_cast<std::size_t>(c)] = sol.estimate[c];
+  if (r.coefficients.size() != unknowns.size()) r.coefficients = unestimated_coefficients(options);
   for (std::size_t c = 0; c < unknowns.size(); ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
     if (!pe.identifiable[c]) continue;
     Eigen::VectorXd jrow = Eigen::VectorXd::Zero(n);
     jrow.head(nc) = pe.jacobian.row(ci).transpose();
-    const CoefficientEstimate estimate = {
-        pe.values[ci], std::sqrt(pe.covariance(ci, ci)) * sandwich.student(jrow, sol.names[c], r), true, {}};
-    if (c < kNumGyroCoefficients)
-      r.coefficients[c] = estimate;
-    else
-      r.rate_terms[c - kNumGyroCoefficients] = estimate;
+    CoefficientEstimate& estimate = r.coefficients.at(c);
+    estimate.value = pe.values[ci];
+    estimate.std = std::sqrt(pe.covariance(ci, ci)) * sandwich.student(jrow, sol.names[c], r);
+    estimate.identifiable = true;
   }
   if (extra_solution != nullptr) {
     ErrorColumnsSolution& e = *extra_solution;

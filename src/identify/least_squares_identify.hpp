@@ -35,6 +35,13 @@ struct ErrorColumnsSolution {
 /// The sensor value whose design rows identification takes (sensor_least_squares.cpp): the design row and the
 /// step back from the products do not depend on the sensor's configured truth, so the default one serves.
 Sensor sensor_of(SensorKind kind);
+/// The same with the options' gyro model (which unknowns a gyro's design row and step back hold).
+Sensor sensor_of(const CalibrationOptions& options);
+
+/// One reduced position's design row for the options' sensor (sensor_least_squares.cpp), in its output unit:
+/// the gyro's model terms under the options' compensation (the unknowns of identify/unknowns.hpp), any other
+/// sensor's reduced design row. What the self-calibration differentiates and every route fits.
+DesignRow position_design_row(const PositionModelTerms& model_terms, const CalibrationOptions& options);
 
 /// The model terms of the options' sensor, reduced by the operator of the record's output
 /// (calibration.cpp).

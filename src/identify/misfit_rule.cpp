@@ -49,19 +49,17 @@ CalibrationResult plain_fit(const Reduction& reduction, const std::vector<Positi
 /// otherwise. Beyond means by far: a weakly identified e (no counter rate offsets) may wander that far with
 /// a std to match, and is no sign of a mistake.
 double gross_scale_factor_error(const CalibrationResult& r, const CalibrationOptions& options) {
-  const CoefficientEstimate& e = r.rate_terms[0];
-  if (options.gyro_model != GyroModel::kDriftRate || !e.identifiable) return 0.0;
-  const double limit = std::max(options.misfit.max_scale_factor_error_ppm, 10.0 * e.std);
-  return std::abs(e.value) > limit ? e.value : 0.0;
+  const CoefficientEstimate* e = r.coefficient(kRateTermNames[0]);
+  if (options.gyro_model != GyroModel::kDriftRate || e == nullptr || !e->identifiable) return 0.0;
+  const double limit = std::max(options.misfit.max_scale_factor_error_ppm, 10.0 * e->std);
+  return std::abs(e->value) > limit ? e->value : 0.0;
 }
 
 void scale_every_std(CalibrationResult& r, double scale) {
   for (CoefficientEstimate& c : r.coefficients) c.std *= scale;
-  for (CoefficientEstimate& c : r.rate_terms) c.std *= scale;
   for (NamedEstimate& c : r.combinations) c.std *= scale;
   for (NamedEstimate& c : r.alternatives) c.std *= scale;
   for (MachineErrorEstimate& e : r.machine_errors) e.std *= scale;
-  for (SensorCoefficientEstimate& c : r.sensor_coefficients) c.std *= scale;
 }
 
 /// The sentence that states a misfit: chi2 against its distribution, or a scale-factor error no gyro has.
@@ -329,7 +327,7 @@ std::string refuse_a_cause_the_data_fit(const Reduction& reduction,
     // Then the data: static holds that do not read +-K1 g.
     try {
       const CalibrationResult plain = plain_fit(reduction, model_terms, model, options, g_level);
-      const SensorCoefficientEstimate& k1 = plain.sensor_coefficients.at(1);
+      const CoefficientEstimate& k1 = plain.coefficients.at(1);
       const std::string statics =
           k1.identifiable ? static_holds_cause(reduction, model_terms, options, k1.value) : std::string();
       if (!statics.empty()) throw Error(fmt::format("calibration refused: {}. {}.", stated, statics));
@@ -450,8 +448,8 @@ double noise_free_level(const Reduction& reduction, const std::vector<PositionMo
 
 void refuse_insignificant_k1(const CalibrationOptions& options, const CalibrationResult& r) {
   const auto k1_at = static_cast<std::size_t>(AccelCoefficient::K1);
-  if (r.sensor_coefficients.size() <= k1_at) return;
-  const SensorCoefficientEstimate& k1 = r.sensor_coefficients[k1_at];
+  if (r.coefficients.size() <= k1_at) return;
+  const CoefficientEstimate& k1 = r.coefficients[k1_at];
   if (!k1.identifiable || !std::isfinite(k1.value) || !std::isfinite(k1.std)) return;
   // K1 as the reduction holds it is the ratio of the record's scale to the configured one.
   const double scale = options.output.scale;
@@ -472,8 +470,8 @@ void check_accelerometer_after_misfit(const Reduction& reduction,
                                       const std::vector<PositionModelTerms>& model_terms,
                                       const CalibrationOptions& options, CalibrationResult& r) {
   const auto k1_at = static_cast<std::size_t>(AccelCoefficient::K1);
-  if (r.sensor_coefficients.size() <= k1_at) return;
-  const SensorCoefficientEstimate& k1 = r.sensor_coefficients[k1_at];
+  if (r.coefficients.size() <= k1_at) return;
+  const CoefficientEstimate& k1 = r.coefficients[k1_at];
   if (!k1.identifiable || !std::isfinite(k1.value) || !std::isfinite(k1.std)) return;
   const double scale = options.output.scale;
   const std::string key = "[record] " + accelerometer_scale_key(options.output);

@@ -29,7 +29,7 @@ std::optional<Reduction> residual_levels(const Reduction& reduction,
   first.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   sensor_least_squares(reduction, model_terms, options, first, ErrorColumns{}, nullptr, &model);
-  const std::vector<double>& u = first.sensor_products;
+  const std::vector<double>& u = first.products;
   Reduction out = reduction;
   std::vector<std::vector<std::size_t>> slots(out.dwells.size());  // per dwell and gamma slot: its position
   for (std::size_t i = 0; i < out.positions.size(); ++i) {

@@ -24,7 +24,7 @@ namespace {
 /// A reduced output's change below this (deg/h for a gyro, g for an accelerometer: the output's unit as
 /// identified) for an error's typical magnitude at every position means the plan does not excite the error:
 /// it is the rounding level of the reduced model terms (~1e-10 deg/h; 1e-9 g is 0.001 ug).
-constexpr double kMinErrorEffectDegH = 1e-9;
+constexpr double kMinErrorEffect = 1e-9;
 /// An estimated error whose predicted standard uncertainty exceeds this multiple of its typical magnitude is
 /// not identifiable: the data bound it no better than a hundred times the size such an error has (the same
 /// judgement as LeastSquaresOptions::max_relative_std).
@@ -33,9 +33,8 @@ constexpr double kMaxErrorStdOverTypical = 100.0;
 /// The covariance of (the sensor's coefficients, the estimated errors) from that of (its products, the
 /// errors), `cov` with the `nc` products first: the delta method with the Jacobian of from_products by
 /// central differences (exact to rounding for the ratios it takes), the errors' block unchanged.
-Eigen::MatrixXd coefficient_error_covariance(SensorKind kind, const std::vector<double>& products,
+Eigen::MatrixXd coefficient_error_covariance(const Sensor& sensor, const std::vector<double>& products,
                                              const Eigen::MatrixXd& cov, Eigen::Index nc) {
-  const Sensor sensor = sensor_of(kind);
   const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(products.data(), nc);
   const Eigen::MatrixXd cu = cov.topLeftCorner(nc, nc);
   const std::vector<bool> all(static_cast<std::size_t>(nc), true);
@@ -64,7 +63,8 @@ CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<Mach
 }
 
 /// The columns of the parameters `which` (indices into ps): the derivative of each reduced model output,
-/// omega_I + sum_j c_j x_j, with respect to the error, in deg/h per the error's unit, by a central difference
+/// known + sum_j c_j x_j (the gyro's omega_I + its regressors), with respect to the error, in the output's
+/// unit per the error's unit, by a central difference
 /// of the reduced exact model terms (the same reduction operator as the data) with the error's typical
 /// magnitude as the step: omega_I and the regressors are smooth in a machine error of that size (their
 /// curvature is of relative order 1e-5 per arcsec), so the difference's truncation error is ~1e-11 relative,
@@ -84,19 +84,11 @@ Eigen::MatrixXd error_columns(const Reduction& reduction, const CentrifugeModel&
     const auto up = model_terms_for(reduction, with_errors(model, ps, plus), options);
     const auto down = model_terms_for(reduction, with_errors(model, ps, minus), options);
     for (Eigen::Index i = 0; i < m; ++i) {
-      const PositionModelTerms& u = up[static_cast<std::size_t>(i)];
-      const PositionModelTerms& d = down[static_cast<std::size_t>(i)];
-      double diff = 0.0;
-      if (options.sensor == SensorKind::kGyro) {
-        diff = u.omega_exact_deg_h - d.omega_exact_deg_h;
-        for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)
-          diff += c[k] * (u.regressors_exact[k] - d.regressors_exact[k]);
-      } else {
-        // The sensor's reduced output at the products c: known + sum_j c_j r_j.
-        diff = u.sensor_exact.known - d.sensor_exact.known;
-        for (std::size_t k = 0; k < u.sensor_exact.size; ++k)
-          diff += c[k] * (u.sensor_exact.regressors[k] - d.sensor_exact.regressors[k]);
-      }
+      // The sensor's reduced output at the products c: known + sum_j c_j r_j.
+      const DesignRow ru = position_design_row(up[static_cast<std::size_t>(i)], options);
+      const DesignRow rd = position_design_row(down[static_cast<std::size_t>(i)], options);
+      double diff = ru.known - rd.known;
+      for (std::size_t k = 0; k < ru.size; ++k) diff += c[k] * (ru.regressors[k] - rd.regressors[k]);
       out(i, static_cast<Eigen::Index>(a)) = diff / (2.0 * h) * f.unit_to_si;
     }
   }
@@ -194,24 +186,26 @@ CalibrationResult self_calibrate(const Reduction& reduction,
             : std::numeric_limits<double>::quiet_NaN();
     e.reason.clear();
   }
-  // The unknowns the errors' columns follow: the gyro model's (identify/unknowns.hpp) or the sensor's
-  // products.
-  const std::size_t unknowns_count =
-      options.sensor == SensorKind::kGyro
-          ? least_squares_unknowns(options.gyro_model).size()
-          : std::visit([](const auto& s) { return s.num_unknowns(); }, sensor_of(options.sensor));
-  const std::vector<double> zero(std::max(unknowns_count, kNumGyroCoefficients), 0.0);
+  // The unknowns the errors' columns follow: the sensor's products (the gyro model's unknowns,
+  // identify/unknowns.hpp).
+  const Sensor sensor = sensor_of(options);
+  const std::size_t unknowns_count = std::visit([](const auto& s) { return s.num_unknowns(); }, sensor);
+  // The products the errors' columns are first taken at. Where the model's known part carries the output
+  // (a gyro's: the rate omega_I, against which its coefficients are small), zero products; where the output
+  // is all in the products (no known part: an accelerometer's K1 a_i ...), zero products would leave every
+  // column zero, and a plain fit at the configured machine gives them.
+  std::vector<double> start(unknowns_count, 0.0);
+  const bool output_in_products =
+      std::all_of(model_terms.begin(), model_terms.end(),
+                  [&](const PositionModelTerms& t) { return position_design_row(t, options).known == 0.0; });
+  if (output_in_products) {
+    CalibrationResult plain = base;
+    least_squares_identify(reduction, model_terms, model, options, plain);
+    std::copy(plain.products.begin(), plain.products.end(), start.begin());
+  }
   Eigen::MatrixXd all_columns = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(reduction.positions.size()),
                                                       static_cast<Eigen::Index>(k));
   {
-    // A sensor's output is all in its products (an accelerometer has no known part): its errors' columns
-    // start from the products of a plain fit at the configured machine, the gyro's from zero coefficients.
-    std::vector<double> start = zero;
-    if (options.sensor != SensorKind::kGyro) {
-      CalibrationResult plain = base;
-      least_squares_identify(reduction, model_terms, model, options, plain);
-      std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), start.begin());
-    }
     const Eigen::MatrixXd cols = error_columns(reduction, model, ps, configured, active, start, options);
     for (std::size_t a = 0; a < active.size(); ++a)
       all_columns.col(static_cast<Eigen::Index>(active[a])) = cols.col(static_cast<Eigen::Index>(a));
@@ -236,12 +230,12 @@ CalibrationResult self_calibrate(const Reduction& reduction,
   for (std::size_t j : active) {
     const double effect =
         all_columns.col(static_cast<Eigen::Index>(j)).cwiseAbs().maxCoeff() * typical_in_unit(j);
-    if (effect < kMinErrorEffectDegH) {
+    if (effect < kMinErrorEffect) {
       estimates[j].reason = fmt::format(
           "not excited: {} {} of it changes the reduced output by less than {:g} {} at every position of "
           "this plan.",
-          typical_in_unit(j), estimates[j].unit, kMinErrorEffectDegH,
-          options.sensor == SensorKind::kGyro ? "deg/h" : "g (the output read in g)");
+          typical_in_unit(j), estimates[j].unit, kMinErrorEffect,
+          std::visit([](const auto& s) { return s.output_unit; }, sensor));
       estimates[j].reason += error_advice(ps[j], reduction);
     }
   }
@@ -297,12 +291,7 @@ CalibrationResult self_calibrate(const Reduction& reduction,
   // Gauss-Newton on the exact model: at e_k, the reduced outputs are linear in the coefficients and, to first
   // order, in the errors' steps; each step solves both by the same weighted least squares as a calibration.
   std::vector<double> values = configured;
-  std::vector<double> coefficients = zero;
-  if (options.sensor != SensorKind::kGyro) {
-    CalibrationResult plain = base;
-    least_squares_identify(reduction, model_terms, model, options, plain);
-    std::copy(plain.sensor_products.begin(), plain.sensor_products.end(), coefficients.begin());
-  }
+  std::vector<double> products = start;
   CalibrationResult r = base;
   ErrorColumnsSolution last;
   int iteration = 0;
@@ -326,7 +315,7 @@ CalibrationResult self_calibrate(const Reduction& reduction,
         iteration == 1 ? model_terms : model_terms_for(reduction, current, options);
     if (iteration > 1) {
       const Eigen::MatrixXd cols =
-          error_columns(reduction, current, ps, values, active, coefficients, options);
+          error_columns(reduction, current, ps, values, active, products, options);
       for (std::size_t a = 0; a < active.size(); ++a)
         all_columns.col(static_cast<Eigen::Index>(active[a])) = cols.col(static_cast<Eigen::Index>(a));
     }
@@ -347,27 +336,15 @@ CalibrationResult self_calibrate(const Reduction& reduction,
             std::abs(step) <= 1e-9 * typical_in_unit(j)))
         converged = false;
     }
-    // The coefficients enter the errors' columns (through the regressors): they must have settled too.
+    // The products enter the errors' columns (through the regressors): they must have settled too, each
+    // moved by less than the convergence's fraction of its std.
     bool settled = iteration > 1;
-    if (options.sensor != SensorKind::kGyro) {
-      // The sensor's products: settled when each moved by less than the convergence's fraction of its std.
-      const Eigen::MatrixXd& cov = last.covariance;
-      for (std::size_t c = 0; c < r.sensor_products.size(); ++c) {
-        const double v = r.sensor_products[c];
-        const double sd = std::sqrt(cov(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)));
-        if (!(std::abs(v - coefficients[c]) <= options.convergence * sd ||
-              std::abs(v - coefficients[c]) <= 1e-12))
-          settled = false;
-        coefficients[c] = v;
-      }
-    }
-    for (std::size_t c = 0; c < kNumGyroCoefficients && options.sensor == SensorKind::kGyro; ++c) {
-      const CoefficientEstimate& ce = r.coefficients[c];
-      const double v = ce.identifiable ? ce.value : 0.0;
-      if (ce.identifiable && !(std::abs(v - coefficients[c]) <= options.convergence * ce.std ||
-                               std::abs(v - coefficients[c]) <= 1e-12))
+    for (std::size_t c = 0; c < r.products.size() && c < products.size(); ++c) {
+      const double v = r.products[c];
+      const double sd = std::sqrt(last.covariance(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)));
+      if (!(std::abs(v - products[c]) <= options.convergence * sd || std::abs(v - products[c]) <= 1e-12))
         settled = false;
-      coefficients[c] = v;
+      products[c] = v;
     }
     converged = (converged && settled) || active.empty();
   }
@@ -384,33 +361,25 @@ CalibrationResult self_calibrate(const Reduction& reduction,
     const auto corr = [&](Eigen::Index x, Eigen::Index y) {
       return cov(x, y) / std::sqrt(cov(x, x) * cov(y, y));
     };
-    if (options.sensor != SensorKind::kGyro) {
-      // With the sensor's coefficients, by their names (docs/contract.md): the covariance of the products
-      // and the errors carried to the coefficients by the delta method, J = d(coefficients)/d(products)
-      // (exact for the ratios an accelerometer takes: K1 = u_K1, Kx = u_x / u_K1).
-      // A scale factor that is not identifiable divides nothing out: no correlation is stated.
-      Eigen::MatrixXd joint;
-      if (r.sensor_products.size() == static_cast<std::size_t>(nc)) try {
-          joint = coefficient_error_covariance(options.sensor, r.sensor_products, cov, nc);
-        } catch (const Error&) {
-          joint.resize(0, 0);
-        }
-      const Eigen::Index np = joint.rows() - (cov.rows() - nc);
-      const std::span<const SensorParameter> table =
-          std::visit([](const auto& s) { return s.parameters(); }, sensor_of(options.sensor));
-      for (std::size_t c = 0; c < table.size() && c < r.sensor_coefficients.size(); ++c) {
-        const auto ci = static_cast<Eigen::Index>(c);
-        e.correlations.emplace_back(
-            std::string(table[c].name),
-            r.sensor_coefficients[c].identifiable && ci < np && joint.size() > 0
-                ? joint(ci, np + ai) / std::sqrt(joint(ci, ci) * joint(np + ai, np + ai))
-                : std::numeric_limits<double>::quiet_NaN());
+    // With the sensor's coefficients, by their names (docs/contract.md): the covariance of the products and
+    // the errors carried to the coefficients by the delta method, J = d(coefficients)/d(products) (the
+    // identity for the gyro's drift coefficients; exact for the ratios an accelerometer takes: K1 = u_K1,
+    // Kx = u_x / u_K1). A scale factor that is not identifiable divides nothing out: no correlation is
+    // stated.
+    Eigen::MatrixXd joint;
+    if (r.products.size() == static_cast<std::size_t>(nc)) try {
+        joint = coefficient_error_covariance(sensor, r.products, cov, nc);
+      } catch (const Error&) {
+        joint.resize(0, 0);
       }
+    const Eigen::Index np = joint.rows() - (cov.rows() - nc);
+    for (std::size_t c = 0; c < r.coefficients.size(); ++c) {
+      const auto ci = static_cast<Eigen::Index>(c);
+      e.correlations.emplace_back(r.coefficients[c].name,
+                                  r.coefficients[c].identifiable && ci < np && joint.size() > 0
+                                      ? joint(ci, np + ai) / std::sqrt(joint(ci, ci) * joint(np + ai, np + ai))
+                                      : std::numeric_limits<double>::quiet_NaN());
     }
-    for (std::size_t c = 0; c < kNumGyroCoefficients && options.sensor == SensorKind::kGyro; ++c)
-      e.correlations.emplace_back(std::string(kCoefficientNames[c]),
-                                  r.coefficients[c].identifiable ? corr(nc + ai, static_cast<Eigen::Index>(c))
-                                                                 : std::numeric_limits<double>::quiet_NaN());
     for (std::size_t b = 0; b < active.size(); ++b)
       if (b != a)
         e.correlations.emplace_back(ps[active[b]].label(), corr(nc + ai, nc + static_cast<Eigen::Index>(b)));

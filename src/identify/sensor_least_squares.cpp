@@ -7,6 +7,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
@@ -16,6 +17,7 @@
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/identify/identifiability.hpp"
+#include "gyrocal/identify/unknowns.hpp"
 
 #include "fit_refusals.hpp"
 #include "misfit_rule.hpp"
@@ -422,6 +424,23 @@ Sensor sensor_of(SensorKind kind) {
   return Gyro{};
 }
 
+Sensor sensor_of(const CalibrationOptions& options) {
+  Sensor sensor = sensor_of(options.sensor);
+  if (Gyro* gyro = std::get_if<Gyro>(&sensor)) gyro->model = options.gyro_model;
+  return sensor;
+}
+
+DesignRow position_design_row(const PositionModelTerms& model_terms, const CalibrationOptions& options) {
+  if (options.sensor != SensorKind::kGyro) return model_terms.sensor_exact;
+  DesignRow row;
+  row.known = model_terms.omega_deg_h(options.compensation);
+  const std::vector<double> x =
+      design_row(model_terms, options.compensation, least_squares_unknowns(options.gyro_model));
+  std::copy(x.begin(), x.end(), row.regressors.begin());
+  row.size = x.size();
+  return row;
+}
+
 /// The sensor's least squares: the products u of its design rows (observation = reduced output - reduced
 /// known part), weighted as the gyro's (generalised least squares on the dwells' covariance with the record's
 /// pooled level; uncertainties from each dwell's own level, a sandwich), then its coefficients by
@@ -595,11 +614,11 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     down[j] -= h;
     jacobian.col(j) = (step_back(up).values - step_back(down).values) / (2.0 * h);
   }
-  r.sensor_products.assign(u.data(), u.data() + u.size());
-  r.sensor_coefficients.clear();
+  r.products.assign(u.data(), u.data() + u.size());
+  r.coefficients.clear();
   for (Eigen::Index k = 0; k < np; ++k) {
     const SensorParameter& par = table[static_cast<std::size_t>(k)];
-    SensorCoefficientEstimate e;
+    CoefficientEstimate e;
     e.name = std::string(par.name);
     // K1 in the output column's unit per g ([record] output_unit), the others in the table's.
     e.unit =
@@ -615,7 +634,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
           (plan_nulls ? sandwich.variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
       e.std = std::sqrt(var) * sandwich.student(jacobian.row(k).transpose(), e.name, r);
     }
-    r.sensor_coefficients.push_back(std::move(e));
+    r.coefficients.push_back(std::move(e));
   }
   if (extra_solution != nullptr) {
     ErrorColumnsSolution& e = *extra_solution;

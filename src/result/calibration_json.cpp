@@ -24,34 +24,17 @@ nlohmann::ordered_json named_estimate_to_json(const NamedEstimate& c) {
 nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
   nlohmann::ordered_json j;
   nlohmann::ordered_json coefficients = nlohmann::ordered_json::object();
-  // A sensor other than the gyro: its own table's coefficients (docs/contract.md, "Accelerometers"): K1 as
-  // fitted on the record's output, in its units per g.
-  for (const SensorCoefficientEstimate& c : r.sensor_coefficients)
+  // The sensor's own table's coefficients (docs/contract.md, "Result" and "Accelerometers"): the gyro's ten,
+  // with drift+rate its rate errors too (docs/physics.md section 15), each with the reason where it is not
+  // identifiable; an accelerometer's K1 as fitted on the record's output, in its units per g.
+  for (const CoefficientEstimate& c : r.coefficients) {
     coefficients[c.name] = {
         {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
         {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
         {"unit", c.unit},
         {"identifiable", c.identifiable}};
-  for (std::size_t k = 0; k < kNumGyroCoefficients && r.sensor == SensorKind::kGyro; ++k) {
-    const CoefficientEstimate& c = r.coefficients[k];
-    coefficients[std::string(kCoefficientNames[k])] = {
-        {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
-        {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
-        {"unit", kCoefficientUnits[k]},
-        {"identifiable", c.identifiable}};
+    if (!c.identifiable && !c.reason.empty()) coefficients[c.name]["reason"] = c.reason;
   }
-  // docs/physics.md section 15: with drift+rate the rate errors are coefficients too.
-  if (r.gyro_model == GyroModel::kDriftRate)
-    for (std::size_t k = 0; k < kNumRateTerms; ++k) {
-      const CoefficientEstimate& c = r.rate_terms[k];
-      coefficients[std::string(kRateTermNames[k])] = {
-          {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
-          {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
-          {"unit", kRateTermUnits[k]},
-          {"identifiable", c.identifiable}};
-      if (!c.identifiable && !c.reason.empty())
-        coefficients[std::string(kRateTermNames[k])]["reason"] = c.reason;
-    }
   j["coefficients"] = coefficients;
   j["combinations"] = nlohmann::ordered_json::array();
   for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));

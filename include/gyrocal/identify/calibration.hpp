@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrocal/identify/misfit.hpp"
@@ -80,12 +81,16 @@ struct CalibrationOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// A coefficient's estimate; value and std are NaN when it is not identifiable.
+/// One coefficient of a sensor's model as identified (a row of its parameter table, sensor/sensor_model.hpp,
+/// with its estimate): value and std in `unit`, NaN when it is not identifiable.
 struct CoefficientEstimate {
+  std::string name;  ///< as in the table and the JSON ("dF", "scale_factor_error_ppm", "K0", "delta_p")
+  /// The table's ("deg/h/g", "ug", "urad"), but an accelerometer's K1 in the output's unit per g ("V/g").
+  std::string unit;
   double value = std::numeric_limits<double>::quiet_NaN();
   double std = std::numeric_limits<double>::quiet_NaN();
   bool identifiable = false;
-  /// Why not identifiable, one sentence with the advice; given for the rate errors of drift+rate
+  /// Why not identifiable, one sentence with the advice; given for the gyro's rate errors of drift+rate
   /// (docs/physics.md section 15), empty when identifiable.
   std::string reason;
 };
@@ -148,32 +153,21 @@ struct DataQuality {
   std::vector<Rejected> rejected;
 };
 
-/// One coefficient of a sensor's parameter table as estimated (a sensor other than the gyro, whose results
-/// stay in CalibrationResult::coefficients): value and std in the table's unit, NaN when not identifiable.
-struct SensorCoefficientEstimate {
-  std::string name;  ///< as in the table and the JSON ("K0", "delta_p")
-  std::string unit;  ///< the table's ("ug", "urad"; K1's in the output's unit per g, "V/g")
-  double value = std::numeric_limits<double>::quiet_NaN();
-  double std = std::numeric_limits<double>::quiet_NaN();
-  bool identifiable = false;
-};
-
 struct CalibrationResult {
   Method method = Method::kLeastSquares;
-  SensorKind sensor =
-      SensorKind::kGyro;  ///< whose coefficients: the gyro's (coefficients, rate_terms) or not
-  /// A sensor other than the gyro: its coefficients in its table's order (K0, K1, K2, ... for an
-  /// accelerometer), stepped back from the products by the delta method on the sandwich covariance. Empty for
-  /// the gyro.
-  std::vector<SensorCoefficientEstimate> sensor_coefficients;
-  /// A sensor other than the gyro: the products as solved (K1*K0, K1, K1*K2, ...; 0 where not identifiable).
-  std::vector<double> sensor_products;
+  SensorKind sensor = SensorKind::kGyro;  ///< whose coefficients these are
+  /// The sensor's coefficients, every one its table has identification estimate, in the table's order: the
+  /// gyro's dF ... dOS, then with drift+rate e (ppm), dO, dS (arcsec; docs/physics.md section 15); an
+  /// accelerometer's K0, K1, K2, ... Stepped back from the products by the delta method on the sandwich
+  /// covariance (least squares), or the closed forms' values. Consumers read them by name (coefficient()).
+  std::vector<CoefficientEstimate> coefficients;
+  /// The products as solved, in the sensor's unknowns' order (the gyro's coefficients themselves, then e,
+  /// (1 + e) dO, (1 + e) dS; an accelerometer's K1*K0, K1, K1*K2, ...); 0 where not identifiable. Least
+  /// squares only.
+  std::vector<double> products;
   Compensation compensation = Compensation::kFull;
   GyroModel gyro_model = GyroModel::kDrift;
   double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
-  std::array<CoefficientEstimate, kNumGyroCoefficients> coefficients;
-  /// With drift+rate: e (ppm), dO, dS (arcsec) in kRateTermNames order (docs/physics.md section 15).
-  std::array<CoefficientEstimate, kNumRateTerms> rate_terms;
   std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
   std::vector<NamedEstimate> alternatives;  ///< closed form's second expressions (dI_1g, ...)
   std::vector<ReducedPosition> positions;   ///< the reduced positions
@@ -182,7 +176,8 @@ struct CalibrationResult {
   std::vector<double> residuals;
   std::vector<std::string> unidentifiable;  ///< the unidentifiable directions, written out
   int rank = 0;
-  /// The unknowns of the least squares: the ten coefficients and the estimated machine errors' columns.
+  /// The unknowns of the least squares: the sensor's products and the estimated machine errors' columns (the
+  /// closed forms: the gyro's ten coefficients).
   int unknowns = static_cast<int>(kNumGyroCoefficients);
   /// Least squares: of its whitened, equilibrated design. Closed form: the same for its 16 positions.
   double condition_number = 0.0;
@@ -205,7 +200,13 @@ struct CalibrationResult {
 
   /// One line: method, compensation, rank, condition, warnings.
   std::string BriefReport() const;
+  /// The coefficient named `name` (as in the JSON), or nullptr when the sensor has none of that name.
+  const CoefficientEstimate* coefficient(std::string_view name) const;
 };
+
+/// The coefficients `options`' sensor identifies, in its table's order, named and with their units, none yet
+/// estimated: what every route of identify() fills.
+std::vector<CoefficientEstimate> unestimated_coefficients(const CalibrationOptions& options);
 
 std::string to_string(Method m);
 std::string to_string(Compensation c);
