@@ -252,9 +252,12 @@ TEST(RatePlatformCalibrate, UncertaintiesOfScaleFactorAndMisalignmentTowardSAreH
     CalibrationOptions o;
     o.gyro_model = GyroModel::kDriftRate;
     const CalibrationResult r = identify(reducer.finish(), model_terms, s.model(), o);
-    ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable && r.coefficients[kNumGyroCoefficients + 2].identifiable);
-    z_e.push_back((r.coefficients[kNumGyroCoefficients].value - 150.0) / r.coefficients[kNumGyroCoefficients].std);
-    z_s.push_back((r.coefficients[kNumGyroCoefficients + 2].value - 40.0) / r.coefficients[kNumGyroCoefficients + 2].std);
+    ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable &&
+                r.coefficients[kNumGyroCoefficients + 2].identifiable);
+    z_e.push_back((r.coefficients[kNumGyroCoefficients].value - 150.0) /
+                  r.coefficients[kNumGyroCoefficients].std);
+    z_s.push_back((r.coefficients[kNumGyroCoefficients + 2].value - 40.0) /
+                  r.coefficients[kNumGyroCoefficients + 2].std);
   }
   for (const auto& [name, z] : {std::make_pair("e", z_e), std::make_pair("dS", z_s)}) {
     double mean = 0, var = 0;
@@ -327,12 +330,14 @@ TEST(RatePlatformPlan, PlanStatesThePredictedUncertaintyOfTheScaleFactorWithAndW
   ASSERT_TRUE(with.coefficients[kNumGyroCoefficients].identifiable);
   // Offsets of 0.25 rad/s put 0.25 rad/s on I or S, the Earth rate at most 7e-5 rad/s: e's uncertainty
   // shrinks by orders of magnitude (more than 100 here), and plan says why it is large without them.
-  EXPECT_GT(without.coefficients[kNumGyroCoefficients].std, 100.0 * with.coefficients[kNumGyroCoefficients].std);
+  EXPECT_GT(without.coefficients[kNumGyroCoefficients].std,
+            100.0 * with.coefficients[kNumGyroCoefficients].std);
   EXPECT_TRUE(has_warning(without, "barely identifiable"));
   EXPECT_FALSE(has_warning(with, "barely identifiable"));
   // dO is weak either way, and said so with its uncertainty.
   EXPECT_TRUE(has_warning(with, "input_axis_misalignment_O_arcsec"));
-  EXPECT_GT(with.coefficients[kNumGyroCoefficients + 1].std, 100.0 * with.coefficients[kNumGyroCoefficients + 2].std);
+  EXPECT_GT(with.coefficients[kNumGyroCoefficients + 1].std,
+            100.0 * with.coefficients[kNumGyroCoefficients + 2].std);
 }
 
 TEST(RatePlatformCalibrate, ClosedFormUsesTheSixteenPositionsAtOffsetZeroAndSaysWhatItLeftOut) {

@@ -228,7 +228,8 @@ TEST(SensitivityRateTerms, ShiftOfScaleFactorAndMisalignmentIsTheSimulatedFinite
   Scenario base = s;
   base.errors = CentrifugeErrors{};
   const CalibrationResult without = simulate_and_calibrate(base);
-  ASSERT_TRUE(without.coefficients[kNumGyroCoefficients].identifiable && without.coefficients[kNumGyroCoefficients + 2].identifiable);
+  ASSERT_TRUE(without.coefficients[kNumGyroCoefficients].identifiable &&
+              without.coefficients[kNumGyroCoefficients + 2].identifiable);
   EXPECT_NEAR(without.coefficients[kNumGyroCoefficients].value, 150.0, 1e-2);
 
   struct Case {
@@ -261,10 +262,13 @@ TEST(SensitivityRateTerms, ShiftOfScaleFactorAndMisalignmentIsTheSimulatedFinite
     Scenario with = base;
     c.add(with.errors, s);
     const CalibrationResult r = simulate_and_calibrate(with);
-    ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable && r.coefficients[kNumGyroCoefficients + 2].identifiable) << c.error;
+    ASSERT_TRUE(r.coefficients[kNumGyroCoefficients].identifiable &&
+                r.coefficients[kNumGyroCoefficients + 2].identifiable)
+        << c.error;
     for (std::size_t k : {std::size_t{0}, std::size_t{2}}) {
       const std::string name(kRateTermNames[k]);
-      const double finite_difference = r.coefficients[kNumGyroCoefficients + k].value - without.coefficients[kNumGyroCoefficients + k].value;
+      const double finite_difference = r.coefficients[kNumGyroCoefficients + k].value -
+                                       without.coefficients[kNumGyroCoefficients + k].value;
       const double predicted = row->least_squares[kNone].at(name);
       // The tolerance: 2e-3 ppm or arcsec (a noise-free record recovers e and dS to about 1e-3) and a share
       // of the shift: 1 % for an error the model absorbs exactly (a mount misalignment is an input-axis

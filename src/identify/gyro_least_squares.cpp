@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -154,7 +153,8 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
   // The products as solved, 0 where not identifiable (what a self-calibration takes the errors' columns at).
   r.products.assign(static_cast<std::size_t>(nc), 0.0);
   for (Eigen::Index c = 0; c < nc; ++c)
-    if (sol.identifiable[static_cast<std::size_t>(c)]) r.products[static_cast<std::size_t>(c)] = sol.estimate[c];
+    if (sol.identifiable[static_cast<std::size_t>(c)])
+      r.products[static_cast<std::size_t>(c)] = sol.estimate[c];
   if (r.coefficients.size() != unknowns.size()) r.coefficients = unestimated_coefficients(options);
   for (std::size_t c = 0; c < unknowns.size(); ++c) {
     const auto ci = static_cast<Eigen::Index>(c);
@@ -166,23 +166,7 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     estimate.std = std::sqrt(pe.covariance(ci, ci)) * sandwich.student(jrow, sol.names[c], r);
     estimate.identifiable = true;
   }
-  if (extra_solution != nullptr) {
-    ErrorColumnsSolution& e = *extra_solution;
-    const auto k = extra.columns.cols();
-    e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
-    e.std = e.value;
-    e.identifiable.assign(static_cast<std::size_t>(k), false);
-    e.covariance = sandwich.covariance();
-    e.null_space = sol.null_space;
-    e.names = sol.names;
-    for (Eigen::Index j = 0; j < k; ++j) {
-      if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
-      e.identifiable[static_cast<std::size_t>(j)] = true;
-      e.value[j] = sol.estimate[nc + j];
-      e.std[j] =
-          sandwich.std_of(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)], r);
-    }
-  }
+  if (extra_solution != nullptr) *extra_solution = error_columns_solution(sol, sandwich, nc, r);
   if (options.gyro_model == GyroModel::kDriftRate) state_rate_terms(reduction, r);
   // Residuals in deg/h, not in whitened units.
   const Eigen::VectorXd residuals = w.observations - w.design * sol.estimate;

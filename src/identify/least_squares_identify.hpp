@@ -32,6 +32,15 @@ struct ErrorColumnsSolution {
   std::vector<std::string> names;  ///< the unknowns' names
 };
 
+class PositionSandwich;
+
+/// The estimated errors' part of a weighted solution (weighted_positions.cpp): the unknowns after the
+/// sensor's nc products, each with its std from the sandwich (warnings of few degrees of freedom into `r`),
+/// the sandwich covariance, null space and names of all unknowns.
+ErrorColumnsSolution error_columns_solution(const LeastSquaresSolution& solution,
+                                            const PositionSandwich& sandwich, Eigen::Index nc,
+                                            CalibrationResult& r);
+
 /// The sensor value whose design rows identification takes (sensor_least_squares.cpp): the design row and the
 /// step back from the products do not depend on the sensor's configured truth, so the default one serves.
 Sensor sensor_of(SensorKind kind);

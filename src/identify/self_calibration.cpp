@@ -314,8 +314,7 @@ CalibrationResult self_calibrate(const Reduction& reduction,
     const std::vector<PositionModelTerms> current_model_terms =
         iteration == 1 ? model_terms : model_terms_for(reduction, current, options);
     if (iteration > 1) {
-      const Eigen::MatrixXd cols =
-          error_columns(reduction, current, ps, values, active, products, options);
+      const Eigen::MatrixXd cols = error_columns(reduction, current, ps, values, active, products, options);
       for (std::size_t a = 0; a < active.size(); ++a)
         all_columns.col(static_cast<Eigen::Index>(active[a])) = cols.col(static_cast<Eigen::Index>(a));
     }
@@ -341,7 +340,8 @@ CalibrationResult self_calibrate(const Reduction& reduction,
     bool settled = iteration > 1;
     for (std::size_t c = 0; c < r.products.size() && c < products.size(); ++c) {
       const double v = r.products[c];
-      const double sd = std::sqrt(last.covariance(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)));
+      const double sd =
+          std::sqrt(last.covariance(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)));
       if (!(std::abs(v - products[c]) <= options.convergence * sd || std::abs(v - products[c]) <= 1e-12))
         settled = false;
       products[c] = v;
@@ -375,10 +375,11 @@ CalibrationResult self_calibrate(const Reduction& reduction,
     const Eigen::Index np = joint.rows() - (cov.rows() - nc);
     for (std::size_t c = 0; c < r.coefficients.size(); ++c) {
       const auto ci = static_cast<Eigen::Index>(c);
-      e.correlations.emplace_back(r.coefficients[c].name,
-                                  r.coefficients[c].identifiable && ci < np && joint.size() > 0
-                                      ? joint(ci, np + ai) / std::sqrt(joint(ci, ci) * joint(np + ai, np + ai))
-                                      : std::numeric_limits<double>::quiet_NaN());
+      e.correlations.emplace_back(
+          r.coefficients[c].name,
+          r.coefficients[c].identifiable && ci < np && joint.size() > 0
+              ? joint(ci, np + ai) / std::sqrt(joint(ci, ci) * joint(np + ai, np + ai))
+              : std::numeric_limits<double>::quiet_NaN());
     }
     for (std::size_t b = 0; b < active.size(); ++b)
       if (b != a)

@@ -636,23 +636,7 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     }
     r.coefficients.push_back(std::move(e));
   }
-  if (extra_solution != nullptr) {
-    ErrorColumnsSolution& e = *extra_solution;
-    const auto k = extra.columns.cols();
-    e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
-    e.std = e.value;
-    e.identifiable.assign(static_cast<std::size_t>(k), false);
-    e.covariance = sandwich.covariance();
-    e.null_space = sol.null_space;
-    e.names = sol.names;
-    for (Eigen::Index j = 0; j < k; ++j) {
-      if (!sol.identifiable[static_cast<std::size_t>(nc + j)]) continue;
-      e.identifiable[static_cast<std::size_t>(j)] = true;
-      e.value[j] = sol.estimate[nc + j];
-      e.std[j] =
-          sandwich.std_of(Eigen::VectorXd::Unit(n, nc + j), sol.names[static_cast<std::size_t>(nc + j)], r);
-    }
-  }
+  if (extra_solution != nullptr) *extra_solution = error_columns_solution(sol, sandwich, nc, r);
   // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
   // data's part along it (the truth's component there times the design's small singular value, or any part
   // a near-dependency of the exact chain still carries) would stay in the residuals and read as a misfit of

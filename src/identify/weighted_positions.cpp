@@ -1,9 +1,11 @@
 #include "weighted_positions.hpp"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "fit_refusals.hpp"
+#include "least_squares_identify.hpp"
 #include "position_covariance.hpp"
 
 namespace gyrocal::identify_detail {
@@ -75,6 +77,27 @@ double PositionSandwich::student(const Eigen::VectorXd& c, const std::string& na
 double PositionSandwich::std_of(const Eigen::VectorXd& c, const std::string& name,
                                 CalibrationResult& r) const {
   return std::sqrt(variance(c)) * student(c, name, r);
+}
+
+ErrorColumnsSolution error_columns_solution(const LeastSquaresSolution& solution,
+                                            const PositionSandwich& sandwich, Eigen::Index nc,
+                                            CalibrationResult& r) {
+  ErrorColumnsSolution e;
+  const Eigen::Index n = solution.estimate.size(), k = n - nc;
+  e.value = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
+  e.std = e.value;
+  e.identifiable.assign(static_cast<std::size_t>(k), false);
+  e.covariance = sandwich.covariance();
+  e.null_space = solution.null_space;
+  e.names = solution.names;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    if (!solution.identifiable[static_cast<std::size_t>(nc + j)]) continue;
+    e.identifiable[static_cast<std::size_t>(j)] = true;
+    e.value[j] = solution.estimate[nc + j];
+    e.std[j] = sandwich.std_of(Eigen::VectorXd::Unit(n, nc + j),
+                               solution.names[static_cast<std::size_t>(nc + j)], r);
+  }
+  return e;
 }
 
 }  // namespace gyrocal::identify_detail

@@ -167,7 +167,7 @@ struct CalibrationResult {
   std::vector<double> products;
   Compensation compensation = Compensation::kFull;
   GyroModel gyro_model = GyroModel::kDrift;
-  double g_level = 0.0;  ///< Ar of the (first) spinning rate, g
+  double g_level = 0.0;                     ///< Ar of the (first) spinning rate, g
   std::vector<NamedEstimate> combinations;  ///< identifiable combinations where coefficients are not
   std::vector<NamedEstimate> alternatives;  ///< closed form's second expressions (dI_1g, ...)
   std::vector<ReducedPosition> positions;   ///< the reduced positions
