@@ -192,8 +192,7 @@ TEST(AccelerometerCalibration, EstimatesTheRadiusErrorAndStretch) {
   EXPECT_NEAR(r.machine_errors[0].value, 30e-6, 1e-10);
   EXPECT_NEAR(r.machine_errors[1].value, 2e-7, 1e-12);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.coefficients[k].value, truth_of(truth, k), k == 1 ? 1e-9 : 1e-4)
-        << r.coefficients[k].name;
+    EXPECT_NEAR(r.coefficients[k].value, truth_of(truth, k), k == 1 ? 1e-9 : 1e-4) << r.coefficients[k].name;
   // Noisy: the radius error within a few of its std (about 2 um on this short test).
   Scenario noisy = truth;
   noisy.accelerometer.noise = Accelerometer::default_noise();

@@ -170,8 +170,8 @@ TEST(AccelerometerMisfit, TheVerdictAndTheStdDoNotDependOnTheUnitTheOutputIsRead
           EXPECT_NEAR(b.value, a.value, 1e-6 * a.std) << a.name;
         }
       }
-      EXPECT_NEAR(other.result.coefficients[1].value / in_g.result.coefficients[1].value,
-                  volts_per_g, 1e-9 * volts_per_g);
+      EXPECT_NEAR(other.result.coefficients[1].value / in_g.result.coefficients[1].value, volts_per_g,
+                  1e-9 * volts_per_g);
     }
   }
 }

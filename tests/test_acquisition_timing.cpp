@@ -152,23 +152,21 @@ TEST(AcquisitionTiming, ANoiseFreeDelayedRecordGivesTheDelayAndTheCoefficients) 
   EXPECT_EQ(e.unit, "s");
   EXPECT_NEAR(e.value, 20e-6, 1e-12);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k],
-                k == 1 ? 1e-9 : 1e-4)
+    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4)
         << r.coefficients[k].name;
   // The delay given as known gives the same.
   Scenario known = config;
   known.errors.output_delay_s = 20e-6;
   const CalibrationResult k = calibrate(known, reduction);
   for (std::size_t c = 0; c < kNumAccelCoefficients; ++c)
-    EXPECT_NEAR(k.coefficients[c].value, truth.accelerometer.coefficients.values[c],
-                c == 1 ? 1e-9 : 1e-4)
+    EXPECT_NEAR(k.coefficients[c].value, truth.accelerometer.coefficients.values[c], c == 1 ? 1e-9 : 1e-4)
         << k.coefficients[c].name;
   // Unknown and not estimated, it moves the quadrature's coefficients by far more than that.
   const CalibrationResult ignored = calibrate(config, reduction);
   double largest = 0.0;
   for (std::size_t c = 0; c < kNumAccelCoefficients; ++c)
-    largest = std::max(
-        largest, std::abs(ignored.coefficients[c].value - truth.accelerometer.coefficients.values[c]));
+    largest = std::max(largest,
+                       std::abs(ignored.coefficients[c].value - truth.accelerometer.coefficients.values[c]));
   EXPECT_GT(largest, 1.0);
 }
 
@@ -247,8 +245,7 @@ TEST(AcquisitionTiming, ACounterEncoderZeroOffByThreeCountsIsEstimated) {
   EXPECT_EQ(e.unit, "arcsec");
   EXPECT_NEAR(e.value, -kThreeCountsArcsec, 1e-6);
   for (std::size_t k = 0; k < kNumAccelCoefficients; ++k)
-    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k],
-                k == 1 ? 1e-9 : 1e-4)
+    EXPECT_NEAR(r.coefficients[k].value, truth.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4)
         << r.coefficients[k].name;
   // Noisy, with the delay estimated beside it: both within 3 std, the coefficients within 4.5.
   Scenario noisy = truth;

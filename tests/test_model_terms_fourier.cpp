@@ -220,8 +220,7 @@ TEST(FourierChannels, AnAccelerometersDesignRowsEqualTheEverySampleOnesWithinThe
   for (std::size_t k = 0; k < cf.coefficients.size(); ++k) {
     const double x = cf.coefficients[k].value;
     EXPECT_NEAR(x, ce.coefficients[k].value, k == 1 ? 1e-12 : 1e-6) << cf.coefficients[k].name;
-    EXPECT_NEAR(x, s.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4)
-        << cf.coefficients[k].name;
+    EXPECT_NEAR(x, s.accelerometer.coefficients.values[k], k == 1 ? 1e-9 : 1e-4) << cf.coefficients[k].name;
   }
 }
 
