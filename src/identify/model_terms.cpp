@@ -52,7 +52,8 @@ std::vector<PositionModelTerms> reduce_model_terms(const Reduction& reduction, c
   for (int c = 0; c < kColumns; ++c)
     gyro.rate_columns[static_cast<std::size_t>(c)] = c < kFirstRegressor || c >= kOmegaO;
   // Where the route's choices differ by sensor, the gyro keeps those it had before the route was one: each
-  // other choice moves its plans' or calibrations' numbers (the routes agree to ~1e-11, not bit for bit).
+  // other choice moves its plans' or calibrations' numbers (the two closed forms agree to ~1e-11, not bit for
+  // bit; the two strides take other samples).
   // Planned dwells (`gyrocal plan`) in the planned closed form, written for these columns (issue 17, item 3);
   // a prediction's long dwells on the arm-angle band's stride (kMaxModelSamplesPerDwell, issue 11, item 9);
   // no per-revolution fits: the gyro's fields hold no PeriodRow, so no dwell of its is levelled again from

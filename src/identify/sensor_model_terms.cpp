@@ -49,13 +49,14 @@ std::vector<PositionModelTerms> reduce_sensor_model_terms(const Reduction& reduc
   design.columns = columns;
   design.rate_columns.assign(static_cast<std::size_t>(columns), false);
   // Where the route's choices differ by sensor, a sensor keeps those it had before the route was one: each
-  // other choice moves an accelerometer's plans' or calibrations' numbers (the routes agree to ~1e-11, not
-  // bit for bit). Planned dwells by the Fourier closed forms (the planned closed form was written for the
-  // gyro's columns before a sensor's route existed, and was never taken here); a prediction's bound spread
-  // evenly over the samples, static holds too; where a dwell follows its measured motion, the per-revolution
-  // fits beside it: an accelerometer reads the centripetal force, first order in the rate, so its model
-  // changes from one revolution to the next and identify takes the scatter of the output minus the model
-  // between revolutions (PositionModelTerms::sensor_periods; docs/accelerometer_internals.md).
+  // other choice moves an accelerometer's plans' or calibrations' numbers (the two closed forms agree to
+  // ~1e-11, not bit for bit; the two strides take other samples). Planned dwells by the Fourier closed forms
+  // (the planned closed form was written for the gyro's columns before a sensor's route existed, and was
+  // never taken here); a prediction's bound spread evenly over the samples, static holds too; where a dwell
+  // follows its measured motion, the per-revolution fits beside it: an accelerometer reads the centripetal
+  // force, first order in the rate, so its model changes from one revolution to the next and identify takes
+  // the scatter of the output minus the model between revolutions (PositionModelTerms::sensor_periods;
+  // docs/accelerometer_internals.md).
   design.stride_bound = ModelStrideBound::kEvenSpread;
   design.per_revolution = true;
   const std::vector<DwellModelValues> per_dwell = reduce_dwells_model(
