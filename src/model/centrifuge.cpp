@@ -41,16 +41,10 @@ Angle through_joint(double constant, const HarmonicSeries& series, double x, dou
 }
 
 /// The motion of a frame along the chain, everything expressed in G: orientation (frame axes -> G),
-/// angular velocity and acceleration, and the frame origin's position, velocity and acceleration.
+/// angular velocity and acceleration, and the frame origin's position, velocity and acceleration (the
+/// fields of PlatformFrameMotion, which is this frame's motion when the chain reaches the position platform).
 /// This is the spatial-velocity recursion; each step is exact, so the derivatives are analytic.
-struct FrameMotion {
-  Matrix3d rotation = Matrix3d::Identity();
-  Vector3d angular_velocity = Vector3d::Zero();
-  Vector3d angular_acceleration = Vector3d::Zero();
-  Vector3d position = Vector3d::Zero();
-  Vector3d velocity = Vector3d::Zero();
-  Vector3d acceleration = Vector3d::Zero();
-
+struct FrameMotion : PlatformFrameMotion {
   /// Right-multiply the orientation by an elementary rotation E_axis(q(t)) about the current frame's axis.
   void rotate(Axis axis, const Angle& a) {
     if (a.q == 0.0 && a.qd == 0.0 && a.qdd == 0.0) return;  // an error that is not there
@@ -129,11 +123,12 @@ Eigen::Vector3d Site::earth_rate_g() const {
 
 CentrifugeModel::CentrifugeModel(const Site& site, const CentrifugeGeometry& geometry,
                                  const CentrifugeErrors& errors)
-    : site_(site), geometry_(geometry), errors_(errors), earth_rate_g_(site.earth_rate_g()) {
+    : site_(site),
+      geometry_(geometry),
+      errors_(errors),
+      earth_rate_g_(site.earth_rate_g()),
+      mount_(errors.mount_misalignment_rad, errors.lever_arm_m) {
   base_rotation_ = elementary(kY, errors.base_tilt_y_rad) * elementary(kX, errors.base_tilt_x_rad);
-  mount_rotation_ = elementary(kZ, errors.mount_misalignment_rad.z()) *
-                    elementary(kY, errors.mount_misalignment_rad.y()) *
-                    elementary(kX, errors.mount_misalignment_rad.x());
   prepared_.main_wobble_x = PreparedHarmonicSeries(errors.main_wobble_x_rad);
   prepared_.main_wobble_y = PreparedHarmonicSeries(errors.main_wobble_y_rad);
   prepared_.main_runout_x = PreparedHarmonicSeries(errors.main_runout_x_m);
@@ -142,7 +137,11 @@ CentrifugeModel::CentrifugeModel(const Site& site, const CentrifugeGeometry& geo
   prepared_.counter_wobble_y = PreparedHarmonicSeries(errors.counter_wobble_y_rad);
 }
 
-SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
+namespace {
+
+/// The chain of docs/physics.md section 3 up to the position platform, into f (which starts at rest at G's
+/// origin): platform_motion, written once for it and for exact_inputs.
+void walk_to_platform(const CentrifugeModel& model, const JointState& j, FrameMotion& f) {
   const CentrifugeErrors& e = model.errors();
   const CentrifugeModel::PreparedErrors& h = model.prepared();
   const Joint th(j.main_angle_rad, j.main_rate_rad_s, j.main_accel_rad_s2);
@@ -151,7 +150,6 @@ SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
                                                       : j.counter_angle_rad;
   const Joint ps(psi, j.counter_rate_rad_s, j.counter_accel_rad_s2);
 
-  FrameMotion f;
   // R_base; then the main-axis runout, (x, y, 0) in the base frame, a function of theta.
   f.rotate_constant(model.base_rotation());
   if (!h.main_runout_x.empty() || !h.main_runout_y.empty()) {
@@ -177,9 +175,15 @@ SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   f.rotate(kZ, through_joint(e.position_perpendicularity_z_rad, e.position_wobble_z_rad, beta, bd, bdd));
   f.rotate(kX, through_joint(e.position_perpendicularity_x_rad, e.position_wobble_x_rad, beta, bd, bdd));
   f.rotate(kY, {-beta, -bd, -bdd});
-  // The gyro centre's offset in position-platform axes, then the mounting misalignment.
-  if (!e.lever_arm_m.isZero(0.0)) f.translate(e.lever_arm_m);
-  f.rotate_constant(model.mount_rotation());
+}
+
+/// The last step of the chain, a sensor's mount on the platform whose motion f holds (f is moved to the
+/// sensor), then the inputs of docs/physics.md section 4: inputs_at_mount, written once for it and
+/// exact_inputs.
+SensorInputs evaluate_at_mount(const CentrifugeModel& model, FrameMotion& f, const SensorMount& mount) {
+  // The sensor centre's offset in position-platform axes, then the mounting misalignment.
+  if (!mount.lever_arm_m().isZero(0.0)) f.translate(mount.lever_arm_m());
+  f.rotate_constant(mount.rotation());
 
   // docs/physics.md section 4.
   const Vector3d& we = model.earth_rate_g();
@@ -190,6 +194,20 @@ SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& j) {
   in.rate_rad_s = f.rotation.transpose() * (we + f.angular_velocity);
   in.specific_force_g = f.rotation.transpose() * inertial_acceleration / g;
   return in;
+}
+
+}  // namespace
+
+PlatformFrameMotion platform_motion(const CentrifugeModel& model, const JointState& joints) {
+  FrameMotion f;
+  walk_to_platform(model, joints, f);
+  return f;
+}
+
+SensorInputs inputs_at_mount(const CentrifugeModel& model, const PlatformFrameMotion& motion,
+                             const SensorMount& mount) {
+  FrameMotion f{motion};
+  return evaluate_at_mount(model, f, mount);
 }
 
 JointState joints_before(const JointState& at_stamp, double delay_s) {
@@ -204,9 +222,28 @@ JointState joints_before(const JointState& at_stamp, double delay_s) {
   return j;
 }
 
+SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& joints) {
+  // inputs_at_mount(model, platform_motion(model, joints), model.mount()), the same operations in the same
+  // order, without copying the platform's motion twice per sample (+1.3 % instructions when it did).
+  FrameMotion f;
+  walk_to_platform(model, joints, f);
+  return evaluate_at_mount(model, f, model.mount());
+}
+
 SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp) {
   const double delay = model.errors().output_delay_s;
   return delay == 0.0 ? exact_inputs(model, at_stamp) : exact_inputs(model, joints_before(at_stamp, delay));
+}
+
+PlatformFrameMotion sensed_platform_motion(const CentrifugeModel& model, const JointState& at_stamp) {
+  const double delay = model.errors().output_delay_s;
+  return delay == 0.0 ? platform_motion(model, at_stamp)
+                      : platform_motion(model, joints_before(at_stamp, delay));
+}
+
+SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp,
+                           const SensorMount& mount) {
+  return inputs_at_mount(model, sensed_platform_motion(model, at_stamp), mount);
 }
 
 JointState spinning_joint_state(const CentrifugeModel& model, double rate_rad_s, double beta_rad,

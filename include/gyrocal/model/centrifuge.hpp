@@ -1,15 +1,18 @@
 #pragma once
 // The exact centrifuge model (docs/physics.md sections 2-4): a kinematic chain with every error source,
-// evaluated to the gyro's inertial angular rate and specific force with analytic derivatives.
+// evaluated to a sensor's inertial angular rate and specific force with analytic derivatives.
 //
 // Following Pinocchio's model/data split, CentrifugeModel is constant once built (geometry, errors and
-// what can be precomputed from them); evaluation is a free function of the model and a joint state.
+// what can be precomputed from them); evaluation is a free function of the model and a joint state. The chain
+// is walked in two steps (after Pinocchio's frames): the machine up to the position platform once
+// (platform_motion), then each sensor's mount on it (inputs_at_mount, model/mount.hpp).
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "gyrocal/core/harmonic.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/model/mount.hpp"
 
 namespace gyrocal {
 
@@ -55,11 +58,14 @@ struct CentrifugeErrors {
   double counter_angle_error_rad = 0.0;
   double position_perpendicularity_x_rad = 0.0;
   double position_perpendicularity_z_rad = 0.0;
-  HarmonicSeries position_wobble_x_rad;                              ///< of beta', rad
-  HarmonicSeries position_wobble_z_rad;                              ///< of beta', rad
-  double position_angle_error_rad = 0.0;                             ///< added to the commanded beta, rad
+  HarmonicSeries position_wobble_x_rad;   ///< of beta', rad
+  HarmonicSeries position_wobble_z_rad;   ///< of beta', rad
+  double position_angle_error_rad = 0.0;  ///< added to the commanded beta, rad
+  /// The one sensor's mount (CentrifugeModel::mount(), model/mount.hpp): kept here beside the machine's
+  /// errors so that its configuration keys and `--estimate mount_misalignment` / `lever_arm` stay as they
+  /// are. Not the machine's: an IMU's channels will each carry their own SensorMount.
   Eigen::Vector3d mount_misalignment_rad = Eigen::Vector3d::Zero();  ///< about I, O, S, rad
-  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  ///< gyro centre offset, position-platform axes, m
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  ///< sensor centre offset, position-platform axes, m
   /// The acquisition's timing ([record] output_delay_s, docs/records.md): the output is stamped this long
   /// after the instant it was sensed (an anti-alias filter's group delay, a multiplexer's skew), s, >= 0. Not
   /// the machine's, but held with its errors so that a self-calibration estimates it as one of them
@@ -123,8 +129,9 @@ class CentrifugeModel {
   const Eigen::Vector3d& earth_rate_g() const { return earth_rate_g_; }
   /// R_base = Ry(base_tilt_y) Rx(base_tilt_x).
   const Eigen::Matrix3d& base_rotation() const { return base_rotation_; }
+  /// The one sensor's mount that the errors configure (mount_misalignment_rad, lever_arm_m); its rotation is
   /// R_mount = Rz(mis_S) Ry(mis_O) Rx(mis_I).
-  const Eigen::Matrix3d& mount_rotation() const { return mount_rotation_; }
+  const SensorMount& mount() const { return mount_; }
 
   /// The wobbles and runouts of the main axis (of theta) and of the counter platform (of psi_r), prepared.
   struct PreparedErrors {
@@ -139,12 +146,38 @@ class CentrifugeModel {
   CentrifugeErrors errors_;
   Eigen::Vector3d earth_rate_g_;
   Eigen::Matrix3d base_rotation_;
-  Eigen::Matrix3d mount_rotation_;
+  SensorMount mount_;
   PreparedErrors prepared_;
 };
 
+/// The position platform's frame motion at one joint state, every vector in the ground frame G
+/// (North-West-Up): the chain of docs/physics.md section 3 up to R_pos(beta), with no sensor's mount.
+/// Computed once per joint state, then evaluated at each mount on the platform (inputs_at_mount).
+struct PlatformFrameMotion {
+  /// R_base R_main(theta) R_count(psi_r) R_pos(beta): takes platform axes to G. Dimensionless.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();      ///< relative to G, in G, rad/s
+  Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< its time derivative, in G, rad/s^2
+  Eigen::Vector3d position =
+      Eigen::Vector3d::Zero();  ///< the platform's origin from the main axis's, in G, m
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      ///< its time derivative in G, m/s
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  ///< its second time derivative in G, m/s^2
+};
+
+/// The position platform's motion at `joints` (docs/physics.md section 3, analytic derivatives: wobbles and
+/// runouts differentiated through their joint angle). Independent of the model's mount.
+PlatformFrameMotion platform_motion(const CentrifugeModel& model, const JointState& joints);
+
+/// Exact inertial rate and specific force in the axes of a sensor at `mount` on a platform moving as `motion`
+/// (docs/physics.md section 4): the lever arm moves the point (its centripetal, tangential and Coriolis
+/// terms), the mount's rotation turns the axes, then the Earth rate and gravity of the model's site are
+/// added.
+SensorInputs inputs_at_mount(const CentrifugeModel& model, const PlatformFrameMotion& motion,
+                             const SensorMount& mount);
+
 /// Exact inertial rate and specific force in the sensor's axes (docs/physics.md section 4), with analytic
-/// derivatives of the chain of section 3 (wobbles and runouts differentiated through their joint angle).
+/// derivatives of the chain of section 3: inputs_at_mount(model, platform_motion(model, joints),
+/// model.mount()).
 SensorInputs exact_inputs(const CentrifugeModel& model, const JointState& joints);
 
 /// The joints `delay_s` (s) before `at_stamp`, from its angles, rates and accelerations (second order in the
@@ -157,6 +190,16 @@ JointState joints_before(const JointState& at_stamp, double delay_s);
 /// The model terms of a calibration are evaluated through it; the simulator takes the timeline's joints
 /// at the earlier instant instead (an independent route).
 SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp);
+
+/// The platform's motion at the instant the output stamped at `at_stamp` was sensed (platform_motion at
+/// joints_before(at_stamp, output_delay_s); at_stamp itself when the delay is 0): computed once for every
+/// mount.
+PlatformFrameMotion sensed_platform_motion(const CentrifugeModel& model, const JointState& at_stamp);
+
+/// sensed_inputs of a sensor at `mount` rather than the model's own: inputs_at_mount of
+/// sensed_platform_motion. sensed_inputs(model, j, model.mount()) is sensed_inputs(model, j) bit for bit.
+SensorInputs sensed_inputs(const CentrifugeModel& model, const JointState& at_stamp,
+                           const SensorMount& mount);
 
 /// Joint state at time t (s) of a steady spinning dwell at main rate omega (rad/s) and position beta (rad):
 /// theta = theta0 + omega*t, psi_r = -theta + psi0 + (delta_omega + offset)*t (docs/physics.md sections 3
