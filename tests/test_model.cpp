@@ -12,6 +12,7 @@
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/model/nominal.hpp"
 #include "support/independent_pose.hpp"
+#include "support/rotations.hpp"
 
 namespace gyrocal {
 namespace {
@@ -24,15 +25,9 @@ using Eigen::Vector3d;
 constexpr double kDeg = kDegToRad;
 constexpr double kSec = kArcsecToRad;
 
-Matrix3d rx(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitX()).toRotationMatrix();
-}
-Matrix3d ry(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix();
-}
-Matrix3d rz(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitZ()).toRotationMatrix();
-}
+using testing::rx;
+using testing::ry;
+using testing::rz;
 
 HarmonicSeries random_series(std::mt19937_64& rng, double scale) {
   std::uniform_real_distribution<double> u(-1, 1);

@@ -13,6 +13,7 @@
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/model/mount.hpp"
 #include "support/independent_pose.hpp"
+#include "support/rotations.hpp"
 
 namespace gyrocal {
 namespace {
@@ -22,15 +23,9 @@ using Eigen::Vector3d;
 
 constexpr double kSec = kArcsecToRad;
 
-Matrix3d rx(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitX()).toRotationMatrix();
-}
-Matrix3d ry(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix();
-}
-Matrix3d rz(double a) {
-  return Eigen::AngleAxisd(a, Vector3d::UnitZ()).toRotationMatrix();
-}
+using testing::rx;
+using testing::ry;
+using testing::rz;
 
 HarmonicSeries series(double amplitude, double phase) {
   HarmonicSeries h;
