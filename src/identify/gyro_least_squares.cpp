@@ -149,7 +149,12 @@ void least_squares_identify(const Reduction& reduction, const std::vector<Positi
     identifiable[kNumGyroCoefficients] = true;
   }
   ParameterEstimates pe = gyro.from_products(u, cu, identifiable);
-  if (e_assumed) pe.identifiable[kNumGyroCoefficients] = false;
+  if (e_assumed) {
+    // e taken as 0 with no variance: no part of its (unidentified, possibly unbounded) gain enters the
+    // misalignments' Student factors either.
+    pe.identifiable[kNumGyroCoefficients] = false;
+    pe.jacobian.col(at_e).setZero();
+  }
   // The products as solved, 0 where not identifiable (what a self-calibration takes the errors' columns at).
   r.products.assign(static_cast<std::size_t>(nc), 0.0);
   for (Eigen::Index c = 0; c < nc; ++c)
