@@ -211,7 +211,11 @@ std::vector<CoefficientEstimate> unestimated_coefficients(const CalibrationOptio
     if (!p.identified) continue;
     CoefficientEstimate c;
     c.name = std::string(p.name);
-    c.unit = std::string(p.unit);
+    // An accelerometer's K1 in the output column's unit per g ([record] output_unit), the rest in the
+    // table's.
+    c.unit = options.sensor == SensorKind::kAccelerometer && p.name == "K1"
+                 ? scale_factor_unit(options.output_unit)
+                 : std::string(p.unit);
     out.push_back(std::move(c));
   }
   return out;

@@ -615,26 +615,19 @@ void sensor_least_squares(const Reduction& reduction, const std::vector<Position
     jacobian.col(j) = (step_back(up).values - step_back(down).values) / (2.0 * h);
   }
   r.products.assign(u.data(), u.data() + u.size());
-  r.coefficients.clear();
-  for (Eigen::Index k = 0; k < np; ++k) {
-    const SensorParameter& par = table[static_cast<std::size_t>(k)];
-    CoefficientEstimate e;
-    e.name = std::string(par.name);
-    // K1 in the output column's unit per g ([record] output_unit), the others in the table's.
-    e.unit =
-        options.sensor == SensorKind::kAccelerometer && k == static_cast<Eigen::Index>(AccelCoefficient::K1)
-            ? scale_factor_unit(options.output_unit)
-            : std::string(par.unit);
+  // The coefficients named as the result names them (unestimated_coefficients: the table's names and units,
+  // K1's in the output column's unit per g).
+  r.coefficients = unestimated_coefficients(options);
+  for (Eigen::Index k = 0; k < np && k < static_cast<Eigen::Index>(r.coefficients.size()); ++k) {
+    CoefficientEstimate& e = r.coefficients[static_cast<std::size_t>(k)];
     e.identifiable = pe.identifiable[static_cast<std::size_t>(k)];
-    if (e.identifiable) {
-      e.value = pe.values[k];
-      // A ratio to the estimable scale: its relative bound too (scale_relative, 0 when K1 is identifiable).
-      const double bound = k == scale_at ? 0.0 : pe.values[k] * scale_relative;
-      const double var =
-          (plan_nulls ? sandwich.variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
-      e.std = std::sqrt(var) * sandwich.student(jacobian.row(k).transpose(), e.name, r);
-    }
-    r.coefficients.push_back(std::move(e));
+    if (!e.identifiable) continue;
+    e.value = pe.values[k];
+    // A ratio to the estimable scale: its relative bound too (scale_relative, 0 when K1 is identifiable).
+    const double bound = k == scale_at ? 0.0 : pe.values[k] * scale_relative;
+    const double var =
+        (plan_nulls ? sandwich.variance(jacobian.row(k).transpose()) : pe.covariance(k, k)) + bound * bound;
+    e.std = std::sqrt(var) * sandwich.student(jacobian.row(k).transpose(), e.name, r);
   }
   if (extra_solution != nullptr) *extra_solution = error_columns_solution(sol, sandwich, nc, r);
   // A plan that leaves a direction unidentifiable: the solver's minimum-norm estimate sets it to zero, so the
