@@ -35,7 +35,7 @@ fs::path static_record(std::size_t rows) {
   gyrocal::RecordSample sample;
   for (std::size_t i = 0; i < rows; ++i) {
     sample.time_s = static_cast<double>(i) / 100.0;
-    sample.output = generator.next(12345.0);  // a sensor's offset: the sums must not lose its digits
+    sample.outputs[0] = generator.next(12345.0);  // a sensor's offset: the sums must not lose its digits
     writer.write(sample);
   }
   writer.finish();

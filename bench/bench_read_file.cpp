@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     while (reader.next(sample)) {
       ++rows;
       sum += sample.time_s + sample.main_angle_deg + sample.counter_angle_deg + sample.position_angle_deg +
-             sample.output;
+             sample.outputs[0];
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double bytes = static_cast<double>(std::filesystem::file_size(argv[1]));

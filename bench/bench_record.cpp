@@ -35,7 +35,7 @@ class SampleSource {
     sample.main_angle_deg = sample.time_s * 567.2282172309;
     sample.counter_angle_deg = -sample.main_angle_deg;
     sample.position_angle_deg = 90.0;
-    sample.output = 1.2345 + noise_[i % noise_.size()];
+    sample.outputs[0] = 1.2345 + noise_[i % noise_.size()];
     sample.extra[0] = 21.0 + noise_[(i + 7) % noise_.size()];
     return sample;
   }
@@ -98,7 +98,7 @@ void BM_ReadRecord(benchmark::State& state) {
     gyrocal::RecordReader reader(path);
     RecordSample sample;
     double sum = 0.0;
-    while (reader.next(sample)) sum += sample.output;
+    while (reader.next(sample)) sum += sample.outputs[0];
     benchmark::DoNotOptimize(sum);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));

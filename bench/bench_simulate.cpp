@@ -50,7 +50,7 @@ void BM_SimulateSamples(benchmark::State& state) {
   std::uint64_t rows = 0;
   double sum = 0.0;
   for (auto _ : state) {
-    rows += simulate(s, {}, [&sum](const RecordSample& r) { sum += r.output; }).samples;
+    rows += simulate(s, {}, [&sum](const RecordSample& r) { sum += r.outputs[0]; }).samples;
   }
   benchmark::DoNotOptimize(sum);
   state.SetItemsProcessed(static_cast<std::int64_t>(rows));

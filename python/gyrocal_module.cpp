@@ -154,7 +154,7 @@ py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed
       columns[1].push_back(s.main_angle_deg);
       columns[2].push_back(s.counter_angle_deg);
       columns[3].push_back(s.position_angle_deg);
-      columns[4].push_back(s.output);
+      columns[4].push_back(s.outputs[0]);
     });
   }
   py::dict out;
@@ -211,8 +211,8 @@ py::object calibrate_arrays_py(const Column& time_s, const Column& main_deg, con
       s.main_angle_deg = main_deg.data()[i];
       s.counter_angle_deg = counter_deg.data()[i];
       s.position_angle_deg = position_deg.data()[i];
-      s.output = gyro_deg_h.data()[i];
-      options.output.range.push(s.output);  // for the misfit's causes (a flat top)
+      s.outputs[0] = gyro_deg_h.data()[i];
+      options.output.range.push(s.outputs[0]);  // for the misfit's causes (a flat top)
       reducer.push(s);
     }
     const Reduction reduction_result = reducer.finish();

@@ -68,8 +68,8 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
   so.seed = seed;
   simulate(truth, so, [&](RecordSample x) {
     if (fault) fault(x);
-    x.output /= scale;
-    o.output.range.push(x.output);
+    x.outputs[0] /= scale;
+    o.output.range.push(x.outputs[0]);
     reducer.push(x);
   });
   Reduction r = reducer.finish();
@@ -77,7 +77,8 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
   const CentrifugeModel model = config.model();
   Outcome out;
   try {
-    out.result = identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.sensor()), model, o);
+    out.result =
+        identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.sensor()), model, o);
     // K1 in the record's units, as calibrate_record states it.
     out.result.coefficients[1].value *= scale;
     out.result.coefficients[1].std *= std::abs(scale);
@@ -151,7 +152,7 @@ TEST(AccelerometerMisfit, TheVerdictAndTheStdDoNotDependOnTheUnitTheOutputIsRead
     const std::vector<std::pair<double, double>> reads = {{1.3, 1300.0}, {1300.0, 1.3}};
     for (const auto& [volts_per_g, scale] : reads) {
       const Outcome other = calibrate(
-          truth, config, 3, [k = volts_per_g](RecordSample& x) { x.output *= k; }, scale);
+          truth, config, 3, [k = volts_per_g](RecordSample& x) { x.outputs[0] *= k; }, scale);
       ASSERT_EQ(other.refused, in_g.refused) << other.message << in_g.message;
       if (in_g.refused) {
         EXPECT_TRUE(has(other.message, "radius error")) << other.message;
@@ -277,7 +278,7 @@ TEST(AccelerometerMisfit, AMisfitNoCauseExplainsListsWhatWasTriedAndWhatWasNot) 
   // causes tried (never an empty list) and names the output delay as not tried, with the estimate that
   // measures it.
   const Scenario s = small_test(10.0);
-  const Outcome out = calibrate(s, s, 8, [](RecordSample& x) { x.output += 200e-6 / 60.0 * x.time_s; });
+  const Outcome out = calibrate(s, s, 8, [](RecordSample& x) { x.outputs[0] += 200e-6 / 60.0 * x.time_s; });
   const std::string text = out.refused ? out.message : warnings_of(out.result);
   EXPECT_TRUE(has(text,
                   "none of the set-up mistakes tried (gamma counted the other way, beta counted the "
@@ -299,7 +300,7 @@ TEST(AccelerometerPlausibility, AColumnThatDoesNotFollowTheSpecificForceIsRefuse
       [&state](RecordSample& x) {
         state = state * 6364136223846793005ULL + 1442695040888963407ULL;
         const double uniform = static_cast<double>(state >> 11) / 9007199254740992.0;
-        x.output = 25.0 + 1e-5 * x.time_s + 0.01 * (uniform - 0.5);
+        x.outputs[0] = 25.0 + 1e-5 * x.time_s + 0.01 * (uniform - 0.5);
       },
       1.0, "Temp_C");
   ASSERT_TRUE(out.refused);
@@ -312,7 +313,7 @@ TEST(AccelerometerPlausibility, StaticHoldsThatDoNotReadPlusAndMinusK1AreRefused
   // The channel's gain halves while the main axis stands still (a range switched for the static holds).
   const Scenario s = small_test(10.0);
   const Outcome out = calibrate(s, s, 10, [](RecordSample& x) {
-    if (x.time_s < 215.0) x.output *= 0.5;  // the static set comes first and ends at 208 s
+    if (x.time_s < 215.0) x.outputs[0] *= 0.5;  // the static set comes first and ends at 208 s
   });
   ASSERT_TRUE(out.refused) << warnings_of(out.result);
   EXPECT_TRUE(has(out.message, "static holds with the input axis up and down")) << out.message;
@@ -346,7 +347,7 @@ TEST(AccelerometerPlausibility, AUnitAndAnInvertedChannelAreWarnedAboutAndChange
   };
   for (const Case& c : cases) {
     const Outcome out = calibrate(
-        s, s, 11, [f = c.factor](RecordSample& x) { x.output *= f; }, c.scale);
+        s, s, 11, [f = c.factor](RecordSample& x) { x.outputs[0] *= f; }, c.scale);
     ASSERT_FALSE(out.refused) << c.name << ": " << out.message;
     const std::string w = warnings_of(out.result);
     for (const std::string& part : c.says) EXPECT_TRUE(has(w, part)) << c.name << ": " << w;

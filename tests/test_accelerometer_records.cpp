@@ -60,9 +60,9 @@ TEST(AccelerometerRecordConfig, OutputScalePerGReadsTheRigsUnitsIntoG) {
   EXPECT_EQ(reader.output_unit(), "g");
   RecordSample row;
   ASSERT_TRUE(reader.next(row));
-  EXPECT_DOUBLE_EQ(row.output, 0.5);
+  EXPECT_DOUBLE_EQ(row.outputs[0], 0.5);
   ASSERT_TRUE(reader.next(row));
-  EXPECT_EQ(row.output, 0.0);
+  EXPECT_EQ(row.outputs[0], 0.0);
   // The written configuration reads back as the same layout.
   EXPECT_EQ(parse_scenario(scenario_to_toml(s), "again.toml").record, s.record);
   // An accelerometer's [record] without output_column reads gyrocal's own column name, accel_g.
@@ -278,18 +278,18 @@ TEST(AccelerometerRigRecord, ARigsRecordInMillivoltsPerGReadsBackInG) {
   RecordSample sample;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     ASSERT_TRUE(reader.next(sample));
-    ASSERT_NEAR(sample.output, rows[i].output / kMilliVoltPerG, 1e-15 * std::abs(rows[i].output));
-    largest = std::max(largest, std::abs(sample.output));
+    ASSERT_NEAR(sample.outputs[0], rows[i].output / kMilliVoltPerG, 1e-15 * std::abs(rows[i].output));
+    largest = std::max(largest, std::abs(sample.outputs[0]));
     // Stopped (the main encoder unchanged since the last row) with the input axis vertical (beta 90 or 270
     // deg): one g along it, up or down, whatever gamma.
     const bool stopped = i > 0 && rows[i].main_angle_deg == rows[i - 1].main_angle_deg;
     const double beta = rows[i].position_angle_deg;
     if (stopped && std::abs(beta - 90.0) < 0.01) {
-      EXPECT_NEAR(sample.output, 1.0, 1e-3) << "row " << i;
+      EXPECT_NEAR(sample.outputs[0], 1.0, 1e-3) << "row " << i;
       ++up;
     }
     if (stopped && std::abs(beta - 270.0) < 0.01) {
-      EXPECT_NEAR(sample.output, -1.0, 1e-3) << "row " << i;
+      EXPECT_NEAR(sample.outputs[0], -1.0, 1e-3) << "row " << i;
       ++down;
     }
   }

@@ -79,12 +79,12 @@ TEST(AccumulatorFeed, GivesTheSameNumbersAsTheCallersThreadForSeveralDwellsInTur
     std::size_t i = 0, j = 0;
     while (i < first.size() || j < second.size()) {
       for (std::size_t k = 0; k < 3001 && i < first.size(); ++k, ++i) {
-        if (first[i].gap_before) feed.break_revolution(fed_a);
-        feed.add(fed_a, first[i].t, first[i].gamma, first[i].value);
+        if (first[i].gap_before) feed.break_revolution({&fed_a, 1});
+        feed.add({&fed_a, 1}, first[i].t, first[i].gamma, &first[i].value);
       }
       for (std::size_t k = 0; k < 5003 && j < second.size(); ++k, ++j) {
-        if (second[j].gap_before) feed.break_revolution(fed_b);
-        feed.add(fed_b, second[j].t, second[j].gamma, second[j].value);
+        if (second[j].gap_before) feed.break_revolution({&fed_b, 1});
+        feed.add({&fed_b, 1}, second[j].t, second[j].gamma, &second[j].value);
       }
     }
     feed.sync();
@@ -97,6 +97,42 @@ TEST(AccumulatorFeed, GivesTheSameNumbersAsTheCallersThreadForSeveralDwellsInTur
   expect_same(fed_b.finish(0), b);
 }
 
+TEST(AccumulatorFeed, FeedsEachAccumulatorOfAGroupItsOwnColumn) {
+  // A dwell of three output columns (an IMU's channels): each row's k-th value goes to the k-th accumulator,
+  // with the gaps' breaks to all three, across batches cut between rows (3 does not divide kBatchSamples).
+  // Each column has its own spikes (column 2 none), so each accumulator runs its own outlier rule.
+  const std::vector<Sample> s0 = dwell_samples(30000, 5), s1 = dwell_samples(30000, 6);
+  std::vector<Sample> s2 = dwell_samples(30000, 7);
+  for (std::size_t i = 5000; i < s2.size(); i += 10007) s2[i].value -= 40.0;  // its spikes taken away
+  std::vector<DwellAccumulator> direct, fed;
+  for (int k = 0; k < 3; ++k) {
+    direct.push_back(make_accumulator(s0));
+    fed.push_back(make_accumulator(s0));
+  }
+  {
+    AccumulatorFeed feed;
+    for (std::size_t i = 0; i < s0.size(); ++i) {
+      const double values[3] = {s0[i].value, s1[i].value, s2[i].value};
+      if (s0[i].gap_before) {
+        for (DwellAccumulator& a : direct) a.break_revolution();
+        feed.break_revolution(fed);
+      }
+      for (std::size_t k = 0; k < 3; ++k) direct[k].add(s0[i].t, s0[i].gamma, &values[k]);
+      feed.add(fed, s0[i].t, s0[i].gamma, values);
+    }
+    feed.sync();
+  }
+  std::vector<DwellValues> want;
+  for (std::size_t k = 0; k < 3; ++k) {
+    want.push_back(direct[k].finish(0));
+    SCOPED_TRACE(k);
+    expect_same(fed[k].finish(0), want.back());
+  }
+  EXPECT_GT(want[0].outliers, 0u);
+  EXPECT_EQ(want[2].outliers, 0u);                // its own rule: the other columns' spikes are not its
+  EXPECT_NE(want[0].value[0], want[1].value[0]);  // each its own column
+}
+
 TEST(AccumulatorFeed, WithoutAThreadMakesTheCallsAtOnce) {
   // The Monte Carlo's reducers (one a trial, the trials on every core) feed their accumulators inline.
   const std::vector<Sample> s = dwell_samples(20000, 4);
@@ -105,10 +141,10 @@ TEST(AccumulatorFeed, WithoutAThreadMakesTheCallsAtOnce) {
   for (const Sample& x : s) {
     if (x.gap_before) {
       direct.break_revolution();
-      feed.break_revolution(fed);
+      feed.break_revolution({&fed, 1});
     }
     direct.add(x.t, x.gamma, &x.value);
-    feed.add(fed, x.t, x.gamma, x.value);
+    feed.add({&fed, 1}, x.t, x.gamma, &x.value);
     ASSERT_EQ(fed.samples(), direct.samples());  // no sync needed: nothing waits
   }
   feed.sync();
@@ -122,7 +158,7 @@ TEST(AccumulatorFeed, CanBeDestroyedWithWorkInFlight) {
   auto acc = std::make_unique<DwellAccumulator>(make_accumulator(s));
   {
     AccumulatorFeed feed;
-    for (const Sample& x : s) feed.add(*acc, x.t, x.gamma, x.value);
+    for (const Sample& x : s) feed.add({acc.get(), 1}, x.t, x.gamma, &x.value);
   }
   acc.reset();
   SUCCEED();

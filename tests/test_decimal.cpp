@@ -329,7 +329,7 @@ TEST(ShortDecimal, TheReaderGivesStrtodsDoubleForEveryForm) {
     for (const auto& texts : fields) {
       ASSERT_TRUE(reader.next(sample));
       const double read[5] = {sample.time_s, sample.main_angle_deg, sample.counter_angle_deg,
-                              sample.position_angle_deg, sample.output};
+                              sample.position_angle_deg, sample.outputs[0]};
       for (std::size_t i = 0; i < 5; ++i) {
         const double exact = std::strtod(texts[i].c_str(), nullptr);
         EXPECT_EQ(bits(read[i]), bits(exact)) << "'" << texts[i] << "', through a layout: " << through_layout;
@@ -346,7 +346,8 @@ std::string reading(const std::string& text, const std::optional<RecordLayout>& 
     RecordReader reader = RecordReader::from_string(text, layout, "mixed.csv", chunk);
     RecordSample s;
     while (reader.next(s)) {
-      for (const double v : {s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output})
+      for (const double v :
+           {s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.outputs[0]})
         out += std::to_string(bits(v)) + ",";
       for (std::size_t e = 0; e < reader.extra_column_count(); ++e)
         out += std::to_string(bits(s.extra[e])) + ",";

@@ -43,7 +43,7 @@ Outcome calibrate_with(const Scenario& s, std::uint64_t seed, const Fault& fault
   so.seed = seed;
   simulate(s, so, [&](RecordSample x) {
     if (fault) fault(x);
-    o.output.range.push(x.output);
+    o.output.range.push(x.outputs[0]);
     reducer.push(x);
   });
   const Reduction r = reducer.finish();
@@ -115,15 +115,15 @@ TEST(Misfit, TheIssuesFourRecordsAreRefusedWithTheirCauseNamed) {
   };
   const std::vector<Case> cases = {
       {"sign flipped",
-       [](RecordSample& x) { x.output = -x.output; },
+       [](RecordSample& x) { x.outputs[0] = -x.outputs[0]; },
        {"sign is flipped", "[record] output_scale_per_deg_h = -1 ", "chi2 = "}},
       {"deg/s where deg/h is configured",
-       [](RecordSample& x) { x.output /= 3600.0; },
+       [](RecordSample& x) { x.outputs[0] /= 3600.0; },
        {"the output is in deg/s", "[record] output_scale_per_deg_h = 0.000277778 "}},
       {"clipped at 15 deg/h",
-       [](RecordSample& x) { x.output = std::clamp(x.output, -15.0, 15.0); },
+       [](RecordSample& x) { x.outputs[0] = std::clamp(x.outputs[0], -15.0, 15.0); },
        {"saturated or clipped", "15 deg/h"}},
-      {"dead sensor writing 0.0", [](RecordSample& x) { x.output = 0.0; }, {"dead or disconnected"}},
+      {"dead sensor writing 0.0", [](RecordSample& x) { x.outputs[0] = 0.0; }, {"dead or disconnected"}},
   };
   for (const Case& c : cases)
     for (Method m : {Method::kLeastSquares, Method::kClosedForm}) {
@@ -144,7 +144,7 @@ TEST(Misfit, TheIssuesFourRecordsAreRefusedWithTheirCauseNamed) {
 }
 
 TEST(Misfit, AConstantOutputIsADeadSensorWhateverItsValue) {
-  const Outcome out = calibrate_with(default_30(), 3, [](RecordSample& x) { x.output = 5.0; });
+  const Outcome out = calibrate_with(default_30(), 3, [](RecordSample& x) { x.outputs[0] = 5.0; });
   ASSERT_TRUE(out.refused);
   EXPECT_NE(out.message.find("constant 5 deg/h"), std::string::npos) << out.message;
 }
@@ -165,7 +165,7 @@ TEST(Misfit, DriftPlusRateFitsASignAsAScaleFactorAndIsStillRefused) {
   ASSERT_FALSE(clean.refused) << clean.message;
   EXPECT_EQ(clean.result.misfit.scale, 1.0);
   const Outcome flipped = calibrate_with(
-      s, 3, [](RecordSample& x) { x.output = -x.output; }, o);
+      s, 3, [](RecordSample& x) { x.outputs[0] = -x.outputs[0]; }, o);
   ASSERT_TRUE(flipped.refused);
   EXPECT_NE(flipped.message.find("scale-factor error is -2"), std::string::npos) << flipped.message;
   EXPECT_NE(flipped.message.find("output_scale_per_deg_h = -1 "), std::string::npos) << flipped.message;
@@ -178,7 +178,7 @@ TEST(Misfit, ASelfCalibrationNamesAFlippedSignRatherThanFailingToConverge) {
   o.estimate =
       parse_machine_error_names({"counter_perpendicularity_x", "counter_perpendicularity_y"}, "test");
   const Outcome out = calibrate_with(
-      s, 4, [](RecordSample& x) { x.output = -x.output; }, o);
+      s, 4, [](RecordSample& x) { x.outputs[0] = -x.outputs[0]; }, o);
   ASSERT_TRUE(out.refused);
   EXPECT_NE(out.message.find("sign is flipped"), std::string::npos) << out.message;
 }
@@ -222,7 +222,7 @@ TEST(Misfit, AModestTemperatureDriftIsAcceptedWithHonestUncertainties) {
   // refused, and over 100 seeds (the least the issue asks; the spread of a std over 100 is about 0.07)
   // (estimate - truth) / std has a standard deviation <= 1.15 for every identifiable coefficient.
   const Scenario s = default_30();
-  const Fault drift = [](RecordSample& x) { x.output += 0.5 / 3600.0 * x.time_s; };
+  const Fault drift = [](RecordSample& x) { x.outputs[0] += 0.5 / 3600.0 * x.time_s; };
   const int seeds = 100;
   std::vector<std::vector<double>> z(kNumGyroCoefficients);
   int scaled = 0;
@@ -248,7 +248,7 @@ TEST(Misfit, ALargeDriftScalesEveryStdAndSaysSo) {
   // 20 deg/h per hour: every record misfits beyond chance, no set-up mistake explains it, so std is scaled by
   // sqrt(chi2/dof), stated in the warning and the JSON, and stays honest (conservative: the drift is smooth).
   const Scenario s = default_30();
-  const Fault drift = [](RecordSample& x) { x.output += 20.0 / 3600.0 * x.time_s; };
+  const Fault drift = [](RecordSample& x) { x.outputs[0] += 20.0 / 3600.0 * x.time_s; };
   std::vector<double> z;
   for (int seed = 0; seed < 20; ++seed) {
     const Outcome out = calibrate_with(s, 3000 + static_cast<std::uint64_t>(seed), drift);

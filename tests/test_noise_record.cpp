@@ -52,7 +52,7 @@ void write_full(const std::filesystem::path& path, const std::vector<double>& y,
     s.time_s = time_of(i);
     s.main_angle_deg = wrap_deg(main_rate_rad_s * s.time_s * kRadToDeg);
     s.counter_angle_deg = wrap_deg(-s.main_angle_deg);
-    s.output = y[i];
+    s.outputs[0] = y[i];
     writer.write(s);
   }
   writer.finish();
@@ -133,7 +133,7 @@ TEST_F(NoiseRecord, AnAccelerometersOutputAloneIsReadInGAndNotTakenForAGyros) {
   EXPECT_EQ(reader.extra_column_count(), 1u);
   RecordSample s;
   ASSERT_TRUE(reader.next(s));
-  EXPECT_EQ(s.output, y[0]);
+  EXPECT_EQ(s.outputs[0], y[0]);
   EXPECT_EQ(s.extra[0], 21.5);
   EXPECT_TRUE(std::isnan(s.main_angle_deg));
   // Characterised as an accelerometer's (in ug), not a gyro's; a gyro's configuration refuses it.
@@ -174,7 +174,7 @@ TEST_F(NoiseRecord, APlatformMovedDuringTheRecordIsRefusedByItsExtent) {
   for (std::size_t i = 0; i < y.size(); ++i) {
     s.time_s = time_of(i);
     s.position_angle_deg = i < y.size() / 2 ? 90.0 : 180.0;
-    s.output = y[i];
+    s.outputs[0] = y[i];
     writer.write(s);
   }
   writer.finish();

@@ -217,7 +217,7 @@ void write_static_record(const std::filesystem::path& path, std::size_t rows, st
   sample.position_angle_deg = 90.0;
   for (std::size_t i = 0; i < rows; ++i) {
     sample.time_s = static_cast<double>(i) / 20.0;
-    sample.output = generator.next(9.5);
+    sample.outputs[0] = generator.next(9.5);
     if (hole_at == 0 || i < hole_at || i >= hole_at + 3) writer.write(sample);
   }
   writer.finish();

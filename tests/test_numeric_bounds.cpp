@@ -235,7 +235,7 @@ TEST(OutputBounds, CalibrateAndNoiseRefuseTheSampleNamingLineAndColumnAndWriteNo
     std::ofstream out(dir / "big.csv");
     RecordWriter writer(out, {}, {});
     for (RecordSample x : record_of(s)) {
-      x.output = 1e200;
+      x.outputs[0] = 1e200;
       writer.write(x);
     }
     writer.finish();
@@ -274,7 +274,7 @@ TEST(OutputBounds, TheReducerSaysWhyADwellOfHugeOutputsHasNoScatter) {
   // overflows; the refusal says so rather than "too few revolutions".
   const Scenario s = small_test();
   std::vector<RecordSample> rows = record_of(s);
-  for (RecordSample& x : rows) x.output = 1e200;
+  for (RecordSample& x : rows) x.outputs[0] = 1e200;
   const std::string m = refusal([&] { reduce_rows(s, rows); });
   EXPECT_FALSE(contains(m, "too few")) << m;
   EXPECT_TRUE(contains(m, "1e+200")) << m;
@@ -337,7 +337,7 @@ TEST(TinyOutputs, AVaryingOutputIsNotCalledConstant) {
   // calibration of nonsense (exit 0) once they are no longer called constant.
   const Scenario s = small_test();
   std::vector<RecordSample> rows = record_of(s);
-  for (RecordSample& x : rows) x.output *= 1e-300;
+  for (RecordSample& x : rows) x.outputs[0] *= 1e-300;
   const std::string m = refusal([&] {
     const Reduction r = reduce_rows(s, rows);
     CalibrationOptions o;

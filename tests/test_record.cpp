@@ -104,8 +104,8 @@ TEST(Record, RoundTripIsBitForBit) {
       // The output within its bound (limits::kOutputMagnitude; beyond it the reader refuses the row, as
       // test_numeric_bounds checks), over the whole range of magnitudes below it.
       do {
-        sample.output = random_double(random);
-      } while (!(std::abs(sample.output) <= limits::kOutputMagnitude));
+        sample.outputs[0] = random_double(random);
+      } while (!(std::abs(sample.outputs[0]) <= limits::kOutputMagnitude));
       sample.extra[0] = random_double(random);
       sample.extra[1] = random_double(random);
       writer.write(sample);
@@ -123,7 +123,7 @@ TEST(Record, RoundTripIsBitForBit) {
                                {a.main_angle_deg, b.main_angle_deg},
                                {a.counter_angle_deg, b.counter_angle_deg},
                                {a.position_angle_deg, b.position_angle_deg},
-                               {a.output, b.output},
+                               {a.outputs[0], b.outputs[0]},
                                {a.extra[0], b.extra[0]},
                                {a.extra[1], b.extra[1]}};
     for (const auto& pair : pairs) {
@@ -282,7 +282,7 @@ TEST(Record, LinesCrossingChunkBoundariesFromAFile) {
     for (int i = 0; i < rows; ++i) {
       sample.time_s = i * 0.005;
       sample.main_angle_deg = i * 2.8359375;
-      sample.output = 1.0 / (i + 1);
+      sample.outputs[0] = 1.0 / (i + 1);
       sample.extra[0] = 20.0 + i * 1e-6;
       writer.write(sample);
     }
@@ -297,7 +297,7 @@ TEST(Record, LinesCrossingChunkBoundariesFromAFile) {
     while (reader.next(sample)) {
       ASSERT_EQ(sample.time_s, count * 0.005);
       ASSERT_EQ(sample.main_angle_deg, count * 2.8359375);
-      ASSERT_EQ(sample.output, 1.0 / (count + 1));
+      ASSERT_EQ(sample.outputs[0], 1.0 / (count + 1));
       ASSERT_EQ(sample.extra[0], 20.0 + count * 1e-6);
       ++count;
     }
@@ -324,7 +324,7 @@ TEST(Record, WriterRefusesWhatTheReaderWouldRefuse) {
   writer.write(sample);
   EXPECT_THROW(writer.write(sample), Error);  // time does not increase
   sample.time_s = 1.0;
-  sample.output = std::numeric_limits<double>::quiet_NaN();
+  sample.outputs[0] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(writer.write(sample), Error);
   EXPECT_THROW(RecordWriter(out, {{"a=b", "c"}}, {}), Error);
   EXPECT_THROW(RecordWriter(out, {{"a", "line\nbreak"}}, {}), Error);

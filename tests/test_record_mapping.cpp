@@ -122,7 +122,7 @@ output_scale_per_deg_h = 2.5
       ASSERT_EQ(read[i].counter_angle_deg, degrees(r.counter, kCounter)) << i;
       ASSERT_EQ(read[i].position_angle_deg, degrees(r.position, kPosition)) << i;
       // 0.3125 mV / (2.5 mV per deg/h) = 0.125 deg/h per k, exactly.
-      ASSERT_EQ(read[i].output, static_cast<double>(r.output_k) * 0.125) << i;
+      ASSERT_EQ(read[i].outputs[0], static_cast<double>(r.output_k) * 0.125) << i;
     }
   }
 }
@@ -185,7 +185,7 @@ output_column = "w"
       ASSERT_NEAR(angle, deg[static_cast<std::size_t>(i)],
                   1e-13 * std::abs(deg[static_cast<std::size_t>(i)]) + 1e-15);
     }
-    ASSERT_EQ(s.output, 0.25 * i);
+    ASSERT_EQ(s.outputs[0], 0.25 * i);
   }
   EXPECT_FALSE(reader.next(s));
 }
@@ -203,7 +203,7 @@ TEST(RecordMapping, TabsQuotedNamesAndTheNativeMagicLineAndMetadata) {
   EXPECT_EQ(s.time_s, 0.5);
   ASSERT_TRUE(reader.next(s));
   EXPECT_EQ(s.main_angle_deg, 5.0);
-  EXPECT_EQ(s.output, 8.0);
+  EXPECT_EQ(s.outputs[0], 8.0);
   // An empty field between two tabs is a field, not a longer delimiter.
   const std::string message = read_error(
       "time s\tmain_angle_deg\tcounter_angle_deg\tposition_angle_deg\tgyro_deg_h\n0\t1\t\t3\t4\n", layout);
@@ -223,7 +223,7 @@ TEST(RecordMapping, AnEmptySectionReadsGyrocalsColumnsByNameWithoutTheMagicLine)
   EXPECT_EQ(rows[0].main_angle_deg, 1.0);
   EXPECT_EQ(rows[0].counter_angle_deg, 2.0);
   EXPECT_EQ(rows[0].position_angle_deg, 3.0);
-  EXPECT_EQ(rows[0].output, 4.0);
+  EXPECT_EQ(rows[0].outputs[0], 4.0);
   // Without a [record] section the magic line is still required.
   EXPECT_NE(read_error(text, std::nullopt).find("this is not a gyrocal record"), std::string::npos);
 }
@@ -236,7 +236,7 @@ TEST(RecordMapping, AbsentAngleColumnsReadAsNaNAndCalibrationRefusesThem) {
   EXPECT_TRUE(std::isnan(rows[1].main_angle_deg));
   EXPECT_TRUE(std::isnan(rows[1].counter_angle_deg));
   EXPECT_EQ(rows[1].position_angle_deg, 4.0);
-  EXPECT_EQ(rows[1].output, 3.0);
+  EXPECT_EQ(rows[1].outputs[0], 3.0);
   const Scenario s = default_scenario();
   try {
     calibrate_record("static.csv", s.model(), s.test, CalibrationOptions{}, layout);
@@ -397,7 +397,7 @@ std::string foreign_layout(const std::string& native) {
     return static_cast<long long>(std::llround(deg / 360.0 * kCountsPerRev));
   };
   while (reader.next(s)) {
-    std::snprintf(line, sizeof line, "%.17g;%lld;%lld;%lld;%lld\n", s.output * kMillivoltsPerDegH,
+    std::snprintf(line, sizeof line, "%.17g;%lld;%lld;%lld;%lld\n", s.outputs[0] * kMillivoltsPerDegH,
                   static_cast<long long>(std::llround(s.time_s * 1000.0)), counts(s.position_angle_deg),
                   counts(s.main_angle_deg) % kCountsPerRev, counts(s.counter_angle_deg));
     out << line;

@@ -62,12 +62,12 @@ position_angle_offset_deg = 90.0
   EXPECT_EQ(s.main_angle_deg, 3.0);       // 20.25 - 17.25
   EXPECT_EQ(s.counter_angle_deg, 2.0);    // 1.5 + 0.5
   EXPECT_EQ(s.position_angle_deg, 45.0);  // 135 - 90
-  EXPECT_EQ(s.output, 10.0);              // (75 - 100) / -2.5
+  EXPECT_EQ(s.outputs[0], 10.0);          // (75 - 100) / -2.5
   ASSERT_TRUE(reader.next(s));
   EXPECT_EQ(s.time_s, 1.0);
   EXPECT_EQ(s.main_angle_deg, -27.25);
   EXPECT_EQ(s.position_angle_deg, 0.125);
-  EXPECT_EQ(s.output, -10.0);  // (125 - 100) / -2.5
+  EXPECT_EQ(s.outputs[0], -10.0);  // (125 - 100) / -2.5
   EXPECT_FALSE(reader.next(s));
 
   // A '.' in a record read with a decimal comma is not a number, and the message says which field.

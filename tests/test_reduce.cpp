@@ -96,7 +96,7 @@ TEST(Spikes, OneSampleNeverMovesAnEstimateAndIsCounted) {
   for (const auto& [where, t] : spike_times(s)) {
     for (double spike : {1e6, 1e200}) {
       std::vector<RecordSample> rows = clean;
-      rows[row_at(rows, t)].output = spike;
+      rows[row_at(rows, t)].outputs[0] = spike;
       const Calibrated c = calibrate_rows(s, rows);
       const std::string tag = where + ", " + std::to_string(spike);
       const bool inside = where.rfind("in a dwell", 0) == 0;
@@ -135,8 +135,8 @@ TEST(Spikes, ANoiseFreeRecordWithASpikeIsIdentifiedExactly) {
   const Timeline tl = make_timeline(s.test, s.model());
   for (int d : {0, 2}) {
     const MeasurementInterval& m = tl.measurements.at(static_cast<std::size_t>(d));
-    rows[row_at(rows, m.start_s + 1.0)].output += 500.0;
-    rows[row_at(rows, m.start_s + 3.0)].output -= 2e4;
+    rows[row_at(rows, m.start_s + 1.0)].outputs[0] += 500.0;
+    rows[row_at(rows, m.start_s + 3.0)].outputs[0] -= 2e4;
   }
   const Calibrated c = calibrate_rows(s, rows);
   EXPECT_EQ(c.reduction.outliers, 4u);
@@ -220,7 +220,7 @@ TEST(Spikes, AStaticHoldRejectsASpikeToo) {
   const Timeline tl = make_timeline(s.test, s.model());
   const MeasurementInterval& hold = tl.measurements.back();
   std::vector<RecordSample> rows = clean;
-  rows[row_at(rows, 0.5 * (hold.start_s + hold.end_s))].output = -1e6;
+  rows[row_at(rows, 0.5 * (hold.start_s + hold.end_s))].outputs[0] = -1e6;
   const Calibrated c = calibrate_rows(s, rows);
   EXPECT_EQ(c.reduction.outliers, 1u);
   for (std::size_t k = 0; k < kNumGyroCoefficients; ++k)

@@ -88,7 +88,7 @@ TEST(Simulate, NoiseFreeOutputIsTheModelAtTheRecordedAngles) {
     j.counter_rate_rad_s = m->kind == SegmentKind::kDwell ? -m->rate_rad_s + delta_omega : 0.0;
     j.position_angle_rad = row.position_angle_deg * kDegToRad;
     const SensorInputs in = exact_inputs(model, j);
-    ASSERT_NEAR(row.output, gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g), 1e-9)
+    ASSERT_NEAR(row.outputs[0], gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g), 1e-9)
         << "at t = " << row.time_s << " s";
     ++checked[m];
   }
@@ -137,7 +137,7 @@ TEST(Simulate, AnAccelerometersRecordIsItsModelAtTheRecordedAngles) {
                  k[AccelCoefficient::Kpo] * f.y() * f.z() + k[AccelCoefficient::Kpp] * f.y() * f.y() +
                  k[AccelCoefficient::Koo] * f.z() * f.z() + k[AccelCoefficient::delta_p] * f.y() +
                  k[AccelCoefficient::delta_o] * f.z());
-    ASSERT_NEAR(row.output, 1.25 * input, 1e-12) << "at t = " << row.time_s << " s";
+    ASSERT_NEAR(row.outputs[0], 1.25 * input, 1e-12) << "at t = " << row.time_s << " s";
     ++checked;
   }
   EXPECT_GT(checked, 100u);
@@ -220,7 +220,7 @@ TEST(Simulate, SameSeedSameBytesAnotherSeedOtherBytes) {
   for (std::size_t i = 0; i < rows_a.size(); ++i) {
     EXPECT_EQ(rows_a[i].main_angle_deg, rows_b[i].main_angle_deg);
     EXPECT_EQ(rows_a[i].counter_angle_deg, rows_b[i].counter_angle_deg);
-    different += rows_a[i].output != rows_b[i].output;
+    different += rows_a[i].outputs[0] != rows_b[i].outputs[0];
   }
   EXPECT_EQ(different, int(rows_a.size()));
 }

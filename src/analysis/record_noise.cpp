@@ -358,7 +358,7 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
   while (reader.next(sample)) {
     sampling.add(sample.time_s);
     motion.add(sample);
-    rate_deg_h.push_back(sample.output * to_noise_unit);
+    rate_deg_h.push_back(sample.outputs[0] * to_noise_unit);
   }
   motion.check(name);
   return characterise(rate_deg_h, sampling.finish(), name, sensor);

@@ -173,7 +173,7 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
   const Reduction reduction =
       reduce_record(reader, reduction_plan(plan, options.sensor, options.reduce), options.reduce,
                     model.geometry().rate_rad_s, [&o](std::span<const RecordSample> rows) {
-                      for (const RecordSample& s : rows) o.output.range.push(s.output);
+                      for (const RecordSample& s : rows) o.output.range.push(s.outputs[0]);
                     });
   const std::vector<PositionModelTerms> model_terms =
       options.sensor == SensorKind::kGyro ? reduce_model_terms(reduction, model, options.reduce)

@@ -129,21 +129,45 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                             "record.output_scale_per_g instead",
                             output_scale_per_deg_h));
   }
-  if (output_unit_name.size() > limits::kOutputUnitBytes)
-    return fail("output_unit", fmt::format("record.output_unit '{}...' is {} bytes long, more than the {} a "
-                                           "unit's name may have (it is printed in every table)",
-                                           output_unit_name.substr(0, limits::kOutputUnitBytes),
-                                           output_unit_name.size(), limits::kOutputUnitBytes));
-  for (char c : output_unit_name) {
-    const auto u = static_cast<unsigned char>(c);
-    if (std::isalnum(u) == 0 || u >= 0x80) {
-      if (std::string_view("/^*._%-").find(c) != std::string_view::npos) continue;
-      return fail(
-          "output_unit",
-          fmt::format("record.output_unit '{}' holds {}: a unit's name is letters, digits and / ^ * . _ "
-                      "% - (\"V\", \"mV\", \"mA\", \"counts\"; \"u\" for micro)",
-                      output_unit_name, printable(c)));
+  // A unit's name is printed in every table and stored with every result: a few letters, digits and signs.
+  const auto unit_name_problem = [&](std::string_view k,
+                                     const std::string& name) -> std::optional<std::string> {
+    if (name.size() > limits::kOutputUnitBytes)
+      return fmt::format(
+          "record.{} '{}...' is {} bytes long, more than the {} a unit's name may have (it is "
+          "printed in every table)",
+          k, name.substr(0, limits::kOutputUnitBytes), name.size(), limits::kOutputUnitBytes);
+    for (char c : name) {
+      const auto u = static_cast<unsigned char>(c);
+      if ((std::isalnum(u) == 0 || u >= 0x80) &&
+          std::string_view("/^*._%-").find(c) == std::string_view::npos)
+        return fmt::format(
+            "record.{} '{}' holds {}: a unit's name is letters, digits and / ^ * . _ % - (\"V\", "
+            "\"mV\", \"mA\", \"counts\"; \"u\" for micro)",
+            k, name, printable(c));
     }
+    return std::nullopt;
+  };
+  if (auto problem = unit_name_problem("output_unit", output_unit_name)) return fail("output_unit", *problem);
+  if (outputs.size() > limits::kMaxOutputColumns)
+    return fail("outputs", fmt::format("record.outputs holds {} output columns, more than the {} a record is "
+                                       "read with at once (limits::kMaxOutputColumns)",
+                                       outputs.size(), limits::kMaxOutputColumns));
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const OutputColumn& o = outputs[i];
+    const std::string k = fmt::format("outputs[{}]", i);
+    if (!(std::isfinite(o.scale) && o.scale != 0.0))
+      return fail(
+          k, fmt::format("record.{}.scale must be a finite non-zero number (output units per {}), not {}", k,
+                         o.unit(), o.scale));
+    if (!std::isfinite(o.offset))
+      return fail(k, fmt::format("record.{}.offset must be a finite number, not {}", k, o.offset));
+    if (o.form != OutputForm::kRate)
+      return fail(k,
+                  fmt::format("record.{} ('{}') holds increments, which gyrocal does not read yet: give its "
+                              "values as rates (an increment divided by its interval)",
+                              k, o.column));
+    if (auto problem = unit_name_problem(k + ".unit_name", o.unit_name)) return fail(k, *problem);
   }
   const std::array<std::pair<std::string_view, double>, 4> offsets = {{
       {"output_offset", output_offset},
@@ -171,16 +195,19 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                                     name, value));
     }
   }
-  const std::array<std::pair<std::string_view, const std::string*>, 5> columns = {{
+  // The output columns are the output keys' one, or each of `outputs` (then output_column is not read).
+  std::vector<std::pair<std::string, const std::string*>> columns = {
       {"time_column", &time_column},
       {"main_angle_column", &main_angle_column},
       {"counter_angle_column", &counter_angle_column},
       {"position_angle_column", &position_angle_column},
-      {"output_column", &output_column},
-  }};
+  };
+  if (outputs.empty()) columns.emplace_back("output_column", &output_column);
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    columns.emplace_back(fmt::format("outputs[{}].column", i), &outputs[i].column);
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const auto& [name, column] = columns[i];
-    const bool required = name == "time_column" || name == "output_column";
+    const bool required = i == 0 || i >= 4;  // the time and the outputs
     if (column->empty()) {
       if (!required) continue;
       return fail(name, fmt::format("record.{} must name a column; only the angle columns may be empty "
@@ -224,6 +251,24 @@ bool RecordLayout::is_default_angle_name(std::string_view name) {
   const RecordLayout defaults;
   return name == defaults.main_angle_column || name == defaults.counter_angle_column ||
          name == defaults.position_angle_column;
+}
+
+std::string_view OutputColumn::unit() const {
+  return quantity == OutputQuantity::kSpecificForce ? "g" : "deg/h";
+}
+
+std::string OutputColumn::column_unit() const {
+  return unit_name.empty() ? std::string(unit()) : unit_name;
+}
+
+std::string_view OutputColumn::scale_key() const {
+  return quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g" : "output_scale_per_deg_h";
+}
+
+std::vector<OutputColumn> RecordLayout::output_columns() const {
+  if (!outputs.empty()) return outputs;
+  return {OutputColumn{output_column, output_quantity, OutputForm::kRate, output_scale(), output_offset,
+                       output_unit_name}};
 }
 
 double RecordLayout::output_scale() const {

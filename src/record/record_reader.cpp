@@ -24,6 +24,8 @@ namespace gyrocal {
 namespace {
 
 constexpr std::size_t kColumnCountMax = kRecordColumns.size() + kMaxExtraColumns;
+// A layout reads its outputs into slots 4, 5, …
+static_assert(4 + limits::kMaxOutputColumns <= kColumnCountMax);
 
 bool is_blank(char c) {
   return c == ' ' || c == '\t';
@@ -108,8 +110,12 @@ struct RecordReader::State {
   std::array<double, 3> angle_divisor{1.0, 1.0, 1.0};     ///< counts per revolution, or 1
   std::array<double, 3> angle_offset{0.0, 0.0, 0.0};      ///< deg, subtracted after the conversion
   std::array<bool, 3> angle_present{true, true, true};
-  double output_offset = 0.0;
-  double output_divisor = 1.0;
+  // A layout's output columns (RecordLayout::output_columns()), into value slots 4, 5, …: each value is
+  // (reading - offset) / divisor.
+  std::vector<OutputColumn> outputs;
+  std::size_t output_count = 0;  ///< outputs.size(), read every row
+  std::array<double, limits::kMaxOutputColumns> output_offset{};
+  std::array<double, limits::kMaxOutputColumns> output_divisor{};
   fast_float::parse_options number_options{fast_float::chars_format::general, '.'};
   char decimal = '.';
   // gyrocal's own format with only the time and the output (time_s,gyro_deg_h or time_s,accel_g).
@@ -175,8 +181,12 @@ struct RecordReader::State {
       angle_present[i] = !names[i]->empty();
     }
     angle_offset = {l.main_angle_offset_deg, l.counter_angle_offset_deg, l.position_angle_offset_deg};
-    output_offset = l.output_offset;
-    output_divisor = l.output_scale();
+    outputs = l.output_columns();
+    output_count = outputs.size();
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+      output_offset[i] = outputs[i].offset;
+      output_divisor[i] = outputs[i].scale;
+    }
     decimal = l.decimal;
     number_options = fast_float::parse_options{fast_float::chars_format::general, l.decimal};
   }
@@ -382,13 +392,18 @@ struct RecordReader::State {
     }
   }
 
-  /// The layout's column keys and names, in slot order (time, main, counter, position, output).
-  std::array<std::pair<std::string_view, const std::string*>, 5> mapped_columns() const {
-    return {{{"time_column", &layout->time_column},
-             {"main_angle_column", &layout->main_angle_column},
-             {"counter_angle_column", &layout->counter_angle_column},
-             {"position_angle_column", &layout->position_angle_column},
-             {"output_column", &layout->output_column}}};
+  /// The layout's column keys and names, in slot order (time, main, counter, position, then each output).
+  std::vector<std::pair<std::string, const std::string*>> mapped_columns() const {
+    std::vector<std::pair<std::string, const std::string*>> mapped = {
+        {"time_column", &layout->time_column},
+        {"main_angle_column", &layout->main_angle_column},
+        {"counter_angle_column", &layout->counter_angle_column},
+        {"position_angle_column", &layout->position_angle_column}};
+    for (std::size_t i = 0; i < outputs.size(); ++i)
+      mapped.emplace_back(
+          layout->outputs.empty() ? std::string("output_column") : fmt::format("outputs[{}].column", i),
+          &outputs[i].column);
+    return mapped;
   }
 
   /// Reads the head of a record through a layout (docs/records.md): blank lines, comment lines (metadata
@@ -662,19 +677,22 @@ struct RecordReader::State {
                      printable(layout->time_column), time_s, previous_time_s));
   }
 
-  /// Refuses the output of the row just read, beyond limits::kOutputMagnitude in magnitude (or not finite
+  /// Refuses output `k` of the row just read, beyond limits::kOutputMagnitude in magnitude (or not finite
   /// after a layout's conversion): `raw` as the field read, `output` in deg/h or g. Names the line and the
   /// column, and for a layout the conversion that gave the value.
-  [[noreturn, gnu::noinline, gnu::cold]] void fail_output(double raw, double output) const {
-    const auto column = static_cast<std::size_t>(std::find(slot.begin(), slot.end(), 4) - slot.begin());
+  [[noreturn, gnu::noinline, gnu::cold]] void fail_output(double raw, double output,
+                                                          std::size_t k = 0) const {
+    const auto column =
+        static_cast<std::size_t>(std::find(slot.begin(), slot.end(), static_cast<int>(4 + k)) - slot.begin());
     const std::string_view unit =
-        layout ? layout->output_unit() : (output_name == kLoneOutputColumns[1] ? "g" : "deg/h");
+        layout ? outputs[k].unit() : (output_name == kLoneOutputColumns[1] ? "g" : "deg/h");
     const std::string conversion =
-        layout ? fmt::format(
-                     ", which reads as {} {} ((value - record.output_offset) / record.{})", output, unit,
-                     layout->output_quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g"
-                                                                               : "output_scale_per_deg_h")
-               : std::string();
+        !layout ? std::string()
+        : layout->outputs.empty()
+            ? fmt::format(", which reads as {} {} ((value - record.output_offset) / record.{})", output, unit,
+                          outputs[k].scale_key())
+            : fmt::format(", which reads as {} {} ((value - offset) / scale of record.outputs[{}])", output,
+                          unit, k);
     fail(fmt::format(
         "column {} ({}) is {}{}; an output is at most {} {} in magnitude (limits::kOutputMagnitude): no "
         "sensor "
@@ -832,10 +850,13 @@ bool RecordReader::has_angles() const {
   return state_->angle_present[0] && state_->angle_present[1] && state_->angle_present[2];
 }
 const std::string& RecordReader::output_column() const {
-  return state_->layout ? state_->layout->output_column : state_->output_name;
+  return state_->layout ? state_->outputs.front().column : state_->output_name;
+}
+std::size_t RecordReader::output_count() const {
+  return state_->layout ? state_->outputs.size() : 1;
 }
 std::string_view RecordReader::output_unit() const {
-  if (state_->layout) return state_->layout->output_unit();
+  if (state_->layout) return state_->outputs.front().unit();
   return state_->output_name == kLoneOutputColumns[1] ? "g" : "deg/h";
 }
 void RecordReader::require_angles() const {
@@ -876,14 +897,14 @@ bool RecordReader::next(RecordSample& sample) {
     if (s.lone_output) {
       constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
       sample.main_angle_deg = sample.counter_angle_deg = sample.position_angle_deg = kNaN;
-      sample.output = values[4];
+      sample.outputs[0] = values[4];
       std::copy(values + kRecordColumns.size(), values + s.columns.size() + 3, sample.extra.begin());
       return true;
     }
     sample.main_angle_deg = values[1];
     sample.counter_angle_deg = values[2];
     sample.position_angle_deg = values[3];
-    sample.output = values[4];
+    sample.outputs[0] = values[4];
     std::copy(values + kRecordColumns.size(), values + s.columns.size(), sample.extra.begin());
     return true;
   }
@@ -894,9 +915,12 @@ bool RecordReader::next(RecordSample& sample) {
                      ? values[i + 1] * s.angle_multiplier[i] / s.angle_divisor[i] - s.angle_offset[i]
                      : std::numeric_limits<double>::quiet_NaN();
   }
-  sample.output = (values[4] - s.output_offset) / s.output_divisor;
-  if (!(std::abs(sample.output) <= limits::kOutputMagnitude)) [[unlikely]]
-    s.fail_output(values[4], sample.output);
+  const std::size_t n = s.output_count;
+  for (std::size_t k = 0; k < n; ++k) {
+    sample.outputs[k] = (values[4 + k] - s.output_offset[k]) / s.output_divisor[k];
+    if (!(std::abs(sample.outputs[k]) <= limits::kOutputMagnitude)) [[unlikely]]
+      s.fail_output(values[4 + k], sample.outputs[k], k);
+  }
   return true;
 }
 

@@ -77,7 +77,7 @@ RecordWriter::~RecordWriter() {
 
 void RecordWriter::write(const RecordSample& sample) {
   const double fixed[] = {sample.time_s, sample.main_angle_deg, sample.counter_angle_deg,
-                          sample.position_angle_deg, sample.output};
+                          sample.position_angle_deg, sample.outputs[0]};
   for (std::size_t i = 0; i < kRecordColumns.size() + extra_count_; ++i) {
     const double value = i < kRecordColumns.size() ? fixed[i] : sample.extra[i - kRecordColumns.size()];
     if (!std::isfinite(value)) {

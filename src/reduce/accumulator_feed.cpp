@@ -14,13 +14,13 @@ AccumulatorFeed::~AccumulatorFeed() {
   if (thread_.joinable()) thread_.join();
 }
 
-void AccumulatorFeed::hand_over(DwellAccumulator* next) {
+void AccumulatorFeed::hand_over(std::span<DwellAccumulator> next) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (error_) std::rethrow_exception(error_);
   if (!open_.empty()) {
     changed_.wait(lock, [&] { return queue_.size() < kMaxBatches || error_; });
     if (error_) std::rethrow_exception(error_);
-    queue_.push_back({target_, std::move(open_)});
+    queue_.push_back({target_accs_, std::move(open_)});
     if (!thread_.joinable()) thread_ = std::thread([this] { work(); });
     changed_.notify_all();
     open_.clear();
@@ -30,12 +30,13 @@ void AccumulatorFeed::hand_over(DwellAccumulator* next) {
     }
   }
   if (open_.capacity() < kBatchSamples) open_.reserve(kBatchSamples);
-  target_ = next;
+  target_accs_ = next;
+  target_ = next.data();
 }
 
 void AccumulatorFeed::sync() {
   if (!threaded_) return;
-  hand_over(nullptr);
+  hand_over({});
   std::unique_lock<std::mutex> lock(mutex_);
   changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
   if (error_) std::rethrow_exception(error_);
@@ -52,11 +53,28 @@ void AccumulatorFeed::work() {
     changed_.notify_all();  // a slot is free
     lock.unlock();
     try {
-      for (const Item& s : b.items) {
-        if (s.break_revolution)
-          b.acc->break_revolution();
-        else
-          b.acc->add(s.time_s, s.gamma_rad, &s.value);
+      // The items are whole rows (add hands a group over before a row that would not fit): the k-th
+      // sample of a row goes to the k-th accumulator.
+      const std::size_t n = b.accs.size();
+      if (n == 1) {
+        // A lone sensor's column: one accumulator, no column count to keep.
+        DwellAccumulator& acc = b.accs.front();
+        for (const Item& s : b.items) {
+          if (s.break_revolution)
+            acc.break_revolution();
+          else
+            acc.add(s.time_s, s.gamma_rad, &s.value);
+        }
+      } else {
+        std::size_t k = 0;
+        for (const Item& s : b.items) {
+          if (s.break_revolution) {
+            for (DwellAccumulator& acc : b.accs) acc.break_revolution();
+            continue;
+          }
+          b.accs[k].add(s.time_s, s.gamma_rad, &s.value);
+          if (++k == n) k = 0;
+        }
       }
     } catch (...) {
       lock.lock();

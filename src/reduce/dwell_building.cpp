@@ -56,10 +56,10 @@ void Reducer::State::finish_run(Run& r) {
   }
   const bool long_enough =
       r.n >= 2 && (r.match.is_static ? r.n >= static_cast<std::size_t>(2 * options.static_batches)
-                                     : r.acc->complete_revolutions() >= 1);
+                                     : r.accs.front().complete_revolutions() >= 1);
   if (!long_enough) {
     reject(r, fmt::format("it measured only {:.3f} s of the {:.3f} s planned: {}",
-                          r.measuring ? r.acc->last_time_s() - r.t_first : 0.0, r.planned_duration,
+                          r.measuring ? r.accs.front().last_time_s() - r.t_first : 0.0, r.planned_duration,
                           r.quality.ended));
     return;
   }
@@ -72,8 +72,8 @@ void Reducer::State::finish_run(Run& r) {
   // biased by up to half a count (docs/calibration.md).
   d.beta_rad = r.match.beta_rad;
   d.gammas_rad = d.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan);
-  d.first_time_s = r.acc->first_time_s();
-  d.last_time_s = r.acc->last_time_s();
+  d.first_time_s = r.accs.front().first_time_s();
+  d.last_time_s = r.accs.front().last_time_s();
   d.samples = r.n;
   d.gaps = r.gaps;
   d.planned_duration_s = r.planned_duration;
@@ -144,18 +144,26 @@ void Reducer::State::finish_run(Run& r) {
           ? fmt::format("dwell at {} rad/s, counter rate offset {} rad/s, beta {:.4f} deg",
                         d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s, beta_deg)
           : fmt::format("dwell at {} rad/s, beta {:.4f} deg", d.planned_rate_rad_s, beta_deg);
-  d.output = r.acc->finish(0);
+  // Each output column's values, from its own accumulator: its own outliers and standard errors.
+  d.output = r.accs.front().finish(0);
+  std::vector<DwellValues> more;
+  more.reserve(r.accs.size() - 1);
+  for (std::size_t k = 1; k < r.accs.size(); ++k) more.push_back(r.accs[k].finish(0));
   // docs/physics.md section 14: a dwell that loses many samples is warned about (1 % is far above the rate
   // at which clean noise reaches the rule's threshold).
   const std::string place = fmt::format("the {} at t = {:.3f} s", what, d.first_time_s);
-  if (static_cast<double>(d.output.outliers) > 0.01 * static_cast<double>(d.samples))
+  for (std::size_t k = 0; k < r.accs.size(); ++k) {
+    const std::size_t outliers = k == 0 ? d.output.outliers : more[k - 1].outliers;
+    if (static_cast<double>(outliers) <= 0.01 * static_cast<double>(d.samples)) continue;
+    const std::string column = output_names.size() > k ? fmt::format(" (output {})", output_names[k]) : "";
     warnings.add("outliers",
-                 fmt::format("{}: {}: {} of its {} samples ({:.1f} %) were rejected as outliers (beyond {} "
+                 fmt::format("{}: {}: {} of its {} samples{} ({:.1f} %) were rejected as outliers (beyond {} "
                              "robust standard deviations of the dwell's fit) and left out of it.",
-                             at(d.first_time_s), what, d.output.outliers, d.samples,
-                             100.0 * static_cast<double>(d.output.outliers) / static_cast<double>(d.samples),
+                             at(d.first_time_s), what, outliers, d.samples, column,
+                             100.0 * static_cast<double>(outliers) / static_cast<double>(d.samples),
                              options.outlier_threshold),
                  place);
+  }
   // Checks a test engineer wants to hear about.
   const double measured = d.last_time_s - d.first_time_s + d.sample_interval_s;
   if (measured < d.planned_duration_s - 2.0 * d.sample_interval_s) {
@@ -188,14 +196,15 @@ void Reducer::State::finish_run(Run& r) {
       worst_rate_offset = std::max(worst_rate_offset, rel);
     }
   }
-  keep(std::move(d));
+  keep(std::move(d), std::move(more));
 }
 
-void Reducer::State::keep(Dwell d) {
+void Reducer::State::keep(Dwell d, std::vector<DwellValues> more) {
   const std::size_t serial = dwells_found++;
   const auto [it, first] = dwell_of_key.emplace(dwell_key(d), dwells.size());
   if (first) {
     dwells.push_back(std::move(d));
+    more_outputs.push_back(std::move(more));
     dwell_serial.push_back(serial);
     return;
   }
@@ -207,6 +216,7 @@ void Reducer::State::keep(Dwell d) {
                           d.beta_rad * kRadToDeg, d.first_time_s));
   if (d.samples > dwells[it->second].samples) {
     dwells[it->second] = std::move(d);
+    more_outputs[it->second] = std::move(more);
     dwell_serial[it->second] = serial;
   }
 }

@@ -9,13 +9,16 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
 #include "gyrocal/reduce/record_summary.hpp"
 
 namespace gyrocal {
 
 namespace {
 
-/// Rows read ahead by the reader's thread: kReadAheadBatches batches of kReadAheadRows rows (3.4 MB).
+/// Rows read ahead by the reader's thread: kReadAheadBatches batches of kReadAheadRows rows (5.2 MB).
 constexpr std::size_t kReadAheadRows = 8192;
 constexpr std::size_t kReadAheadBatches = 4;
 
@@ -108,10 +111,12 @@ class ReadAhead {
 
 }  // namespace
 
-Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
-                        double reference_rate_rad_s,
-                        const std::function<void(std::span<const RecordSample>)>& observe) {
-  Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
+namespace {
+
+/// The one pass of reduce_record and reduce_record_channels: the rows read ahead, summarised, observed and
+/// pushed into `reducer`.
+void push_record(Reducer& reducer, RecordReader& reader,
+                 const std::function<void(std::span<const RecordSample>)>& observe) {
   reducer.set_record_layout(reader.layout());
   RecordSummary summary;  // of every row read
   ReadAhead ahead(reader);
@@ -121,7 +126,34 @@ Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const Reduce
     for (const RecordSample& s : rows) reducer.push_unsummarised(s);
   }
   reducer.set_summary(summary);
+}
+
+}  // namespace
+
+Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
+                        double reference_rate_rad_s,
+                        const std::function<void(std::span<const RecordSample>)>& observe) {
+  if (reader.output_count() != 1)
+    throw Error(fmt::format("{}: it is read with {} output columns; reduce_record_channels reduces them.",
+                            reader.name(), reader.output_count()));
+  Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
+  push_record(reducer, reader, observe);
   return reducer.finish();
+}
+
+std::vector<Reduction> reduce_record_channels(
+    RecordReader& reader, const TestSpec& plan, const ReduceOptions& options, double reference_rate_rad_s,
+    const std::function<void(std::span<const RecordSample>)>& observe) {
+  Reducer reducer(PlannedTest{plan, reference_rate_rad_s}, options, reader.name());
+  std::vector<std::string> names;
+  if (reader.layout()) {
+    for (const OutputColumn& o : reader.layout()->output_columns()) names.push_back(o.column);
+  } else {
+    names.push_back(reader.output_column());
+  }
+  reducer.set_output_columns(names);
+  push_record(reducer, reader, observe);
+  return reducer.finish_channels();
 }
 
 }  // namespace gyrocal

@@ -45,6 +45,17 @@ void Reducer::set_threaded_accumulation(bool threaded) {
   state_->feed.emplace(threaded);
 }
 
+void Reducer::set_output_columns(const std::vector<std::string>& names) {
+  if (state_->rows > 0) throw Error("Reducer::set_output_columns: only before the first row.");
+  if (names.empty() || names.size() > limits::kMaxOutputColumns)
+    throw Error(
+        fmt::format("{}: a record is reduced with 1 to {} output columns (limits::kMaxOutputColumns), "
+                    "not {}.",
+                    state_->source, limits::kMaxOutputColumns, names.size()));
+  state_->outputs = names.size();
+  state_->output_names = names.size() > 1 ? names : std::vector<std::string>{};
+}
+
 void Reducer::set_record_layout(const std::optional<RecordLayout>& layout) {
   state_->layout = layout;
 }
@@ -63,7 +74,48 @@ void Reducer::set_summary(const RecordSummary& summary) {
 }
 
 Reduction Reducer::finish() {
+  if (state_->outputs != 1)
+    throw Error(fmt::format("{}: the reducer reads {} output columns; finish_channels() reduces them.",
+                            state_->source, state_->outputs));
+  Reduction out = state_->finish_first_column();
+  state_->check_degrees_of_freedom(out, std::string());
+  return out;
+}
+
+std::vector<Reduction> Reducer::finish_channels() {
   State& st = *state_;
+  std::vector<Reduction> out;
+  out.reserve(st.outputs);
+  // The dwells are moved into the first column's reduction in time order: keep each one's other columns
+  // beside it.
+  out.push_back(st.finish_first_column());
+  const Reduction& first = out.front();
+  for (std::size_t c = 1; c < st.outputs; ++c) {
+    Reduction r = first;
+    r.outliers = 0;
+    for (std::size_t i = 0; i < r.dwells.size(); ++i) {
+      r.dwells[i].output = std::move(st.chosen_more[i][c - 1]);
+      r.outliers += r.dwells[i].output.outliers;
+    }
+    for (ReducedPosition& p : r.positions) {
+      const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
+      const auto k = static_cast<std::size_t>(p.gamma_slot);
+      p.mean = d.output.value[k];
+      p.std_err = d.output.std_err[k];
+      p.samples = d.output.samples[k];
+      p.outliers = d.output.outliers;
+      p.channel = static_cast<int>(c);
+    }
+    out.push_back(std::move(r));
+  }
+  st.chosen_more.clear();
+  for (std::size_t c = 0; c < out.size(); ++c)
+    st.check_degrees_of_freedom(out[c], st.output_names.size() > c ? st.output_names[c] : std::string());
+  return out;
+}
+
+Reduction Reducer::State::finish_first_column() {
+  State& st = *this;
   while (st.run) st.end_run("the record ends", State::Ending::kRecordEnds);
   Reduction out;
   out.samples_read = st.rows;
@@ -86,12 +138,14 @@ Reduction Reducer::finish() {
     // Moved, not copied: a dwell holds a few numbers a revolution (docs/performance.md).
     chosen[dwell_key(st.dwells[i])] = static_cast<int>(out.dwells.size());
     out.dwells.push_back(std::move(st.dwells[i]));
+    st.chosen_more.push_back(std::move(st.more_outputs[i]));
     out.samples_used += out.dwells.back().samples;
     out.outliers += out.dwells.back().output.outliers;
     out.gaps += out.dwells.back().gaps;
     out.encoder_glitch_rows += out.dwells.back().quality.encoder_glitch_rows;
   }
   st.dwells.clear();
+  st.more_outputs.clear();
   st.dwell_of_key.clear();
   out.rejected = st.rejected;
   std::sort(out.rejected.begin(), out.rejected.end(),
@@ -122,17 +176,22 @@ Reduction Reducer::finish() {
                             missing.size(), missing.size() > 1 ? "s" : "", list,
                             st.summary.describe(st.plan, st.layout, st.rejected, st.dwells_found)));
   }
+  return out;
+}
+
+void Reducer::State::check_degrees_of_freedom(Reduction& r, const std::string& column) const {
+  const std::string in_column = column.empty() ? std::string() : fmt::format(" (output {})", column);
   // A standard error is the scatter between revolutions (or batches) about a line: without a degree of
   // freedom left there is no measurement of the noise, and no number may stand in for one
   // (docs/calibration.md, "Degrees of freedom").
   int zero = 0;
-  for (const Dwell& d : out.dwells) {
+  for (const Dwell& d : r.dwells) {
     if (d.output.dof > 0.0) continue;
     // The scatter is about a mean (and a drift), and at a counter rate offset also the heading's sweep.
     const int needed =
         d.is_static
             ? 2
-            : (st.options.linear_drift ? 3 : 2) +
+            : (options.linear_drift ? 3 : 2) +
                   (heading_sweep_rad_s(d.planned_rate_rad_s, d.planned_counter_rate_offset_rad_s) != 0.0 ? 2
                                                                                                          : 0);
     if (d.output.revolutions >= needed) {
@@ -142,36 +201,37 @@ Reduction Reducer::finish() {
       for (double v : d.output.value)
         if (!(std::abs(v) <= largest)) largest = std::abs(v);
       throw Error(fmt::format(
-          "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, but the scatter "
+          "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg{} has {} complete {}, but the scatter "
           "between "
           "them is not a finite number: its outputs reach {:g}, whose squares leave a double's range (an "
           "output is at most {:g} in magnitude, limits::kOutputMagnitude).",
-          st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
-          d.beta_rad * kRadToDeg, d.output.revolutions, d.is_static ? "batches" : "revolutions", largest,
-          limits::kOutputMagnitude));
+          source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
+          d.beta_rad * kRadToDeg, in_column, d.output.revolutions, d.is_static ? "batches" : "revolutions",
+          largest, limits::kOutputMagnitude));
     }
     throw Error(fmt::format(
-        "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg has {} complete {}, too few for a standard "
+        "{}: at t = {:.6f} s the {} at {} rad/s, beta {:.4f} deg{} has {} complete {}, too few for a "
+        "standard "
         "error from the scatter between them; it needs at least {}{}.",
-        st.source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
-        d.beta_rad * kRadToDeg, d.output.revolutions, d.is_static ? "batches" : "revolutions", needed,
+        source, d.first_time_s, d.is_static ? "static hold" : "dwell", d.planned_rate_rad_s,
+        d.beta_rad * kRadToDeg, in_column, d.output.revolutions, d.is_static ? "batches" : "revolutions",
+        needed,
         d.is_static ? ""
-        : st.options.method == ReduceOptions::Method::kWindowMean
+        : options.method == ReduceOptions::Method::kWindowMean
             ? ": raise [test] revolutions (window means count a revolution only when it passes through every "
               "window, so a dwell's first or last may not count)"
             : fmt::format(" ([test] revolutions = {} or more)", needed)));
   }
-  for (const ReducedPosition& p : out.positions)
+  for (const ReducedPosition& p : r.positions)
     if (p.std_err == 0.0) ++zero;
   if (zero > 0)
-    out.warnings.push_back(
-        fmt::format("{}: {} position{} show no scatter at all between revolutions: a "
+    r.warnings.push_back(
+        fmt::format("{}: {} position{}{} show no scatter at all between revolutions: a "
                     "noise-free record, whose uncertainties mean nothing.",
-                    st.source, zero, zero > 1 ? "s" : ""));
-  return out;
+                    source, zero, zero > 1 ? "s" : "", in_column));
 }
 
-ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_index) {
+ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_index, int channel) {
   int slot = 0;
   for (std::size_t k = 0; k < d.gammas_rad.size(); ++k)
     if (d.gammas_rad[k] == p.gamma_rad) slot = static_cast<int>(k);
@@ -188,6 +248,7 @@ ReducedPosition reduced_position(const Position& p, const Dwell& d, int dwell_in
   rp.outliers = d.output.outliers;
   rp.dwell = dwell_index;
   rp.gamma_slot = slot;
+  rp.channel = channel;
   return rp;
 }
 

@@ -4,6 +4,7 @@
 // path, kept in one file so that it is compiled as one), dwell_building.cpp ends a run into a dwell or a
 // rejected run, reducer.cpp finishes the reduction. Internal to src/reduce.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <deque>
@@ -80,7 +81,10 @@ struct LineSums {
 struct Row {
   double t = 0.0;
   double theta = 0.0, psi = 0.0, beta = 0.0;  // deg
-  double y = 0.0;                             // gyro output, deg/h
+  double y = 0.0;                             // the first output column's value (a lone sensor's output)
+  // The row's number in the record: the values of its other output columns, with several, are kept once
+  // in Reducer::State::more_outputs (a row is copied a few times on its way; it stays this small).
+  std::uint64_t serial = 0;
 };
 
 /// The encoder of a row's first reading (main, counter, position) that no encoder writes: beyond
@@ -278,7 +282,9 @@ struct Run {
   // angles stay within beta_tolerance_deg of them.
   double hold_theta = 0.0, hold_psi = 0.0;
   // The measured part.
-  std::optional<DwellAccumulator> acc;
+  // One accumulator per output column, fed the same samples (Reducer::set_output_columns); the first's
+  // sample count, times and revolutions are the dwell's.
+  std::vector<DwellAccumulator> accs;
   bool measuring = false;  // the first row of the measured part has been measured
   double t_first = 0.0, theta_first = 0.0, psi_first = 0.0;
   std::vector<LineSums> phase_theta, phase_psi, phase_rel;  // rel: psi_r + theta
@@ -326,7 +332,24 @@ struct Reducer::State {
   std::optional<Run> run;
   // The dwells found, one a key (dwell_key): a repeat replaces the one kept only if it holds more samples
   // (the first of the longest is used), so that a record repeating its test keeps one test's dwells.
-  std::vector<Dwell> dwells;
+  std::vector<Dwell> dwells;  // Dwell::output: the first output column's values
+  /// Per kept dwell: the reduced values of the output columns after the first (empty with one column).
+  std::vector<std::vector<DwellValues>> more_outputs;
+  /// The output columns each row holds (RecordSample::outputs) and, with more than one, their names for
+  /// messages.
+  std::size_t outputs = 1;
+  std::vector<std::string> output_names;
+  /// With several output columns: the values of the columns after the first of every row still held
+  /// (window, a run's held rows and guard), by serial from more_front on. Memory: the rows held, no more.
+  std::deque<std::array<double, limits::kMaxOutputColumns - 1>> more_outputs_of_rows;
+  std::uint64_t more_front = 0;
+
+  /// Keeps the row's other output columns (several columns only), first dropping those of rows no longer
+  /// held.
+  void keep_more_outputs(const RecordSample& s);
+  /// The values of every output column of row `u` into `values` (several columns only). Throws if the row's
+  /// other columns are no longer kept (an internal error: never a silent wrong value).
+  void row_outputs(const Row& u, double* values) const;
   std::vector<std::size_t> dwell_serial;  ///< per kept dwell: its number among all found, in time order
   std::map<DwellKey, std::size_t> dwell_of_key;
   std::size_t dwells_found = 0;
@@ -399,7 +422,17 @@ struct Reducer::State {
   void finish_run(Run& r);
 
   /// Keeps a found dwell: the first of its key, or a repeat holding more samples than the one kept.
-  void keep(Dwell d);
+  void keep(Dwell d, std::vector<DwellValues> more);
+
+  /// The one-column Reduction of every kept dwell (their first column's values), with the record's checks:
+  /// Reducer::finish's work, before it splits the output columns (finish_channels).
+  Reduction finish_first_column();
+  /// Per kept dwell in finish_first_column's order: its other columns' values (more_outputs), until
+  /// finish_channels takes them.
+  std::vector<std::vector<DwellValues>> chosen_more;
+  /// Refuses a reduction (`column` names its output column in messages, or "" for a lone one) in which a
+  /// dwell has no degree of freedom for its standard errors; warns of positions without scatter.
+  void check_degrees_of_freedom(Reduction& r, const std::string& column) const;
 
   /// The most telling rejected run for a planned position that has no dwell.
   std::string why_missing(const Position& p) const;

@@ -27,7 +27,37 @@ void Reducer::push_unsummarised(const RecordSample& s) {
     throw Error(fmt::format("{}: time does not increase.", st.at(s.time_s)));
   ++st.rows;
   st.t_last = s.time_s;
-  st.take(Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.output});
+  if (st.outputs > 1) st.keep_more_outputs(s);
+  st.take(
+      Row{s.time_s, s.main_angle_deg, s.counter_angle_deg, s.position_angle_deg, s.outputs[0], st.rows - 1});
+}
+
+void Reducer::State::keep_more_outputs(const RecordSample& s) {
+  // The oldest row still held: the window's first, a run's first held row, its guard's first (each holds
+  // rows in the record's order; between rows nothing else holds one, take() having emptied its queues).
+  std::uint64_t oldest = rows - 1;
+  if (!window.empty()) oldest = std::min(oldest, window.front().serial);
+  if (run) {
+    if (!run->held.empty()) oldest = std::min(oldest, run->held.front().serial);
+    if (!run->guard.empty()) oldest = std::min(oldest, run->guard.front().u.serial);
+  }
+  while (more_front < oldest && !more_outputs_of_rows.empty()) {
+    more_outputs_of_rows.pop_front();
+    ++more_front;
+  }
+  if (more_outputs_of_rows.empty()) more_front = rows - 1;
+  std::array<double, limits::kMaxOutputColumns - 1> more{};
+  std::copy_n(s.outputs.begin() + 1, outputs - 1, more.begin());
+  more_outputs_of_rows.push_back(more);
+}
+
+void Reducer::State::row_outputs(const Row& u, double* values) const {
+  if (u.serial < more_front || u.serial - more_front >= more_outputs_of_rows.size())
+    throw Error(fmt::format("{}: internal error: the output columns of the row at t = {} s were not kept.",
+                            source, u.t));
+  values[0] = u.y;
+  const auto& more = more_outputs_of_rows[static_cast<std::size_t>(u.serial - more_front)];
+  std::copy_n(more.begin(), outputs - 1, values + 1);
 }
 
 void Reducer::State::look(const Row& raw) {
@@ -180,8 +210,13 @@ void Reducer::State::decide(Run& r, double t) {
   const double rate = r.match.planned_rate_rad_s, offset = r.match.planned_counter_rate_offset_rad_s;
   r.planned_duration =
       r.match.is_static ? hold_duration() : plan.revolutions * 2.0 * kPi / std::abs(rate - offset);
-  r.acc.emplace(options, r.match.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan),
-                r.match.is_static, 1, r.planned_duration, true, heading_sweep_rad_s(rate, offset));
+  const std::vector<double> gammas =
+      r.match.is_static ? std::vector<double>{r.match.gamma_rad} : spinning_gammas(plan);
+  r.accs.clear();
+  r.accs.reserve(outputs);
+  for (std::size_t k = 0; k < outputs; ++k)
+    r.accs.emplace_back(options, gammas, r.match.is_static, 1, r.planned_duration, true,
+                        heading_sweep_rad_s(rate, offset));
 }
 
 void Reducer::State::follow(const Row& raw) {
@@ -378,7 +413,7 @@ void Reducer::State::measure(const Row& u, bool gap, bool dropped, double t_reco
     }
     if (gap) {
       ++r.gaps;
-      feed->break_revolution(*r.acc);
+      feed->break_revolution(r.accs);
       r.phase_theta.emplace_back();
       r.phase_psi.emplace_back();
       r.phase_rel.emplace_back();
@@ -431,7 +466,13 @@ void Reducer::State::measure(const Row& u, bool gap, bool dropped, double t_reco
       r.basis_turns = turns;
     }
   }
-  feed->add(*r.acc, u.t, -psi * kDegToRad, u.y);
+  if (outputs == 1) {
+    feed->add(std::span<DwellAccumulator>(r.accs.data(), 1), u.t, -psi * kDegToRad, &u.y);
+  } else {
+    double values[limits::kMaxOutputColumns];
+    row_outputs(u, values);
+    feed->add(std::span<DwellAccumulator>(r.accs.data(), outputs), u.t, -psi * kDegToRad, values);
+  }
 }
 
 void Reducer::State::end_run(std::string reason, Ending how) {

@@ -67,7 +67,7 @@ void sample_at(const CentrifugeModel& model, const Sensor& sensor, const Timelin
   // rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
   // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
   const double clean = sensor_output(sensor, inputs);
-  sample.output = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
+  sample.outputs[0] = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
 }
 
 /// The simulation loop; `sink` is a template parameter so that the record writer's call is direct.

@@ -312,7 +312,7 @@ inline std::vector<RecordSample> as_samples(const std::vector<RigRow>& rows) {
     x.main_angle_deg = r.main_angle_deg;
     x.counter_angle_deg = r.counter_angle_deg;
     x.position_angle_deg = r.position_angle_deg;
-    x.output = r.output;
+    x.outputs[0] = r.output;
     out.push_back(x);
   }
   return out;

@@ -81,6 +81,10 @@ inline constexpr std::size_t kOutputUnitBytes = 16;
 /// static record with one 1e308 sample as "no combination of noise terms fits"). A larger output is refused
 /// naming its line and column.
 inline constexpr double kOutputMagnitude = 1e50;
+/// The most output columns a record is read with at once (the channels of one unit: an IMU's six, a spare
+/// two): each is reduced beside the others in the one pass over the record, so the bound is one of memory per
+/// row (reduce/reducer.hpp) and of the reader's value slots.
+inline constexpr std::size_t kMaxOutputColumns = 8;
 /// The largest magnitude of an encoder angle, deg (a layout's counts or radians after their conversion):
 /// 1e10 deg, 2.8e7 turns, which an unwrapped angle or an accumulating counter reaches after 200 days of
 /// spinning at 10 rad/s; a double still resolves 2e-6 deg (0.007 arcsec) there, below any encoder's count.

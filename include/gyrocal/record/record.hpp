@@ -64,8 +64,10 @@ struct RecordSample {
   double main_angle_deg = 0.0;      ///< main axis encoder θ, deg (wrapped or unwrapped)
   double counter_angle_deg = 0.0;   ///< counter-rotating platform ψr relative to the arm, deg
   double position_angle_deg = 0.0;  ///< position platform β, deg
-  double output =
-      0.0;  ///< the sensor's output: deg/h for a gyro, g for an accelerometer (its column: accel_g)
+  /// The outputs, one per output column in the layout's order (RecordLayout::output_columns(); gyrocal's own
+  /// format has one): deg/h for a gyro's rate, g for an accelerometer's specific force (its column: accel_g).
+  /// Only the first RecordReader::output_count() are meaningful.
+  std::array<double, limits::kMaxOutputColumns> outputs{};
   /// Values of the extra columns, in header order; only the first RecordReader::extra_column_count() are
   /// meaningful.
   std::array<double, kMaxExtraColumns> extra{};
@@ -160,8 +162,11 @@ class RecordReader {
   /// Throws gyrocal::Error, naming the record (and the [record] key, the header and the columns found), when
   /// it lacks an angle column: what a calibration calls before reducing it.
   void require_angles() const;
-  /// The name of the output column ("gyro_deg_h", "accel_g", or the layout's output_column).
+  /// The name of the (first) output column ("gyro_deg_h", "accel_g", or the layout's output_column).
   const std::string& output_column() const;
+  /// How many output columns each row gives (RecordSample::outputs): 1 in gyrocal's own format, the
+  /// layout's output_columns() through a layout.
+  std::size_t output_count() const;
   /// The unit of RecordSample::output: "g" for gyrocal's own format with an accel_g column, or through a
   /// layout whose output is a specific force (RecordLayout::output_quantity); else "deg/h".
   std::string_view output_unit() const;

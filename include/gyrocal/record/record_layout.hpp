@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace gyrocal {
 
@@ -17,6 +18,35 @@ enum class AngleUnit { kDegrees, kRadians };
 /// What a record's output column measures: a gyro's rate (read into deg/h) or an accelerometer's specific
 /// force (read into g). The configuration sets it from [sensor] kind.
 enum class OutputQuantity { kRate, kSpecificForce };
+
+/// How an output column's values stand for the sensor's input: a rate (or specific force) at the row's stamp,
+/// or an increment, its integral over the interval that ends at the stamp (an IMU's angle and velocity
+/// increments, docs/records.md). Increments are not read yet: RecordLayout::IsValid refuses them.
+enum class OutputForm { kRate, kIncrement };
+
+/// One output column of a record: one channel's values and how they convert into the sensor's unit (deg/h
+/// for a rate, g for a specific force): value = (reading - offset) / scale. A lone sensor's is the one that
+/// [record]'s output keys describe (RecordLayout::output_columns()); a unit of several channels holds one per
+/// channel (RecordLayout::outputs).
+struct OutputColumn {
+  std::string column = "gyro_deg_h";  ///< its name in the header
+  OutputQuantity quantity = OutputQuantity::kRate;
+  OutputForm form = OutputForm::kRate;
+  /// Output units per deg/h (a rate) or per g (a specific force); finite and non-zero, negative for an
+  /// output whose sign is the opposite of gyrocal's.
+  double scale = 1.0;
+  double offset = 0.0;    ///< what the column reads at zero input, in its own units; finite
+  std::string unit_name;  ///< the column's unit as the lab names it ("mV"); empty: unit()
+
+  /// The unit the reader gives the values in: "deg/h" for a rate, "g" for a specific force.
+  std::string_view unit() const;
+  /// The unit of the column itself: unit_name, or unit() when it is empty.
+  std::string column_unit() const;
+  /// The [record] key of a lone sensor's scale ("output_scale_per_deg_h" or "output_scale_per_g").
+  std::string_view scale_key() const;
+
+  friend bool operator==(const OutputColumn&, const OutputColumn&) = default;
+};
 
 /// The names of the units as a configuration writes them ("s", "ms", "us", "ns"; "deg", "rad").
 std::string_view to_string(TimeUnit unit);
@@ -83,6 +113,14 @@ struct RecordLayout {
   /// The decimal mark of the numbers: '.' (default) or ',' (then the delimiter must be another character,
   /// typically ';').
   char decimal = '.';
+
+  /// The output columns of a record of several channels, in the channels' order (at most
+  /// limits::kMaxOutputColumns, each naming its own column). Empty (the default, and every configuration of
+  /// one sensor): the one column that the output keys above describe.
+  std::vector<OutputColumn> outputs;
+
+  /// The output columns the record is read with, in order: `outputs`, or the one the output keys describe.
+  std::vector<OutputColumn> output_columns() const;
 
   /// True when the layout can be read. Otherwise false, with `error` set (when not null) to one sentence
   /// naming the key as `record.<key>` (without a final period), and `key` (when not null) to that key.

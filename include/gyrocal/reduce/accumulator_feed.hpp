@@ -1,14 +1,16 @@
 #pragma once
 // A dwell's accumulation on a thread of its own (docs/performance.md, "The accumulation's thread"): the
 // reducer hands each measured sample over in batches, and a worker thread adds them to the dwell's
-// DwellAccumulator in the order given, so that the outlier rule and the fit's sums (a third of the reducer's
-// work) run beside the segmentation of the record rather than after it. The accumulator sees the very calls
-// it would have seen on the caller's thread, in the same order: its results are the same, bit for bit.
+// DwellAccumulators (one per output column, docs/calibration.md "Several output columns") in the order given,
+// so that the outlier rule and the fit's sums (a third of the reducer's work) run beside the segmentation of
+// the record rather than after it. The accumulator sees the very calls it would have seen on the caller's
+// thread, in the same order: its results are the same, bit for bit.
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
 #include <exception>
 #include <mutex>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -16,7 +18,8 @@
 
 namespace gyrocal {
 
-/// Feeds DwellAccumulators from one producer thread through one worker thread. Between sync() calls the
+/// Feeds groups of DwellAccumulators (a dwell's, one per output column) from one producer thread through one
+/// worker thread. Between sync() calls the
 /// accumulators fed must not be touched (read, moved or destroyed) by anyone else; after sync() they are the
 /// caller's again until the next add(). The worker starts with the first batch and is joined by the
 /// destructor (work still queued then is dropped: the accumulators it was for are being abandoned).
@@ -33,16 +36,23 @@ class AccumulatorFeed {
   AccumulatorFeed(const AccumulatorFeed&) = delete;
   AccumulatorFeed& operator=(const AccumulatorFeed&) = delete;
 
-  /// acc.add(time_s, gamma_rad, &value), on the worker, after every call handed over before it.
-  void add(DwellAccumulator& acc, double time_s, double gamma_rad, double value) {
-    if (!threaded_) return acc.add(time_s, gamma_rad, &value);
-    if (&acc != target_ || open_.size() >= kBatchSamples) hand_over(acc);
-    open_.push_back({time_s, gamma_rad, value, false});
+  /// accs[k].add(time_s, gamma_rad, &values[k]) for each k, on the worker, after every call handed over
+  /// before it. `accs` is one group (at most kBatchSamples of them) for as long as it is fed.
+  void add(std::span<DwellAccumulator> accs, double time_s, double gamma_rad, const double* values) {
+    if (!threaded_) {
+      for (std::size_t k = 0; k < accs.size(); ++k) accs[k].add(time_s, gamma_rad, values + k);
+      return;
+    }
+    if (accs.data() != target_ || open_.size() + accs.size() > kBatchSamples) hand_over(accs);
+    for (std::size_t k = 0; k < accs.size(); ++k) open_.push_back({time_s, gamma_rad, values[k], false});
   }
-  /// acc.break_revolution(), on the worker, in its place among the samples.
-  void break_revolution(DwellAccumulator& acc) {
-    if (!threaded_) return acc.break_revolution();
-    if (&acc != target_ || open_.size() >= kBatchSamples) hand_over(acc);
+  /// break_revolution() of each of `accs`, on the worker, in its place among the samples.
+  void break_revolution(std::span<DwellAccumulator> accs) {
+    if (!threaded_) {
+      for (DwellAccumulator& acc : accs) acc.break_revolution();
+      return;
+    }
+    if (accs.data() != target_ || open_.size() >= kBatchSamples) hand_over(accs);
     open_.push_back({0.0, 0.0, 0.0, true});
   }
   /// Returns once every call handed over has been made; rethrows the first exception the worker met.
@@ -53,18 +63,19 @@ class AccumulatorFeed {
     double time_s, gamma_rad, value;
     bool break_revolution;
   };
+  /// A batch's items are whole rows: a row's samples, one per accumulator of the group in order, or a break.
   struct Batch {
-    DwellAccumulator* acc = nullptr;
+    std::span<DwellAccumulator> accs;
     std::vector<Item> items;
   };
-  /// Queues the open batch (if any) and opens one for `next` (null: none).
-  void hand_over(DwellAccumulator* next);
-  void hand_over(DwellAccumulator& next) { hand_over(&next); }
+  /// Queues the open batch (if any) and opens one for `next` (empty: none).
+  void hand_over(std::span<DwellAccumulator> next);
   void work();
 
   // The producer's side.
   bool threaded_;
   DwellAccumulator* target_ = nullptr;
+  std::span<DwellAccumulator> target_accs_;
   std::vector<Item> open_;
   // Shared with the worker, under mutex_.
   std::mutex mutex_;

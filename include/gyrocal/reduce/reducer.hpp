@@ -133,20 +133,27 @@ struct ReducedPosition {
   std::size_t outliers = 0;
   int dwell = 0;       ///< index into Reduction::dwells
   int gamma_slot = 0;  ///< index into that dwell's gammas
+  /// The output column (channel) it reduces: its index in the record's output columns
+  /// (RecordLayout::output_columns(); 0 for a record of one sensor).
+  int channel = 0;
 };
 
-/// The reduced position of plan position `p` measured by `dwell` (index `dwell_index` in the reduction): its
-/// gamma's slot in the dwell, value, standard error and sample count.
-ReducedPosition reduced_position(const Position& p, const Dwell& dwell, int dwell_index);
+/// The reduced position of plan position `p` measured by `dwell` (index `dwell_index` in the reduction) in
+/// output column `channel` (whose values are dwell.output): its gamma's slot in the dwell, value, standard
+/// error and sample count.
+ReducedPosition reduced_position(const Position& p, const Dwell& dwell, int dwell_index, int channel = 0);
 
+/// One output column's reduction of a record (a lone sensor's, or one channel of several read in one pass:
+/// Reducer::finish_channels): its dwells, whose `output` holds this column's values, and every planned
+/// position in order, each carrying the column as its `channel`.
 struct Reduction {
   std::vector<Dwell> dwells;
   std::vector<ReducedPosition> positions;  ///< every position of the plan, in order
   std::vector<std::string> warnings;
-  std::size_t samples_read = 0;         ///< rows of the record
-  std::size_t samples_used = 0;         ///< rows in the measured parts of the dwells used
-  std::size_t outliers = 0;             ///< of those, rejected as outliers (and replaced by the dwell's fit)
-  std::size_t gaps = 0;                 ///< breaks in the time series inside the dwells used (Dwell::gaps)
+  std::size_t samples_read = 0;  ///< rows of the record
+  std::size_t samples_used = 0;  ///< rows in the measured parts of the dwells used
+  std::size_t outliers = 0;      ///< of those, rejected as outliers in this column (and left out of its fit)
+  std::size_t gaps = 0;          ///< breaks in the time series inside the dwells used (Dwell::gaps)
   std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside the dwells used: encoders off their line
   std::vector<RejectedRun> rejected;    ///< steady runs that gave no dwell (the longest kRejectedKept)
 };
@@ -187,6 +194,10 @@ class Reducer {
   /// called with false before the first push (a caller whose threads already keep every core busy, such as
   /// the Monte Carlo's trials). The numbers are the same either way.
   void set_threaded_accumulation(bool threaded);
+  /// The record's rows hold `names.size()` output columns (RecordSample::outputs, 1 to
+  /// limits::kMaxOutputColumns; one by default), each reduced beside the others in the one pass with its own
+  /// outlier rule and standard errors; `names` name them in messages. Only before the first push.
+  void set_output_columns(const std::vector<std::string>& names);
   Reducer(const Reducer&) = delete;
   Reducer& operator=(const Reducer&) = delete;
 
@@ -199,8 +210,12 @@ class Reducer {
   /// The layout the record was read through (nullopt: gyrocal's own format), for the message of finish()
   /// only: it names the [record] key a unit mistake points to.
   void set_record_layout(const std::optional<RecordLayout>& layout);
-  /// Match the dwells to the plan; an error if a planned position has no dwell.
+  /// Match the dwells to the plan; an error if a planned position has no dwell. For a record of one output
+  /// column (a reducer of several refuses it: finish_channels).
   Reduction finish();
+  /// finish() for every output column (set_output_columns): one Reduction per column, in order, each with
+  /// the same dwells (their `output` that column's values) and positions whose `channel` is the column.
+  std::vector<Reduction> finish_channels();
   /// The dwells held so far: one a planned place (rate, counter rate offset, beta, a static hold's gamma),
   /// the longest of a record that repeats it (the first of equal length), so that memory does not grow with
   /// repeats; 0 after finish(), which moves them into the Reduction.
@@ -215,8 +230,14 @@ class Reducer {
 /// accumulation runs on another, reduce/accumulator_feed.hpp). `observe`, when given, sees every batch of
 /// rows, in order, on the caller's thread, before the reducer does (e.g. the output's range,
 /// identify/misfit.hpp).
+/// For a record of one output column (a reader of several is refused: reduce_record_channels).
 Reduction reduce_record(RecordReader& reader, const TestSpec& plan, const ReduceOptions& options,
                         double reference_rate_rad_s,
                         const std::function<void(std::span<const RecordSample>)>& observe = {});
+/// reduce_record for every output column the reader gives (RecordReader::output_count(), through a layout's
+/// RecordLayout::outputs): one pass over the record, one Reduction per column in order (finish_channels).
+std::vector<Reduction> reduce_record_channels(
+    RecordReader& reader, const TestSpec& plan, const ReduceOptions& options, double reference_rate_rad_s,
+    const std::function<void(std::span<const RecordSample>)>& observe = {});
 
 }  // namespace gyrocal
