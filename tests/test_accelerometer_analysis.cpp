@@ -51,7 +51,7 @@ std::map<std::string, double> simulated_calibration(const Scenario& truth, const
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = told.model();
   const CalibrationResult c =
-      identify(r, reduce_sensor_model_terms(r, model, o.reduce, told.sensor()), model, o);
+      identify(r, reduce_sensor_model_terms(r, model, o.reduce, told.channels().front()), model, o);
   std::map<std::string, double> out;
   for (const CoefficientEstimate& e : c.coefficients)
     if (e.identifiable) out[e.name] = e.value;

@@ -62,8 +62,8 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
                             CalibrationOptions o = CalibrationOptions{}) {
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
-                  o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.channels().front()),
+                  model, o);
 }
 
 /// The truth in the table's order and units.

@@ -50,8 +50,8 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
                             CalibrationOptions o = CalibrationOptions{}) {
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
-                  o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.channels().front()),
+                  model, o);
 }
 
 std::string all_warnings(const CalibrationResult& r) {

@@ -78,7 +78,7 @@ Outcome calibrate(const Scenario& truth, const Scenario& config, std::uint64_t s
   Outcome out;
   try {
     out.result =
-        identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.sensor()), model, o);
+        identify(r, reduce_sensor_model_terms(r, model, o.reduce, config.channels().front()), model, o);
     // K1 in the record's units, as calibrate_record states it.
     out.result.coefficients[1].value *= scale;
     out.result.coefficients[1].std *= std::abs(scale);

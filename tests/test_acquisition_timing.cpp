@@ -62,8 +62,8 @@ CalibrationResult calibrate(const Scenario& config, const Reduction& reduction,
   const CentrifugeModel model = config.model();
   if (config.sensor_kind == SensorKind::kGyro)
     return identify(reduction, reduce_model_terms(reduction, model, o.reduce), model, o);
-  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
-                  o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.channels().front()),
+                  model, o);
 }
 
 /// Each accelerometer coefficient within `z_max` of its standard uncertainty of the truth.

@@ -311,8 +311,8 @@ CalibrationResult calibrate_accelerometer(const Scenario& config, const Scenario
   CalibrationOptions o;
   o.sensor = SensorKind::kAccelerometer;
   const CentrifugeModel model = config.model();
-  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.sensor()), model,
-                  o);
+  return identify(reduction, reduce_sensor_model_terms(reduction, model, o.reduce, config.channels().front()),
+                  model, o);
 }
 
 /// The run a history keeps of a calibration result: its coefficients, filled by hand.

@@ -177,9 +177,9 @@ TEST(FourierChannels, AnAccelerometersDesignRowsEqualTheEverySampleOnesWithinThe
   const Reduction r = reducer.finish();
   std::vector<DwellModelTermsRoute> routes;
   const auto fourier =
-      reduce_sensor_model_terms(r, s.model(), ro, s.sensor(), 0, ModelTermsRoute::kExact, &routes);
+      reduce_sensor_model_terms(r, s.model(), ro, s.channels().front(), 0, ModelTermsRoute::kExact, &routes);
   const auto every =
-      reduce_sensor_model_terms(r, s.model(), ro, s.sensor(), 0, ModelTermsRoute::kEverySample);
+      reduce_sensor_model_terms(r, s.model(), ro, s.channels().front(), 0, ModelTermsRoute::kEverySample);
   ASSERT_EQ(routes.size(), r.dwells.size());
   double worst = 0.0;
   for (std::size_t i = 0; i < r.positions.size(); ++i) {

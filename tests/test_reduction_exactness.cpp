@@ -245,7 +245,7 @@ TEST(ReductionExactness, AnAccelerometersDesignRowsAreReducedByTheOutputsOperato
   const Eigen::VectorXd u = s.accelerometer.products();
   const auto worst = [&](const Reduction& x) {
     const std::vector<PositionModelTerms> ch =
-        reduce_sensor_model_terms(x, model, ReduceOptions{}, Sensor{Accelerometer{}});
+        reduce_sensor_model_terms(x, model, ReduceOptions{}, lone_channel(Accelerometer{}));
     double w = 0.0;
     for (std::size_t i = 0; i < x.positions.size(); ++i) {
       const DesignRow& row = ch[i].sensor_exact;

@@ -70,10 +70,11 @@ PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& 
   planned.test = reduction_plan(s.test, s.sensor_kind, options);
   PlannedSensorTest p;
   p.reduction = planned_reduction(planned);
-  const Sensor sensor = s.sensor();
+  const SensorChannel channel = s.channels().front();
+  const Sensor& sensor = channel.sensor;
   // The sensor's truth on the true machine: known + sum_j u_j r_j, u its products.
   const std::vector<PositionModelTerms> truth =
-      reduce_sensor_model_terms(p.reduction, s.model(), options, sensor, kMaxModelSamplesPerDwell);
+      reduce_sensor_model_terms(p.reduction, s.model(), options, channel, kMaxModelSamplesPerDwell);
   Eigen::VectorXd u;
   if (const auto* a = std::get_if<Accelerometer>(&sensor)) u = a->products();
   for (std::size_t i = 0; i < p.reduction.positions.size(); ++i) {
@@ -84,7 +85,7 @@ PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& 
     p.reduction.positions[i].mean = e;
   }
   set_predicted_std_errors(p.reduction, output_noise(s), s.test.sample_rate_hz, options);
-  p.model_terms = reduce_sensor_model_terms(p.reduction, told, options, sensor, kMaxModelSamplesPerDwell);
+  p.model_terms = reduce_sensor_model_terms(p.reduction, told, options, channel, kMaxModelSamplesPerDwell);
   return p;
 }
 

@@ -321,9 +321,10 @@ MonteCarloResult run_monte_carlo(const MonteCarloModel& m, const MonteCarloOptio
     so.seed = rng.next_u64();
     simulate(s, so, [&](const RecordSample& sample) { reducer.push(sample); });
     const Reduction r = reducer.finish();
-    const auto model_terms = s.sensor_kind == SensorKind::kGyro
-                                 ? reduce_model_terms(r, model0, m.calibration.reduce)
-                                 : reduce_sensor_model_terms(r, model0, m.calibration.reduce, s.sensor());
+    const auto model_terms =
+        s.sensor_kind == SensorKind::kGyro
+            ? reduce_model_terms(r, model0, m.calibration.reduce)
+            : reduce_sensor_model_terms(r, model0, m.calibration.reduce, s.channels().front());
     std::vector<std::string> names = m.names;
     std::vector<double> stated;
     const std::vector<double> e = estimate_errors(identify(r, model_terms, model0, m.calibration), m.scenario,

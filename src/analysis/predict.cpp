@@ -641,9 +641,10 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
   planned.test = reduction_plan(s.test, s.sensor_kind, options.reduce);
   Reduction r = planned_reduction(planned);
   const CentrifugeModel model = s.model();
-  const Sensor sensor = s.sensor();
+  const SensorChannel channel = s.channels().front();
+  const Sensor& sensor = channel.sensor;
   const std::vector<PositionModelTerms> model_terms =
-      reduce_sensor_model_terms(r, model, options.reduce, sensor);
+      reduce_sensor_model_terms(r, model, options.reduce, channel);
   const Accelerometer& a = std::get<Accelerometer>(sensor);
   const Eigen::VectorXd u = a.products();
   for (std::size_t i = 0; i < r.positions.size(); ++i) {

@@ -195,11 +195,12 @@ SensitivityResult sensor_sensitivity_study(const Scenario& scenario, const Sensi
         const CentrifugeModel told = s.model();
         PlannedSensorTest p = planned_sensor_test(s, told, o.reduce);
         runs[i][1] = identify(p.reduction, p.model_terms, told, o);
-        runs[i][0] = i == 0 ? runs[i][1]
-                            : identify(p.reduction,
-                                       reduce_sensor_model_terms(p.reduction, base_model, o.reduce,
-                                                                 s.sensor(), kMaxModelSamplesPerDwell),
-                                       base_model, o);
+        runs[i][0] = i == 0
+                         ? runs[i][1]
+                         : identify(p.reduction,
+                                    reduce_sensor_model_terms(p.reduction, base_model, o.reduce,
+                                                              s.channels().front(), kMaxModelSamplesPerDwell),
+                                    base_model, o);
         ++done;
       },
       [&] {

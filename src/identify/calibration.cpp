@@ -33,7 +33,7 @@ std::vector<PositionModelTerms> model_terms_for(const Reduction& reduction, cons
                                                 const CalibrationOptions& options) {
   if (options.sensor == SensorKind::kGyro)
     return reduce_model_terms(reduction, model, options.reduce, options.max_model_samples_per_dwell);
-  return reduce_sensor_model_terms(reduction, model, options.reduce, sensor_of(options.sensor),
+  return reduce_sensor_model_terms(reduction, model, options.reduce, lone_channel(sensor_of(options.sensor)),
                                    options.max_model_samples_per_dwell);
 }
 

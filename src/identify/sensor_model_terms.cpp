@@ -11,10 +11,13 @@
 namespace gyrocal {
 namespace {
 
-/// The sensor's design row at the joints (the encoders at the output's stamp) as the reduction's columns: the
-/// known part, then the regressors; at the inputs the output holds (sensed_inputs: the acquisition's delay).
-void design_columns(const Sensor& sensor, const CentrifugeModel& model, const JointState& j, double* out) {
-  const DesignRow row = sensor_design_row(sensor, sensed_inputs(model, j));
+/// The channel's design row at the joints (the encoders at the output's stamp) as the reduction's columns:
+/// the known part, then the regressors; at the inputs the output holds (the platform's motion the
+/// acquisition's delay earlier, sensed_platform_motion, evaluated at the channel).
+void design_columns(const SensorChannel& channel, const CentrifugeModel& model, const JointState& j,
+                    double* out) {
+  const DesignRow row =
+      sensor_design_row(channel.sensor, channel_inputs(model, sensed_platform_motion(model, j), channel));
   out[0] = row.known;
   for (std::size_t k = 0; k < row.size; ++k) out[k + 1] = row.regressors[k];
 }
@@ -35,13 +38,11 @@ TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOpt
   return out;
 }
 
-std::vector<PositionModelTerms> reduce_sensor_model_terms(const Reduction& reduction,
-                                                          const CentrifugeModel& model,
-                                                          const ReduceOptions& options, const Sensor& sensor,
-                                                          std::size_t max_samples_per_dwell,
-                                                          ModelTermsRoute route,
-                                                          std::vector<DwellModelTermsRoute>* routes) {
-  const DesignRow probe = sensor_design_row(sensor, exact_inputs(model, JointState{}));
+std::vector<PositionModelTerms> reduce_sensor_model_terms(
+    const Reduction& reduction, const CentrifugeModel& model, const ReduceOptions& options,
+    const SensorChannel& channel, std::size_t max_samples_per_dwell, ModelTermsRoute route,
+    std::vector<DwellModelTermsRoute>* routes) {
+  const DesignRow probe = sensor_design_row(channel.sensor, exact_inputs(model, JointState{}));
   const int columns = 1 + static_cast<int>(probe.size);
   // The design row's known part and regressors are in the output's unit and its powers (g, g^2, g^3): no
   // column is a difference of the joints' rates.
@@ -61,7 +62,7 @@ std::vector<PositionModelTerms> reduce_sensor_model_terms(const Reduction& reduc
   design.per_revolution = true;
   const std::vector<DwellModelValues> per_dwell = reduce_dwells_model(
       reduction, model, options, max_samples_per_dwell, route, design,
-      [&](const Dwell&, const JointState& j, double* row) { design_columns(sensor, model, j, row); });
+      [&](const Dwell&, const JointState& j, double* row) { design_columns(channel, model, j, row); });
   if (routes) *routes = dwell_routes(per_dwell);
   std::vector<PositionModelTerms> out;
   for (const ReducedPosition& p : reduction.positions) {

@@ -9,7 +9,11 @@
 
 #include <fmt/format.h>
 
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/core/limits.hpp"
+#include "gyrocal/core/random.hpp"
 #include "gyrocal/model/gyro.hpp"
+#include "gyrocal/sensor/channel.hpp"
 #include "gyrocal/sensor/sensor.hpp"
 #include "gyrocal/simulate/accelerometer_noise.hpp"
 #include "gyrocal/simulate/noise.hpp"
@@ -43,31 +47,50 @@ std::string list(const std::vector<double>& values, double scale) {
 /// The sensor's noise: the gyro's in deg/h, the accelerometer's referred to its input and scaled by K1.
 using NoiseGenerator = std::variant<GyroNoiseGenerator, AccelerometerNoiseGenerator>;
 
-NoiseGenerator make_noise(const Scenario& scenario, double fs, std::uint64_t seed) {
-  return scenario.sensor_kind == SensorKind::kAccelerometer
-             ? NoiseGenerator(std::in_place_type<AccelerometerNoiseGenerator>, scenario.accelerometer.noise,
-                              scenario.accelerometer.coefficients[AccelCoefficient::K1], fs, seed)
-             : NoiseGenerator(std::in_place_type<GyroNoiseGenerator>, scenario.noise, fs, seed);
+/// The scenario's channels (at most limits::kMaxOutputColumns, a record's outputs) and a noise generator for
+/// each. The first channel's stream is seeded with `seed`, so that a lone sensor's record is what it always
+/// was; each further channel's with derive_stream_seed(seed, its number), so that the channels' noises are
+/// independent.
+std::vector<SensorChannel> record_channels(const Scenario& scenario, double fs, std::uint64_t seed,
+                                           std::vector<NoiseGenerator>& noise) {
+  std::vector<SensorChannel> channels = scenario.channels();
+  if (channels.size() > limits::kMaxOutputColumns)
+    throw Error(fmt::format("A record holds at most {} channels (limits::kMaxOutputColumns), not {}.",
+                            limits::kMaxOutputColumns, channels.size()));
+  noise.clear();
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    const std::uint64_t s = k == 0 ? seed : derive_stream_seed(seed, k);
+    if (const auto* a = std::get_if<Accelerometer>(&channels[k].sensor))
+      noise.emplace_back(std::in_place_type<AccelerometerNoiseGenerator>, a->noise,
+                         a->coefficients[AccelCoefficient::K1], fs, s);
+    else
+      noise.emplace_back(std::in_place_type<GyroNoiseGenerator>, std::get<Gyro>(channels[k].sensor).noise, fs,
+                         s);
+  }
+  return channels;
 }
 
-/// The row at time t: the encoders' readings and the sensor's output with the generator's next noise.
-void sample_at(const CentrifugeModel& model, const Sensor& sensor, const Timeline& timeline, double t,
-               NoiseGenerator& noise, RecordSample& sample) {
+/// The row at time t: the encoders' readings and each channel's output with its generator's next noise.
+void sample_at(const CentrifugeModel& model, const std::vector<SensorChannel>& channels,
+               const Timeline& timeline, double t, std::vector<NoiseGenerator>& noise, RecordSample& sample) {
   const JointState joints = joint_state_at(timeline, t);
   // The output stamped at t was sensed the acquisition's delay earlier ([record] output_delay_s): the
-  // machine's own motion at that instant (the encoders are read at t).
+  // machine's own motion at that instant (the encoders are read at t). The platform's motion once, then
+  // each channel's inputs at its mount and on its axes.
   const double delay_s = model.errors().output_delay_s;
-  const SensorInputs inputs = delay_s == 0.0 ? exact_inputs(model, joints)
-                                             : exact_inputs(model, joint_state_at(timeline, t - delay_s));
+  const PlatformFrameMotion motion =
+      platform_motion(model, delay_s == 0.0 ? joints : joint_state_at(timeline, t - delay_s));
   sample.time_s = t;
   sample.main_angle_deg = encoder_deg(joints.main_angle_rad);
   sample.counter_angle_deg = encoder_deg(joints.counter_angle_rad);
   sample.position_angle_deg = encoder_deg(joints.position_angle_rad);
-  // The sensor's noise-free output at the exact inputs (Gyro: docs/physics.md sections 6 and 15, the sensed
-  // rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
+  // Each sensor's noise-free output at its exact inputs (Gyro: docs/physics.md sections 6 and 15, the
+  // sensed rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
   // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
-  const double clean = sensor_output(sensor, inputs);
-  sample.outputs[0] = std::visit([clean](auto& generator) { return generator.next(clean); }, noise);
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    const double clean = sensor_output(channels[k].sensor, channel_inputs(model, motion, channels[k]));
+    sample.outputs[k] = std::visit([clean](auto& generator) { return generator.next(clean); }, noise[k]);
+  }
 }
 
 /// The simulation loop; `sink` is a template parameter so that the record writer's call is direct.
@@ -76,12 +99,12 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
                       const SimulationOptions& options, Sink&& sink) {
   const CentrifugeModel model = scenario.model();
   const double fs = scenario.test.sample_rate_hz;
-  const Sensor sensor = scenario.sensor();
-  NoiseGenerator noise = make_noise(scenario, fs, seed);
+  std::vector<NoiseGenerator> noise;
+  const std::vector<SensorChannel> channels = record_channels(scenario, fs, seed, noise);
   const std::uint64_t n = sample_count(timeline, fs);
   RecordSample sample;
   for (std::uint64_t k = 0; k < n; ++k) {
-    sample_at(model, sensor, timeline, static_cast<double>(k) / fs, noise, sample);
+    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample);
     sink(sample);
     if (options.progress && (k + 1) % kProgressEverySamples == 0) {
       options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
@@ -197,12 +220,12 @@ RecordSize estimate_record_size(const Scenario& scenario) {
   RecordWriter writer(rows, {}, {}, column);
   const std::size_t rows_head = rows.str().size();
   const CentrifugeModel model = scenario.model();
-  const Sensor sensor = scenario.sensor();
-  NoiseGenerator noise = make_noise(scenario, fs, scenario.test.seed);
+  std::vector<NoiseGenerator> noise;
+  const std::vector<SensorChannel> channels = record_channels(scenario, fs, scenario.test.seed, noise);
   RecordSample sample;
   std::uint64_t written = 0;
   for (std::uint64_t k = 0; k < size.rows; k += stride, ++written) {
-    sample_at(model, sensor, timeline, static_cast<double>(k) / fs, noise, sample);
+    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample);
     writer.write(sample);
   }
   writer.finish();

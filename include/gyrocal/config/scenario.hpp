@@ -12,6 +12,7 @@
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/record/record_layout.hpp"
 #include "gyrocal/reduce/dwell_accumulator.hpp"
+#include "gyrocal/sensor/channel.hpp"
 #include "gyrocal/sensor/sensor.hpp"
 
 namespace gyrocal {
@@ -77,6 +78,12 @@ struct Scenario {
 
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
+
+  /// The unit's channels, in the record's order (sensor/channel.hpp): today's one sensor is one channel,
+  /// named by its kind, its axes the mount's (model().mount(), which [centrifuge.errors]
+  /// mount_misalignment_rad and lever_arm_m configure) and its output column the [record] section's
+  /// (RecordLayout::output_columns()) or gyrocal's own (gyro_deg_h, accel_g).
+  std::vector<SensorChannel> channels() const;
 };
 
 /// The default scenario of docs/physics.md section 11.

@@ -11,6 +11,7 @@
 #include "gyrocal/model/centrifuge.hpp"
 #include "gyrocal/plan/test_spec.hpp"
 #include "gyrocal/reduce/reducer.hpp"
+#include "gyrocal/sensor/channel.hpp"
 #include "gyrocal/sensor/sensor.hpp"
 
 namespace gyrocal {
@@ -27,17 +28,18 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
 /// K3 and the radius (docs/accelerometer.md). Static holds keep gamma_deg.
 TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options);
 
-/// Model terms of every position of `reduction`, in its order, for `sensor` on `model`: PositionModelTerms::
-/// sensor_exact holds the reduced design row (the gyro's fields zero). Every sample of a dwell is reduced
-/// (its stretches as the output has them; a planned dwell's evenly spaced instants): by default (route
-/// kExact) from the design row's Fourier series in the two joint angles in closed form where its check holds
-/// (reduce_dwell_by_fourier, as the gyro's model terms), else by evaluating every sample (kEverySample, or a
-/// dwell that follows its measured motion); or every k-th sample as ReduceOptions::
+/// Model terms of every position of `reduction`, in its order, for `channel`'s sensor on its axes on
+/// `model`'s mount (sensor/channel.hpp: the platform's motion at each instant, then the channel's inputs on
+/// it): PositionModelTerms::sensor_exact holds the reduced design row (the gyro's fields zero). Every sample
+/// of a dwell is reduced (its stretches as the output has them; a planned dwell's evenly spaced instants): by
+/// default (route kExact) from the design row's Fourier series in the two joint angles in closed form where
+/// its check holds (reduce_dwell_by_fourier, as the gyro's model terms), else by evaluating every sample
+/// (kEverySample, or a dwell that follows its measured motion); or every k-th sample as ReduceOptions::
 /// model_samples_per_revolution and `max_samples_per_dwell` ask (as reduce_model_terms). `routes`, when
 /// given, receives what was done per dwell.
 std::vector<PositionModelTerms> reduce_sensor_model_terms(
     const Reduction& reduction, const CentrifugeModel& model, const ReduceOptions& options,
-    const Sensor& sensor, std::size_t max_samples_per_dwell = 0,
+    const SensorChannel& channel, std::size_t max_samples_per_dwell = 0,
     ModelTermsRoute route = ModelTermsRoute::kExact, std::vector<DwellModelTermsRoute>* routes = nullptr);
 
 }  // namespace gyrocal
