@@ -20,7 +20,7 @@ void AccumulatorFeed::hand_over(std::span<DwellAccumulator> next) {
   if (!open_.empty()) {
     changed_.wait(lock, [&] { return queue_.size() < kMaxBatches || error_; });
     if (error_) std::rethrow_exception(error_);
-    queue_.push_back({target_accs_, std::move(open_)});
+    queue_.push_back({target_, std::move(open_)});
     if (!thread_.joinable()) thread_ = std::thread([this] { work(); });
     changed_.notify_all();
     open_.clear();
@@ -30,8 +30,7 @@ void AccumulatorFeed::hand_over(std::span<DwellAccumulator> next) {
     }
   }
   if (open_.capacity() < kBatchSamples) open_.reserve(kBatchSamples);
-  target_accs_ = next;
-  target_ = next.data();
+  target_ = next;
 }
 
 void AccumulatorFeed::sync() {

@@ -109,10 +109,6 @@ class ReadAhead {
   bool holding_ = false, stop_ = false;
 };
 
-}  // namespace
-
-namespace {
-
 /// The one pass of reduce_record and reduce_record_channels: the rows read ahead, summarised, observed and
 /// pushed into `reducer`.
 void push_record(Reducer& reducer, RecordReader& reader,

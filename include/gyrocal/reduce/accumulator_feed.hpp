@@ -19,10 +19,10 @@
 namespace gyrocal {
 
 /// Feeds groups of DwellAccumulators (a dwell's, one per output column) from one producer thread through one
-/// worker thread. Between sync() calls the
-/// accumulators fed must not be touched (read, moved or destroyed) by anyone else; after sync() they are the
-/// caller's again until the next add(). The worker starts with the first batch and is joined by the
-/// destructor (work still queued then is dropped: the accumulators it was for are being abandoned).
+/// worker thread. Between sync() calls the accumulators fed must not be touched (read, moved or destroyed) by
+/// anyone else; after sync() they are the caller's again until the next add(). The worker starts with the
+/// first batch and is joined by the destructor (work still queued then is dropped: the accumulators it was
+/// for are being abandoned).
 class AccumulatorFeed {
  public:
   /// Samples per batch handed to the worker, and batches in flight at most (memory: ~1 MB).
@@ -43,7 +43,7 @@ class AccumulatorFeed {
       for (std::size_t k = 0; k < accs.size(); ++k) accs[k].add(time_s, gamma_rad, values + k);
       return;
     }
-    if (accs.data() != target_ || open_.size() + accs.size() > kBatchSamples) hand_over(accs);
+    if (accs.data() != target_.data() || open_.size() + accs.size() > kBatchSamples) hand_over(accs);
     for (std::size_t k = 0; k < accs.size(); ++k) open_.push_back({time_s, gamma_rad, values[k], false});
   }
   /// break_revolution() of each of `accs`, on the worker, in its place among the samples.
@@ -52,7 +52,7 @@ class AccumulatorFeed {
       for (DwellAccumulator& acc : accs) acc.break_revolution();
       return;
     }
-    if (accs.data() != target_ || open_.size() >= kBatchSamples) hand_over(accs);
+    if (accs.data() != target_.data() || open_.size() >= kBatchSamples) hand_over(accs);
     open_.push_back({0.0, 0.0, 0.0, true});
   }
   /// Returns once every call handed over has been made; rethrows the first exception the worker met.
@@ -74,8 +74,7 @@ class AccumulatorFeed {
 
   // The producer's side.
   bool threaded_;
-  DwellAccumulator* target_ = nullptr;
-  std::span<DwellAccumulator> target_accs_;
+  std::span<DwellAccumulator> target_;  ///< the group the open batch is for
   std::vector<Item> open_;
   // Shared with the worker, under mutex_.
   std::mutex mutex_;
