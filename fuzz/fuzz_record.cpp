@@ -77,9 +77,11 @@ Reading read_all(const std::string& text, std::size_t chunk_bytes,
 bool same_bits(const gyrocal::RecordSample& a, const gyrocal::RecordSample& b, std::size_t extra) {
   const auto eq = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
   if (!eq(a.time_s, b.time_s) || !eq(a.main_angle_deg, b.main_angle_deg) ||
-      !eq(a.counter_angle_deg, b.counter_angle_deg) || !eq(a.position_angle_deg, b.position_angle_deg) ||
-      !eq(a.output, b.output))
+      !eq(a.counter_angle_deg, b.counter_angle_deg) || !eq(a.position_angle_deg, b.position_angle_deg))
     return false;
+  // Every output slot: those a reading does not fill stay as the sample began (zero) in both.
+  for (std::size_t i = 0; i < a.outputs.size(); ++i)
+    if (!eq(a.outputs[i], b.outputs[i])) return false;
   for (std::size_t i = 0; i < extra; ++i)
     if (!eq(a.extra[i], b.extra[i])) return false;
   return true;
