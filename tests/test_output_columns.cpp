@@ -177,7 +177,7 @@ TEST(OutputColumns, EachColumnIsReducedAsItIsAloneWithItsOwnOutliers) {
   std::vector<RecordSample> rows = simulated_rows(s);
   // Column 1: -3 x column 0 + 7 (a sensor of another scale and bias: the reduction is linear and the outlier
   // rule scale-free, so its values are -3 v + 7 and its standard errors 3 se). Column 2: column 0 with a
-  // spike every 997 rows (its own outliers).
+  // spike every 101 rows (its own outliers).
   std::size_t spikes = 0;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     rows[i].outputs[1] = -3.0 * rows[i].outputs[0] + 7.0;

@@ -253,8 +253,20 @@ bool RecordLayout::is_default_angle_name(std::string_view name) {
          name == defaults.position_angle_column;
 }
 
-std::string_view OutputColumn::unit() const {
+namespace {
+
+/// The unit the reader gives an output of `quantity` in, and the [record] key of its scale.
+std::string_view unit_of(OutputQuantity quantity) {
   return quantity == OutputQuantity::kSpecificForce ? "g" : "deg/h";
+}
+std::string_view scale_key_of(OutputQuantity quantity) {
+  return quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g" : "output_scale_per_deg_h";
+}
+
+}  // namespace
+
+std::string_view OutputColumn::unit() const {
+  return unit_of(quantity);
 }
 
 std::string OutputColumn::column_unit() const {
@@ -262,7 +274,7 @@ std::string OutputColumn::column_unit() const {
 }
 
 std::string_view OutputColumn::scale_key() const {
-  return quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g" : "output_scale_per_deg_h";
+  return scale_key_of(quantity);
 }
 
 std::vector<OutputColumn> RecordLayout::output_columns() const {
@@ -276,7 +288,7 @@ double RecordLayout::output_scale() const {
 }
 
 std::string_view RecordLayout::output_unit() const {
-  return output_quantity == OutputQuantity::kSpecificForce ? "g" : "deg/h";
+  return unit_of(output_quantity);
 }
 
 std::string RecordLayout::column_unit() const {
@@ -288,7 +300,7 @@ std::string accelerometer_output_unit(const std::optional<RecordLayout>& layout)
 }
 
 std::string_view RecordLayout::output_scale_key() const {
-  return output_quantity == OutputQuantity::kSpecificForce ? "output_scale_per_g" : "output_scale_per_deg_h";
+  return scale_key_of(output_quantity);
 }
 
 double output_scale_per_g(const std::optional<RecordLayout>& layout) {

@@ -98,13 +98,9 @@ std::vector<Reduction> Reducer::finish_channels() {
       r.outliers += r.dwells[i].output.outliers;
     }
     for (ReducedPosition& p : r.positions) {
-      const Dwell& d = r.dwells[static_cast<std::size_t>(p.dwell)];
-      const auto k = static_cast<std::size_t>(p.gamma_slot);
-      p.mean = d.output.value[k];
-      p.std_err = d.output.std_err[k];
-      p.samples = d.output.samples[k];
-      p.outliers = d.output.outliers;
-      p.channel = static_cast<int>(c);
+      const Position planned{p.index, p.rate_rad_s, p.beta_rad, p.gamma_rad, p.counter_rate_offset_rad_s};
+      p = reduced_position(planned, r.dwells[static_cast<std::size_t>(p.dwell)], p.dwell,
+                           static_cast<int>(c));
     }
     out.push_back(std::move(r));
   }
