@@ -79,11 +79,26 @@ struct Scenario {
   /// The centrifuge model this scenario describes.
   CentrifugeModel model() const { return CentrifugeModel(site, centrifuge, errors); }
 
-  /// The unit's channels, in the record's order (sensor/channel.hpp): today's one sensor is one channel,
-  /// named by its kind, its axes the mount's (model().mount(), which [centrifuge.errors]
+  /// [sensor] kind = "imu" and its [[channel]] tables (docs/imu.md): a whole IMU's channels in the record's
+  /// order, each a gyro or an accelerometer (its truth and noise for simulation) on its own axes in the
+  /// IMU's body frame, its output column named by the channel (or its `column` key), read as a rate or an
+  /// increment with the channel's output_scale. Empty for a lone sensor (sensor_kind and its sections then
+  /// describe it).
+  std::vector<SensorChannel> imu_channels;
+
+  /// True when the scenario describes a whole IMU ([sensor] kind = "imu").
+  bool is_imu() const { return !imu_channels.empty(); }
+
+  /// The unit's channels, in the record's order (sensor/channel.hpp): an IMU's imu_channels; a lone sensor
+  /// is one channel, named by its kind, its axes the mount's (model().mount(), which [centrifuge.errors]
   /// mount_misalignment_rad and lever_arm_m configure) and its output column the [record] section's
   /// (RecordLayout::output_columns()) or gyrocal's own (gyro_deg_h, accel_g).
   std::vector<SensorChannel> channels() const;
+
+  /// The layout a record of this scenario is read with: `record` for a lone sensor (nullopt: gyrocal's own
+  /// format, magic line required); for an IMU, `record` (or gyrocal's own column names) with one output
+  /// column per channel (RecordLayout::outputs, the channels' OutputColumn).
+  std::optional<RecordLayout> reading_layout() const;
 };
 
 /// The default scenario of docs/physics.md section 11.
