@@ -1,0 +1,460 @@
+#include "gyrocal/identify/imu_calibration.hpp"
+
+// An IMU's joint identification (docs/imu.md, "One joint solve"): each channel's reduced positions weighted
+// by its own levels (weighted_positions.hpp), stacked into one least squares whose unknowns are every
+// channel's products and the shared machine errors, Gauss-Newton on the exact model for the errors as a lone
+// sensor's self-calibration (self_calibration.cpp), the uncertainties a sandwich of every channel's own
+// levels, each channel's coefficients stepped back from its products by its sensor's from_products.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gyrocal/core/error.hpp"
+#include "gyrocal/identify/sensor_model_terms.hpp"
+#include "gyrocal/model/nominal.hpp"
+
+#include "closed_form_identify.hpp"
+#include "position_covariance.hpp"
+#include "weighted_positions.hpp"
+
+namespace gyrocal {
+namespace {
+
+using identify_detail::weigh_positions;
+using identify_detail::WeightedPositions;
+
+/// `model` with the parameters `ps` set to `values_si`.
+CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
+                            const std::vector<double>& values_si) {
+  CentrifugeErrors e = model.errors();
+  for (std::size_t i = 0; i < ps.size(); ++i) ps[i].set(e, values_si[i]);
+  return CentrifugeModel(model.site(), model.geometry(), e);
+}
+
+std::size_t unknowns_of(const Sensor& s) {
+  return std::visit([](const auto& x) { return x.num_unknowns(); }, s);
+}
+
+/// The output's noise-free level of a channel, in its unit (identify/misfit.hpp): a standard error at or
+/// below it is rounding, not noise.
+double noise_free_level(const SensorChannel& c) {
+  return kind_of(c.sensor) == SensorKind::kGyro ? kGyroNoiseFreeDegH : kAccelerometerNoiseFreeRelative;
+}
+
+/// Everything the joint solve keeps of one channel at one Gauss-Newton step.
+struct ChannelProblem {
+  std::vector<PositionModelTerms> terms;  ///< its model terms at the current machine
+  Eigen::MatrixXd error_columns;          ///< d(reduced model output)/d(error), output unit per error unit
+  WeightedPositions weighted;             ///< its positions, weighted by its own levels
+};
+
+/// The reduced model output of one position at products u: known + sum_j u_j r_j.
+double model_output(const DesignRow& row, const Eigen::VectorXd& u) {
+  double v = row.known;
+  for (std::size_t j = 0; j < row.size; ++j) v += u[static_cast<Eigen::Index>(j)] * row.regressors[j];
+  return v;
+}
+
+/// The columns of the estimated errors for one channel at its products u: each the central difference of
+/// its reduced model output with the error's typical magnitude as the step (as self_calibration.cpp).
+Eigen::MatrixXd error_columns(const Reduction& reduction, const SensorChannel& channel,
+                              const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
+                              const std::vector<double>& values_si, const Eigen::VectorXd& u,
+                              const CalibrationOptions& options) {
+  const auto m = static_cast<Eigen::Index>(reduction.positions.size());
+  Eigen::MatrixXd out(m, static_cast<Eigen::Index>(ps.size()));
+  for (std::size_t a = 0; a < ps.size(); ++a) {
+    const MachineErrorField& f = ps[a].info();
+    const double h = f.typical_si;
+    std::vector<double> plus = values_si, minus = values_si;
+    plus[a] += h;
+    minus[a] -= h;
+    const auto up = reduce_sensor_model_terms(reduction, with_errors(model, ps, plus), options.reduce, channel,
+                                              options.max_model_samples_per_dwell);
+    const auto down = reduce_sensor_model_terms(reduction, with_errors(model, ps, minus), options.reduce,
+                                                channel, options.max_model_samples_per_dwell);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      out(i, static_cast<Eigen::Index>(a)) =
+          (model_output(up[k].sensor_exact, u) - model_output(down[k].sensor_exact, u)) / (2.0 * h) *
+          f.unit_to_si;
+    }
+  }
+  return out;
+}
+
+/// One channel's positions weighted by its own levels, its design [regressors | error columns].
+WeightedPositions weigh_channel(const Reduction& reduction, const SensorChannel& channel,
+                                const std::vector<PositionModelTerms>& terms, const Eigen::MatrixXd& errors,
+                                const std::vector<std::string>& names, const CalibrationOptions& options) {
+  const auto m = static_cast<Eigen::Index>(reduction.positions.size());
+  const auto nc = static_cast<Eigen::Index>(unknowns_of(channel.sensor));
+  const Eigen::Index k = errors.cols();
+  Eigen::MatrixXd design(m, nc + k);
+  Eigen::VectorXd observations(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const DesignRow& row = terms[static_cast<std::size_t>(i)].sensor_exact;
+    if (static_cast<Eigen::Index>(row.size) != nc)
+      throw Error(fmt::format("channel {}: its model terms hold {} unknowns, its sensor {} (internal).",
+                              channel.name, row.size, nc));
+    for (Eigen::Index j = 0; j < nc; ++j) design(i, j) = row.regressors[static_cast<std::size_t>(j)];
+    if (k > 0) design.row(i).tail(k) = errors.row(i);
+    const double mean = reduction.positions[static_cast<std::size_t>(i)].mean;
+    if (!std::isfinite(mean))
+      throw Error(fmt::format("channel {}: a reduced output is not a finite number: its outputs are too large "
+                              "to average; check its column {}.",
+                              channel.name, channel.output.column));
+    observations[i] = mean - row.known;
+  }
+  const bool gyro = kind_of(channel.sensor) == SensorKind::kGyro;
+  return weigh_positions(reduction, std::move(design), std::move(observations), names, options.min_std_err,
+                         options.reduce, gyro ? "deg/h" : "g",
+                         fmt::format("channel {}'s outputs", channel.name));
+}
+
+/// The joint problem's solution at one step.
+struct JointSolution {
+  LeastSquaresSolution solution;
+  Eigen::MatrixXd covariance;       ///< the sandwich of every channel's own levels
+  std::vector<Eigen::MatrixXd> gains;  ///< per channel: G_c, n x m_c (x = sum_c G_c y_c)
+};
+
+/// Stacks every channel's whitened rows (its products' block, the shared errors' last columns) and solves.
+JointSolution solve_joint(const std::vector<ChannelProblem>& problems, const std::vector<Eigen::Index>& offsets,
+                          Eigen::Index n, Eigen::Index k, const std::vector<std::string>& names,
+                          const CalibrationOptions& options) {
+  Eigen::Index rows = 0;
+  for (const ChannelProblem& p : problems) rows += p.weighted.whitened.design.rows();
+  LeastSquaresProblem joint;
+  joint.design = Eigen::MatrixXd::Zero(rows, n);
+  joint.observations.resize(rows);
+  joint.weights = Eigen::VectorXd::Ones(rows);
+  joint.names = names;
+  Eigen::Index at = 0;
+  for (std::size_t c = 0; c < problems.size(); ++c) {
+    const LeastSquaresProblem& w = problems[c].weighted.whitened;
+    const Eigen::Index mc = w.design.rows(), nc = w.design.cols() - k;
+    joint.design.block(at, offsets[c], mc, nc) = w.design.leftCols(nc);
+    if (k > 0) joint.design.block(at, n - k, mc, k) = w.design.rightCols(k);
+    joint.observations.segment(at, mc) = w.observations;
+    at += mc;
+  }
+  LeastSquaresOptions lso = options.least_squares;
+  lso.rank_tolerance = std::max(lso.rank_tolerance, 1.0 / options.max_uncertainty_ratio);
+  JointSolution out;
+  out.solution = solve_least_squares(joint, lso);
+  // The sandwich: x = Cov X~' L^-1 y stacked by channel, so x = sum_c G_c y_c with G_c = Cov X~_c' L_c^-1,
+  // and its covariance sum_c G_c C_c G_c' with C_c the channel's own levels (weighted_positions.hpp).
+  out.covariance = Eigen::MatrixXd::Zero(n, n);
+  at = 0;
+  for (std::size_t c = 0; c < problems.size(); ++c) {
+    const WeightedPositions& w = problems[c].weighted;
+    const Eigen::Index mc = w.design.rows();
+    const Eigen::MatrixXd xt = joint.design.middleRows(at, mc);  // X~_c in the joint columns
+    const Eigen::MatrixXd g =
+        (w.weighting.matrixU().solve(xt * out.solution.covariance)).transpose();  // (L_c^-T X~_c Cov)'
+    out.covariance += g * w.covariance * g.transpose();
+    out.gains.push_back(g);
+    at += mc;
+  }
+  return out;
+}
+
+/// The factor widening the standard uncertainty of c'x for the degrees of freedom of the levels it rests on:
+/// each channel's Student factor (position_covariance.hpp) weighted by the part of the variance it gives.
+double student(const std::vector<Reduction>& reductions, const std::vector<ChannelProblem>& problems,
+               const JointSolution& js, const Eigen::VectorXd& c) {
+  double total = 0.0, widened = 0.0;
+  for (std::size_t k = 0; k < problems.size(); ++k) {
+    const Eigen::VectorXd g = js.gains[k].transpose() * c;
+    const double v = g.dot(problems[k].weighted.covariance * g);
+    if (!(v > 0.0)) continue;
+    double nu = 0.0;
+    const double f = identify_detail::student_factor(reductions[k], problems[k].weighted.covariance, g, &nu);
+    total += v;
+    widened += v * f * f;
+  }
+  return total > 0.0 ? std::sqrt(widened / total) : 1.0;
+}
+
+/// The step back of one channel from its products u (covariance cu) to its coefficients, by the delta method
+/// with from_products' Jacobian by central differences (exact to rounding for the ratios it takes).
+ParameterEstimates step_back(const Sensor& sensor, const Eigen::VectorXd& u, const Eigen::MatrixXd& cu,
+                             Eigen::MatrixXd* jacobian) {
+  const std::vector<bool> all(static_cast<std::size_t>(u.size()), true);
+  const auto values = [&](const Eigen::VectorXd& x) {
+    return std::visit([&](const auto& s) { return s.from_products(x, cu, all); }, sensor);
+  };
+  ParameterEstimates pe = values(u);
+  jacobian->setZero(pe.values.size(), u.size());
+  for (Eigen::Index j = 0; j < u.size(); ++j) {
+    const double h = 1e-6 * std::max(std::abs(u[j]), 1e-3);
+    Eigen::VectorXd up = u, down = u;
+    up[j] += h;
+    down[j] -= h;
+    jacobian->col(j) = (values(up).values - values(down).values) / (2.0 * h);
+  }
+  return pe;
+}
+
+}  // namespace
+
+const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) const {
+  for (const ImuChannelResult& c : channels)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
+                                  const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
+                                  const CalibrationOptions& options) {
+  if (channels.empty() || reductions.size() != channels.size())
+    throw Error(fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
+                            channels.size(), reductions.size()));
+  if (options.method != Method::kLeastSquares)
+    throw Error("an IMU is calibrated by least squares (--method least-squares): the closed forms are the lone "
+                "gyro's 16-position formulas.");
+  if (options.compensation != Compensation::kFull)
+    throw Error("an IMU is calibrated with --compensation full: its channels' inputs are the exact model's "
+                "(docs/imu.md).");
+  const std::vector<MachineErrorParameter>& ps = options.estimate;
+  for (const MachineErrorParameter& p : ps)
+    if (p.info().vector == &CentrifugeErrors::mount_misalignment_rad)
+      throw Error(fmt::format(
+          "--estimate {}: an IMU's mount misalignment cannot be estimated beside its channels' tilts: each "
+          "channel's input-axis tilts are measured against the mount, which the lab's fixture defines, so the "
+          "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
+          p.error_name()));
+  const std::size_t nch = channels.size();
+  const auto k = static_cast<Eigen::Index>(ps.size());
+  // The unknowns: each channel's products ("gx.dF"), then the errors.
+  std::vector<Eigen::Index> offsets;
+  std::vector<std::string> names;
+  for (const SensorChannel& c : channels) {
+    offsets.push_back(static_cast<Eigen::Index>(names.size()));
+    const auto table = std::visit([](const auto& s) { return s.unknown_names(); }, c.sensor);
+    for (std::string_view u : table) names.push_back(fmt::format("{}.{}", c.name, u));
+  }
+  for (const MachineErrorParameter& p : ps) names.push_back(p.label());
+  const auto n = static_cast<Eigen::Index>(names.size());
+  const Eigen::Index np = n - k;
+
+  std::vector<double> configured(ps.size()), values(ps.size());
+  for (std::size_t j = 0; j < ps.size(); ++j) values[j] = configured[j] = ps[j].get(model.errors());
+  // The products the errors' columns are first taken at: a plain joint fit at the configured machine (an
+  // accelerometer's output is all in its products, so zero products would leave its columns zero).
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  std::vector<ChannelProblem> problems(nch);
+  JointSolution js;
+  ImuCalibrationResult r;
+  const auto channel_names = [&](std::size_t c, bool with_errors) {
+    std::vector<std::string> out(names.begin() + offsets[c],
+                                 names.begin() + offsets[c] + static_cast<Eigen::Index>(unknowns_of(
+                                                                  channels[c].sensor)));
+    if (with_errors) out.insert(out.end(), names.end() - k, names.end());
+    return out;
+  };
+  for (int iteration = 0;; ++iteration) {
+    const bool plain = iteration == 0 && k > 0;  // the start, without the errors' columns
+    const CentrifugeModel current = with_errors(model, ps, values);
+    for (std::size_t c = 0; c < nch; ++c) {
+      ChannelProblem& p = problems[c];
+      p.terms = reduce_sensor_model_terms(reductions[c], current, options.reduce, channels[c],
+                                          options.max_model_samples_per_dwell);
+      const auto nc = static_cast<Eigen::Index>(unknowns_of(channels[c].sensor));
+      p.error_columns = plain || k == 0
+                            ? Eigen::MatrixXd(reductions[c].positions.size(), 0)
+                            : error_columns(reductions[c], channels[c], current, ps, values,
+                                            x.segment(offsets[c], nc), options);
+      p.weighted = weigh_channel(reductions[c], channels[c], p.terms, p.error_columns,
+                                 channel_names(c, !plain), options);
+    }
+    if (plain) {
+      std::vector<std::string> product_names(names.begin(), names.end() - k);
+      const JointSolution start = solve_joint(problems, offsets, np, 0, product_names, options);
+      x.head(np) = start.solution.estimate;
+      continue;
+    }
+    js = solve_joint(problems, offsets, n, k, names, options);
+    const LeastSquaresSolution& sol = js.solution;
+    r.iterations = iteration;
+    if (k == 0) {
+      x = sol.estimate;
+      break;
+    }
+    bool converged = true;
+    for (Eigen::Index a = 0; a < k; ++a) {
+      const auto j = static_cast<std::size_t>(a);
+      if (!sol.identifiable[static_cast<std::size_t>(np + a)])
+        throw Error(fmt::format(
+            "--estimate {}: this IMU's plan cannot separate it from the channels' coefficients and the other "
+            "errors estimated (it is collinear with them); estimate fewer errors or add dwells "
+            "(docs/imu.md, \"What one mounting identifies\").",
+            ps[j].label()));
+      const double step = sol.estimate[np + a];
+      const double sd = std::sqrt(js.covariance(np + a, np + a));
+      values[j] += step * ps[j].info().unit_to_si;
+      const double typical = ps[j].info().typical_si / ps[j].info().unit_to_si;
+      if (!(std::abs(step) <= options.convergence * sd || std::abs(step) <= 1e-9 * typical)) converged = false;
+    }
+    for (Eigen::Index j = 0; j < np; ++j) {
+      const double sd = std::sqrt(js.covariance(j, j));
+      if (!(std::abs(sol.estimate[j] - x[j]) <= options.convergence * sd ||
+            std::abs(sol.estimate[j] - x[j]) <= 1e-12 * std::max(1.0, std::abs(x[j]))))
+        converged = false;
+    }
+    x.head(np) = sol.estimate.head(np);
+    if (converged) break;
+    if (iteration >= options.max_iterations)
+      throw Error(fmt::format(
+          "the IMU's self-calibration (--estimate) did not converge in {} Gauss-Newton iterations: the "
+          "configured values are too far from the machine's, or the errors are barely identifiable.",
+          options.max_iterations));
+  }
+  const LeastSquaresSolution& sol = js.solution;
+  r.rank = sol.rank;
+  r.unknowns = static_cast<int>(n);
+  r.condition_number = sol.effective_condition_number;
+  r.covariance = js.covariance;
+  r.names = names;
+  for (const std::string& w : sol.warnings)
+    if (w.rfind("chi2 = ", 0) != 0) r.warnings.push_back("least squares: " + w);
+
+  // Each channel: its residuals and misfit test, then its coefficients.
+  Eigen::Index at = 0;
+  double worst_scale = 1.0;
+  for (std::size_t c = 0; c < nch; ++c) {
+    const SensorChannel& ch = channels[c];
+    const ChannelProblem& p = problems[c];
+    const Reduction& red = reductions[c];
+    const auto nc = static_cast<Eigen::Index>(unknowns_of(ch.sensor));
+    ImuChannelResult out;
+    out.name = ch.name;
+    out.sensor = kind_of(ch.sensor);
+    out.positions = red.positions;
+    out.outliers = red.outliers;
+    for (const std::string& w : red.warnings) out.warnings.push_back(w);
+    const Eigen::Index mc = p.weighted.design.rows();
+    Eigen::VectorXd xc(nc + k);
+    xc << x.segment(offsets[c], nc), Eigen::VectorXd::Zero(k);  // the errors are in the model already
+    const Eigen::VectorXd residuals = p.weighted.observations - p.weighted.design.leftCols(nc) * xc.head(nc);
+    out.residuals.assign(residuals.data(), residuals.data() + residuals.size());
+    // Its chi2 on its own whitened rows; its degrees of freedom its rows less its part of the hat matrix's
+    // trace (what the joint fit spent on its rows).
+    const Eigen::VectorXd wres = p.weighted.weighting.matrixL().solve(residuals);
+    double spent = 0.0;
+    for (Eigen::Index i = 0; i < mc; ++i) {
+      Eigen::VectorXd xi = Eigen::VectorXd::Zero(n);
+      xi.segment(offsets[c], nc) = p.weighted.whitened.design.row(i).head(nc).transpose();
+      if (k > 0) xi.tail(k) = p.weighted.whitened.design.row(i).tail(k).transpose();
+      spent += xi.dot(sol.covariance * xi);
+    }
+    const int dof = static_cast<int>(std::lround(static_cast<double>(mc) - spent));
+    out.misfit = test_misfit(red, wres.squaredNorm(), dof, noise_free_level(ch));
+    if (out.misfit.tested && out.misfit.p_value < options.misfit.p_min) {
+      const double scale = std::sqrt(out.misfit.chi2 / std::max(1, out.misfit.dof));
+      if (options.test_misfit && scale > options.misfit.max_scale)
+        throw Error(fmt::format(
+            "channel {} (column {}): its residuals are {:.3g} times its noise (chi2 {:.4g} on {} degrees of "
+            "freedom, more than [calibration] misfit's {:g}): its output does not follow a {}'s model on its "
+            "axes: a dead, clipped or sign-flipped channel, a wrong column, axis or output_scale.",
+            ch.name, ch.output.column, scale, out.misfit.chi2, out.misfit.dof, options.misfit.max_scale,
+            to_string(out.sensor)));
+      out.misfit.scale = scale;
+      worst_scale = std::max(worst_scale, scale);
+      out.warnings.push_back(fmt::format(
+          "its residuals are {:.3g} times the noise its dwells show (chi2 {:.4g} on {} degrees of freedom, p = "
+          "{:.2g}): every std of its coefficients is multiplied by that factor.",
+          scale, out.misfit.chi2, out.misfit.dof, out.misfit.p_value));
+    }
+    // Coefficients: the delta method on its products' block of the joint covariance.
+    const Eigen::VectorXd u = x.segment(offsets[c], nc);
+    const Eigen::MatrixXd cu = js.covariance.block(offsets[c], offsets[c], nc, nc);
+    Eigen::MatrixXd jac;
+    const ParameterEstimates pe = step_back(ch.sensor, u, cu, &jac);
+    out.products.assign(u.data(), u.data() + u.size());
+    const double output_scale = out.sensor == SensorKind::kAccelerometer ? ch.output.scale : 1.0;
+    CalibrationOptions one = options;
+    one.sensor = out.sensor;
+    if (const auto* g = std::get_if<Gyro>(&ch.sensor)) one.gyro_model = g->model;
+    one.output_unit = ch.output.column_unit();
+    out.coefficients = unestimated_coefficients(one);
+    for (Eigen::Index q = 0; q < pe.values.size() && q < static_cast<Eigen::Index>(out.coefficients.size());
+         ++q) {
+      CoefficientEstimate& e = out.coefficients[static_cast<std::size_t>(q)];
+      Eigen::VectorXd row = Eigen::VectorXd::Zero(n);
+      row.segment(offsets[c], nc) = jac.row(q).transpose();
+      bool identifiable = true;
+      for (Eigen::Index j = 0; j < nc; ++j)
+        if (jac(q, j) != 0.0 && !sol.identifiable[static_cast<std::size_t>(offsets[c] + j)])
+          identifiable = false;
+      e.identifiable = identifiable;
+      if (!identifiable) {
+        e.reason = "not identifiable from this plan with the errors estimated (docs/imu.md)";
+        continue;
+      }
+      const bool k1 = out.sensor == SensorKind::kAccelerometer && e.name == "K1";
+      e.value = pe.values[q] * (k1 ? output_scale : 1.0);
+      e.std = std::sqrt(row.dot(js.covariance * row)) * student(reductions, problems, js, row) *
+              out.misfit.scale * (k1 ? std::abs(output_scale) : 1.0);
+    }
+    r.channels.push_back(std::move(out));
+    at += mc;
+  }
+  // The shared errors.
+  for (std::size_t j = 0; j < ps.size(); ++j) {
+    const auto a = static_cast<Eigen::Index>(j);
+    const MachineErrorField& f = ps[j].info();
+    MachineErrorEstimate e;
+    e.parameter = ps[j];
+    e.error = f.kind == MachineErrorKind::kSeries ? std::string(f.name) : ps[j].error_name();
+    e.harmonic = ps[j].harmonic;
+    e.part = ps[j].part == HarmonicPart::kCos ? "cos" : ps[j].part == HarmonicPart::kSin ? "sin" : "";
+    e.unit = f.unit;
+    e.configured = configured[j] / f.unit_to_si;
+    e.identifiable = true;
+    e.value = values[j] / f.unit_to_si;
+    const Eigen::VectorXd unit = Eigen::VectorXd::Unit(n, np + a);
+    e.std = std::sqrt(js.covariance(np + a, np + a)) * student(reductions, problems, js, unit) * worst_scale;
+    r.machine_errors.push_back(std::move(e));
+  }
+  // The record's quality: its rows and gaps are every channel's; outliers summed.
+  const Reduction& first = reductions.front();
+  r.data_quality.rows_read = first.samples_read;
+  r.data_quality.rows_used = first.samples_used;
+  r.data_quality.gaps = first.gaps;
+  r.data_quality.encoder_glitch_rows = first.encoder_glitch_rows;
+  for (const Reduction& red : reductions) r.data_quality.outliers += red.outliers;
+  for (const RejectedRun& rr : first.rejected)
+    r.data_quality.rejected.push_back({rr.start_s, rr.end_s, rr.reason});
+  r.warnings.insert(r.warnings.begin(), first.warnings.begin(), first.warnings.end());
+  r.g_level = radial_level_g(model.site(), model.geometry().radius_m, identify_detail::first_spinning_rate(first.positions));
+  return r;
+}
+
+ImuCalibrationResult calibrate_imu_record(RecordReader& reader, const std::vector<SensorChannel>& channels,
+                                          const CentrifugeModel& model, const TestSpec& plan,
+                                          const CalibrationOptions& options) {
+  reader.require_angles();
+  if (reader.output_count() != channels.size())
+    throw Error(fmt::format("the record is read with {} output columns for an IMU of {} channels.",
+                            reader.output_count(), channels.size()));
+  // Every channel reduced to the harmonic content of a revolution when any is an accelerometer (its K3 and
+  // the radius need it; a gyro's reduction serves at any gamma).
+  const bool any_accelerometer = std::any_of(channels.begin(), channels.end(), [](const SensorChannel& c) {
+    return kind_of(c.sensor) == SensorKind::kAccelerometer;
+  });
+  const TestSpec reduce_plan = reduction_plan(
+      plan, any_accelerometer ? SensorKind::kAccelerometer : SensorKind::kGyro, options.reduce);
+  const std::vector<Reduction> reductions =
+      reduce_record_channels(reader, reduce_plan, options.reduce, model.geometry().rate_rad_s);
+  return identify_imu(reductions, channels, model, options);
+}
+
+}  // namespace gyrocal
