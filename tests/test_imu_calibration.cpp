@@ -2,7 +2,6 @@
 // shared radius error and stretch from one mounting. The records come from this test's own generator (the
 // exact model sampled at each instant, not the simulator), with machine errors of every kind.
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -77,14 +76,25 @@ std::vector<SensorChannel> triad() {
 
 /// The plan and machine: the default accelerometer scenario's (static holds, 6 and 12 rad/s, four beta, eight
 /// gamma) with few revolutions, on a machine with errors of every kind and an arm 20 um long that stretches
-/// by 1e-7 m/(rad/s)^2.
-Scenario imu_scenario() {
+/// by 1e-7 m/(rad/s)^2. A shorter record (fewer samples, the same plan) serves the study over many seeds.
+Scenario imu_scenario(double sample_rate_hz = 100.0, double static_hold_s = 4.0, int revolutions = 6) {
   Scenario s = default_accelerometer_scenario();
-  s.test.revolutions = 6;
-  s.test.static_hold_s = 4.0;
-  s.test.sample_rate_hz = 100.0;
-  s.errors.radius_error_m = 20e-6;
-  s.errors.radius_stretch_m_per_rad2_s2 = 1e-7;
+  s.test.revolutions = revolutions;
+  s.test.static_hold_s = static_hold_s;
+  s.test.sample_rate_hz = sample_rate_hz;
+  // The default machine's errors (perpendicularities, wobbles, the platform's rate mismatch) and one of every
+  // other kind, all known to the calibration but the radius error and stretch.
+  CentrifugeErrors& e = s.errors;
+  e.base_tilt_x_rad = 2.0 * kArcsecToRad;
+  e.main_perpendicularity_y_rad = 1.5 * kArcsecToRad;
+  e.main_runout_x_m.terms = {{1, 1e-6, 30.0 * kDegToRad}};
+  e.position_perpendicularity_x_rad = 2.0 * kArcsecToRad;
+  e.position_wobble_x_rad.terms = {{1, 1.0 * kArcsecToRad, 10.0 * kDegToRad}};
+  e.position_angle_error_rad = 3.0 * kArcsecToRad;
+  e.counter_angle_error_rad = -2.0 * kArcsecToRad;
+  e.lever_arm_m = Eigen::Vector3d(0.01, 0.0, 0.005);
+  e.radius_error_m = 20e-6;
+  e.radius_stretch_m_per_rad2_s2 = 1e-7;
   s.imu_channels = triad();
   return s;
 }
@@ -141,7 +151,8 @@ CentrifugeModel configured_machine(const Scenario& s) {
 TEST(ImuCalibration, NoiseFreeRatesRecoverEveryChannelAndTheRadius) {
   const Scenario s = imu_scenario();
   const std::vector<Reduction> reductions = reduce_generated(s, 1, 0.0, 0.0);
-  const ImuCalibrationResult r = identify_imu(reductions, s.channels(), configured_machine(s), estimating_radius());
+  const ImuCalibrationResult r =
+      identify_imu(reductions, s.channels(), configured_machine(s), estimating_radius());
   EXPECT_EQ(r.rank, r.unknowns);
   EXPECT_EQ(r.unknowns, 3 * 10 + 3 * 11 + 2);
   ASSERT_EQ(r.channels.size(), 6u);
@@ -167,14 +178,82 @@ TEST(ImuCalibration, NoiseFreeRatesRecoverEveryChannelAndTheRadius) {
       }
     }
   }
+  // The triad's geometry: the angle between ax's and ay's fitted input axes, against the configured tilts'
+  // by hand (ax: i = x, p = y, o = z; ay: i = y, p = z, o = x; tilts in urad).
+  const auto tilt = [&](std::size_t c, AccelCoefficient k) {
+    return std::get<Accelerometer>(s.imu_channels[c].sensor).coefficients[k] * 1e-6;
+  };
+  const Eigen::Vector3d n_ax =
+      Eigen::Vector3d(1.0, tilt(3, AccelCoefficient::delta_p), tilt(3, AccelCoefficient::delta_o))
+          .normalized();
+  const Eigen::Vector3d n_ay =
+      Eigen::Vector3d(tilt(4, AccelCoefficient::delta_o), 1.0, tilt(4, AccelCoefficient::delta_p))
+          .normalized();
+  const double want_deg = std::acos(n_ax.dot(n_ay)) * kRadToDeg;
+  ASSERT_EQ(r.input_axis_angles.size(), 3u);  // the accelerometers' three pairs (the gyros' model is drift)
+  EXPECT_EQ(r.input_axis_angles[0].first, "ax");
+  EXPECT_EQ(r.input_axis_angles[0].second, "ay");
+  EXPECT_NEAR(r.input_axis_angles[0].angle_deg, want_deg, 1e-9 * kRadToDeg);
+  EXPECT_NEAR(r.input_axis_angles[0].deviation_urad, (want_deg - 90.0) * kDegToRad * 1e6, 1e-3);
+  EXPECT_GT(r.input_axis_angles[0].std_urad, 0.0);
   ASSERT_EQ(r.machine_errors.size(), 2u);
-  if (std::getenv("IMU_DIAG")) {
-    for (const auto& ch : r.channels)
-      for (const auto& c : ch.coefficients) std::printf("%s %s %.12g %.3g\n", ch.name.c_str(), c.name.c_str(), c.value, c.std);
-    for (const auto& e : r.machine_errors) std::printf("%s %.12g %.3g it %d\n", e.error.c_str(), e.value, e.std, r.iterations);
-  }
   EXPECT_NEAR(r.machine_errors[0].value, 20e-6, 1e-9);  // m
   EXPECT_NEAR(r.machine_errors[1].value, 1e-7, 1e-11);  // m/(rad/s)^2
+}
+
+/// The std and mean of a sample of z-scores.
+struct ZStats {
+  double mean = 0.0, std = 0.0;
+  std::size_t n = 0;
+};
+ZStats stats(const std::vector<double>& z) {
+  ZStats s;
+  s.n = z.size();
+  for (double v : z) s.mean += v / static_cast<double>(z.size());
+  for (double v : z) s.std += (v - s.mean) * (v - s.mean) / static_cast<double>(z.size() - 1);
+  s.std = std::sqrt(s.std);
+  return s;
+}
+
+// Honest uncertainties: over many noisy records, each channel's errors divided by their stated std (every
+// coefficient of the channel pooled) and the radius error's have unit spread and no bias. 100 seeds (the
+// sanitizer build: 12, with bands as wide in units of the statistic's own spread).
+TEST(ImuCalibration, ZScoresOverSeedsAreHonestForEveryChannelAndTheRadius) {
+  const Scenario s = imu_scenario(30.0, 2.0, 4);
+  const CentrifugeModel machine = configured_machine(s);
+  const int seeds = testing::sanitized() ? 12 : 100;
+  std::vector<std::vector<double>> z(s.imu_channels.size());
+  std::vector<double> z_radius, z_stretch;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const std::vector<Reduction> reductions =
+        reduce_generated(s, static_cast<std::uint64_t>(seed), 0.5, 1e-4);
+    const ImuCalibrationResult r = identify_imu(reductions, s.channels(), machine, estimating_radius());
+    for (std::size_t c = 0; c < r.channels.size(); ++c) {
+      const SensorChannel& truth = s.imu_channels[c];
+      for (std::size_t j = 0; j < r.channels[c].coefficients.size(); ++j) {
+        const CoefficientEstimate& e = r.channels[c].coefficients[j];
+        const double want = std::holds_alternative<Gyro>(truth.sensor)
+                                ? std::get<Gyro>(truth.sensor).drift.values[j]
+                                : std::get<Accelerometer>(truth.sensor).coefficients.values[j];
+        z[c].push_back((e.value - want) / e.std);
+      }
+    }
+    z_radius.push_back((r.machine_errors[0].value - 20e-6) / r.machine_errors[0].std);
+    z_stretch.push_back((r.machine_errors[1].value - 1e-7) / r.machine_errors[1].std);
+  }
+  const auto check = [seeds](const std::vector<double>& values, const std::string& what) {
+    const ZStats st = stats(values);
+    // The contract's bands at 100 seeds; with fewer, 3.5 times the statistic's spread (std: 1/sqrt(2 n) per
+    // seed's worth of values, mean 1/sqrt(n)).
+    const double per_seed = static_cast<double>(values.size()) / seeds;
+    const double std_band = seeds >= 100 ? 0.2 : 3.5 / std::sqrt(2.0 * seeds * std::min(per_seed, 1.0));
+    const double mean_band = seeds >= 100 ? 0.3 : 3.5 / std::sqrt(static_cast<double>(seeds));
+    EXPECT_NEAR(st.std, 1.0, std_band) << what << ": z-scores' std over " << st.n << " values";
+    EXPECT_NEAR(st.mean, 0.0, mean_band) << what << ": z-scores' mean over " << st.n << " values";
+  };
+  for (std::size_t c = 0; c < z.size(); ++c) check(z[c], s.imu_channels[c].name);
+  check(z_radius, "radius_error");
+  check(z_stretch, "radius_stretch");
 }
 
 }  // namespace

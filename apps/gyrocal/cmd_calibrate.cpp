@@ -10,11 +10,13 @@
 #include "gyrocal/history/run.hpp"
 #include "gyrocal/history/sha256.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/imu_calibration.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/report/html_report.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/imu_calibration_json.hpp"
 #include "gyrocal/result/test_statement_json.hpp"
 #include "tables.hpp"
 
@@ -112,6 +114,26 @@ void register_calibrate(CLI::App& app) {
     choices.reduction = opt->reduction;
     const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
+    if (s.is_imu()) {
+      // A whole IMU (docs/imu.md): every channel's column in one pass, one joint solve.
+      if (storing)
+        throw Error(
+            "--history does not store an IMU's calibration yet: its history holds one sensor's "
+            "coefficients per run (docs/history.md); leave --history out.");
+      const std::optional<RecordLayout> layout = s.reading_layout();
+      require_angle_columns(layout, opt->record);
+      RecordReader reader(opt->record, layout);
+      const ImuCalibrationResult r = calibrate_imu_record(reader, s.channels(), s.model(), s.test, options);
+      if (!opt->json.empty()) {
+        nlohmann::ordered_json j = imu_calibration_to_json(r);
+        j["record"] = opt->record;
+        j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
+        j["plan"] = plan_to_json(s.test);
+        write_result(opt->json, j, "calibration", opt->force);
+      }
+      if (opt->json != "-") print_out("{}", imu_result_table(r));
+      return;
+    }
     require_angle_columns(s.record, opt->record);
     // The record's output column and metadata against the configuration, before its rows are read
     // (docs/interface.md). The record is opened once: the reader that read its head reads its rows (a pipe,

@@ -7,6 +7,7 @@
 
 #include "gyrocal/analysis/record_noise.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/imu_calibration.hpp"
 #include "gyrocal/model/gyro.hpp"
 #include "gyrocal/sensor/sensor_model.hpp"
 
@@ -27,6 +28,8 @@ PrintedUnit printed_unit(std::string_view unit);
 
 /// Coefficients (value ± std, unit), combinations, alternatives, warnings of one result.
 std::string result_table(const CalibrationResult& result);
+/// An IMU's calibration as text (imu_table.cpp): each channel's coefficients and misfit, the shared errors.
+std::string imu_result_table(const ImuCalibrationResult& result);
 
 /// Several results side by side, with the truth in the first column when given.
 std::string comparison_table(const std::vector<std::string>& labels,

@@ -81,33 +81,7 @@ CalibrationResult identify(const Reduction& record_reduction,
   r.coefficients = unestimated_coefficients(options);
   r.positions = reduction.positions;
   r.warnings = reduction.warnings;
-  r.data_quality.rows_read = reduction.samples_read;
-  r.data_quality.rows_used = reduction.samples_used;
-  r.data_quality.outliers = reduction.outliers;
-  r.data_quality.gaps = reduction.gaps;
-  r.data_quality.encoder_glitch_rows = reduction.encoder_glitch_rows;
-  for (const Dwell& d : reduction.dwells) {
-    DataQuality::Dwell q;
-    q.is_static = d.is_static;
-    q.rate_rad_s = d.planned_rate_rad_s;
-    q.measured_rate_rad_s = d.main.rate_rad_s;
-    q.beta_deg = d.beta_rad * kRadToDeg;
-    q.gamma_deg = d.is_static ? d.gammas_rad.at(0) * kRadToDeg : 0.0;
-    q.start_s = d.quality.run_start_s;
-    q.end_s = d.quality.run_end_s;
-    q.rows = d.quality.rows;
-    q.rows_used = d.samples;
-    q.settle_rows = d.quality.settle_rows;
-    q.beyond_planned_rows = d.quality.beyond_planned_rows;
-    q.encoder_glitch_rows = d.quality.encoder_glitch_rows;
-    q.before_leaving_rows = d.quality.before_leaving_rows;
-    q.outliers = d.output.outliers;
-    q.gaps = d.gaps;
-    q.ended = d.quality.ended;
-    r.data_quality.dwells.push_back(q);
-  }
-  for (const RejectedRun& x : reduction.rejected)
-    r.data_quality.rejected.push_back({x.start_s, x.end_s, x.reason});
+  r.data_quality = data_quality_of(reduction);
   r.g_level =
       radial_level_g(model.site(), model.geometry().radius_m, first_spinning_rate(reduction.positions));
   if (options.test_misfit)
@@ -196,6 +170,37 @@ CalibrationResult calibrate_record(RecordReader& reader, const CentrifugeModel& 
     c.std *= std::abs(scale);
   }
   return result;
+}
+
+DataQuality data_quality_of(const Reduction& reduction) {
+  DataQuality q;
+  q.rows_read = reduction.samples_read;
+  q.rows_used = reduction.samples_used;
+  q.outliers = reduction.outliers;
+  q.gaps = reduction.gaps;
+  q.encoder_glitch_rows = reduction.encoder_glitch_rows;
+  for (const Dwell& d : reduction.dwells) {
+    DataQuality::Dwell w;
+    w.is_static = d.is_static;
+    w.rate_rad_s = d.planned_rate_rad_s;
+    w.measured_rate_rad_s = d.main.rate_rad_s;
+    w.beta_deg = d.beta_rad * kRadToDeg;
+    w.gamma_deg = d.is_static ? d.gammas_rad.at(0) * kRadToDeg : 0.0;
+    w.start_s = d.quality.run_start_s;
+    w.end_s = d.quality.run_end_s;
+    w.rows = d.quality.rows;
+    w.rows_used = d.samples;
+    w.settle_rows = d.quality.settle_rows;
+    w.beyond_planned_rows = d.quality.beyond_planned_rows;
+    w.encoder_glitch_rows = d.quality.encoder_glitch_rows;
+    w.before_leaving_rows = d.quality.before_leaving_rows;
+    w.outliers = d.output.outliers;
+    w.gaps = d.gaps;
+    w.ended = d.quality.ended;
+    q.dwells.push_back(w);
+  }
+  for (const RejectedRun& x : reduction.rejected) q.rejected.push_back({x.start_s, x.end_s, x.reason});
+  return q;
 }
 
 const CoefficientEstimate* CalibrationResult::coefficient(std::string_view name) const {

@@ -6,6 +6,7 @@
 // sensor's self-calibration (self_calibration.cpp), the uncertainties a sandwich of every channel's own
 // levels, each channel's coefficients stepped back from its products by its sensor's from_products.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -16,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "gyrocal/core/error.hpp"
+#include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -61,31 +63,52 @@ double model_output(const DesignRow& row, const Eigen::VectorXd& u) {
   return v;
 }
 
-/// The columns of the estimated errors for one channel at its products u: each the central difference of
-/// its reduced model output with the error's typical magnitude as the step (as self_calibration.cpp).
-Eigen::MatrixXd error_columns(const Reduction& reduction, const SensorChannel& channel,
-                              const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
-                              const std::vector<double>& values_si, const Eigen::VectorXd& u,
-                              const CalibrationOptions& options) {
-  const auto m = static_cast<Eigen::Index>(reduction.positions.size());
-  Eigen::MatrixXd out(m, static_cast<Eigen::Index>(ps.size()));
+/// How one channel's reduced design rows move with each estimated error: per error, per position, the
+/// central difference of the known part and of each regressor, with the error's typical magnitude as the step
+/// (as self_calibration.cpp), per unit of the error. Taken once, at the configured machine: the rows are
+/// smooth in the errors (their curvature is of relative order 1e-5 per typical magnitude), so the columns
+/// they give at any products are the Jacobian Gauss-Newton needs, while each step's residuals are those of
+/// the current machine.
+struct RowDerivatives {
+  std::vector<std::vector<DesignRow>> per_error;  ///< [error][position]
+};
+
+RowDerivatives row_derivatives(const Reduction& reduction, const SensorChannel& channel,
+                               const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
+                               const std::vector<double>& values_si, const CalibrationOptions& options) {
+  RowDerivatives out;
   for (std::size_t a = 0; a < ps.size(); ++a) {
     const MachineErrorField& f = ps[a].info();
     const double h = f.typical_si;
     std::vector<double> plus = values_si, minus = values_si;
     plus[a] += h;
     minus[a] -= h;
-    const auto up = reduce_sensor_model_terms(reduction, with_errors(model, ps, plus), options.reduce, channel,
-                                              options.max_model_samples_per_dwell);
+    const auto up = reduce_sensor_model_terms(reduction, with_errors(model, ps, plus), options.reduce,
+                                              channel, options.max_model_samples_per_dwell);
     const auto down = reduce_sensor_model_terms(reduction, with_errors(model, ps, minus), options.reduce,
                                                 channel, options.max_model_samples_per_dwell);
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      out(i, static_cast<Eigen::Index>(a)) =
-          (model_output(up[k].sensor_exact, u) - model_output(down[k].sensor_exact, u)) / (2.0 * h) *
-          f.unit_to_si;
+    std::vector<DesignRow> rows(up.size());
+    const double per_unit = f.unit_to_si / (2.0 * h);
+    for (std::size_t i = 0; i < up.size(); ++i) {
+      const DesignRow& ru = up[i].sensor_exact;
+      const DesignRow& rd = down[i].sensor_exact;
+      rows[i].size = ru.size;
+      rows[i].known = (ru.known - rd.known) * per_unit;
+      for (std::size_t j = 0; j < ru.size; ++j)
+        rows[i].regressors[j] = (ru.regressors[j] - rd.regressors[j]) * per_unit;
     }
+    out.per_error.push_back(std::move(rows));
   }
+  return out;
+}
+
+/// The columns of the estimated errors for one channel at its products u: d(known + sum_j u_j r_j)/d(error),
+/// in the output's unit per the error's unit.
+Eigen::MatrixXd error_columns(const RowDerivatives& d, const Eigen::VectorXd& u, Eigen::Index m) {
+  Eigen::MatrixXd out(m, static_cast<Eigen::Index>(d.per_error.size()));
+  for (std::size_t a = 0; a < d.per_error.size(); ++a)
+    for (Eigen::Index i = 0; i < m; ++i)
+      out(i, static_cast<Eigen::Index>(a)) = model_output(d.per_error[a][static_cast<std::size_t>(i)], u);
   return out;
 }
 
@@ -107,9 +130,10 @@ WeightedPositions weigh_channel(const Reduction& reduction, const SensorChannel&
     if (k > 0) design.row(i).tail(k) = errors.row(i);
     const double mean = reduction.positions[static_cast<std::size_t>(i)].mean;
     if (!std::isfinite(mean))
-      throw Error(fmt::format("channel {}: a reduced output is not a finite number: its outputs are too large "
-                              "to average; check its column {}.",
-                              channel.name, channel.output.column));
+      throw Error(
+          fmt::format("channel {}: a reduced output is not a finite number: its outputs are too large "
+                      "to average; check its column {}.",
+                      channel.name, channel.output.column));
     observations[i] = mean - row.known;
   }
   const bool gyro = kind_of(channel.sensor) == SensorKind::kGyro;
@@ -121,14 +145,14 @@ WeightedPositions weigh_channel(const Reduction& reduction, const SensorChannel&
 /// The joint problem's solution at one step.
 struct JointSolution {
   LeastSquaresSolution solution;
-  Eigen::MatrixXd covariance;       ///< the sandwich of every channel's own levels
+  Eigen::MatrixXd covariance;          ///< the sandwich of every channel's own levels
   std::vector<Eigen::MatrixXd> gains;  ///< per channel: G_c, n x m_c (x = sum_c G_c y_c)
 };
 
 /// Stacks every channel's whitened rows (its products' block, the shared errors' last columns) and solves.
-JointSolution solve_joint(const std::vector<ChannelProblem>& problems, const std::vector<Eigen::Index>& offsets,
-                          Eigen::Index n, Eigen::Index k, const std::vector<std::string>& names,
-                          const CalibrationOptions& options) {
+JointSolution solve_joint(const std::vector<ChannelProblem>& problems,
+                          const std::vector<Eigen::Index>& offsets, Eigen::Index n, Eigen::Index k,
+                          const std::vector<std::string>& names, const CalibrationOptions& options) {
   Eigen::Index rows = 0;
   for (const ChannelProblem& p : problems) rows += p.weighted.whitened.design.rows();
   LeastSquaresProblem joint;
@@ -203,6 +227,61 @@ ParameterEstimates step_back(const Sensor& sensor, const Eigen::VectorXd& u, con
   return pe;
 }
 
+/// One channel's fitted input-axis tilts as rows of the joint unknowns: the tilt toward the second axis and
+/// toward the third, in rad, each with its gradient with respect to every unknown (the delta method's row).
+struct FittedTilts {
+  std::size_t channel = 0;
+  double toward_second = 0.0, toward_third = 0.0;  ///< rad
+  Eigen::VectorXd grad_second, grad_third;         ///< rad per unit of each unknown
+};
+
+/// The angles between the fitted input axes of every two channels of one kind (InputAxisAngle), their std
+/// from the tilts' joint covariance (every channel's and the errors' unknowns: the correlations the shared
+/// unknowns create are in it) by a central difference of the angle in the four tilts.
+std::vector<InputAxisAngle> input_axis_angles(const std::vector<SensorChannel>& channels,
+                                              const std::vector<FittedTilts>& tilts,
+                                              const Eigen::MatrixXd& covariance) {
+  std::vector<InputAxisAngle> out;
+  const auto axis = [&](const FittedTilts& t, double a, double b) {
+    const Eigen::Matrix3d& m = channels[t.channel].axes;
+    return Eigen::Vector3d(m.col(0) + a * m.col(1) + b * m.col(2)).normalized();
+  };
+  const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return std::atan2(u.cross(v).norm(), u.dot(v));
+  };
+  for (std::size_t a = 0; a < tilts.size(); ++a)
+    for (std::size_t b = a + 1; b < tilts.size(); ++b) {
+      const FittedTilts& ta = tilts[a];
+      const FittedTilts& tb = tilts[b];
+      if (kind_of(channels[ta.channel].sensor) != kind_of(channels[tb.channel].sensor)) continue;
+      const std::array<double, 4> x = {ta.toward_second, ta.toward_third, tb.toward_second, tb.toward_third};
+      const auto at = [&](const std::array<double, 4>& v) {
+        return angle(axis(ta, v[0], v[1]), axis(tb, v[2], v[3]));
+      };
+      Eigen::VectorXd grad = Eigen::VectorXd::Zero(covariance.rows());
+      const std::array<const Eigen::VectorXd*, 4> rows = {&ta.grad_second, &ta.grad_third, &tb.grad_second,
+                                                          &tb.grad_third};
+      for (std::size_t q = 0; q < 4; ++q) {
+        const double h = 1e-7;
+        std::array<double, 4> up = x, down = x;
+        up[q] += h;
+        down[q] -= h;
+        grad += (at(up) - at(down)) / (2.0 * h) * *rows[q];
+      }
+      InputAxisAngle e;
+      e.first = channels[ta.channel].name;
+      e.second = channels[tb.channel].name;
+      const double value = at(x);
+      const double nominal = angle(channels[ta.channel].axes.col(0), channels[tb.channel].axes.col(0));
+      e.angle_deg = value * kRadToDeg;
+      e.nominal_deg = nominal * kRadToDeg;
+      e.deviation_urad = (value - nominal) * 1e6;
+      e.std_urad = std::sqrt(std::max(0.0, grad.dot(covariance * grad))) * 1e6;
+      out.push_back(std::move(e));
+    }
+  return out;
+}
+
 }  // namespace
 
 const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) const {
@@ -215,20 +294,24 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
                                   const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
                                   const CalibrationOptions& options) {
   if (channels.empty() || reductions.size() != channels.size())
-    throw Error(fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
-                            channels.size(), reductions.size()));
+    throw Error(
+        fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
+                    channels.size(), reductions.size()));
   if (options.method != Method::kLeastSquares)
-    throw Error("an IMU is calibrated by least squares (--method least-squares): the closed forms are the lone "
-                "gyro's 16-position formulas.");
+    throw Error(
+        "an IMU is calibrated by least squares (--method least-squares): the closed forms are the lone "
+        "gyro's 16-position formulas.");
   if (options.compensation != Compensation::kFull)
-    throw Error("an IMU is calibrated with --compensation full: its channels' inputs are the exact model's "
-                "(docs/imu.md).");
+    throw Error(
+        "an IMU is calibrated with --compensation full: its channels' inputs are the exact model's "
+        "(docs/imu.md).");
   const std::vector<MachineErrorParameter>& ps = options.estimate;
   for (const MachineErrorParameter& p : ps)
     if (p.info().vector == &CentrifugeErrors::mount_misalignment_rad)
       throw Error(fmt::format(
           "--estimate {}: an IMU's mount misalignment cannot be estimated beside its channels' tilts: each "
-          "channel's input-axis tilts are measured against the mount, which the lab's fixture defines, so the "
+          "channel's input-axis tilts are measured against the mount, which the lab's fixture defines, so "
+          "the "
           "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
           p.error_name()));
   const std::size_t nch = channels.size();
@@ -251,12 +334,13 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
   // accelerometer's output is all in its products, so zero products would leave its columns zero).
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   std::vector<ChannelProblem> problems(nch);
+  std::vector<RowDerivatives> derivatives;  // per channel, at the configured machine
   JointSolution js;
   ImuCalibrationResult r;
   const auto channel_names = [&](std::size_t c, bool with_errors) {
-    std::vector<std::string> out(names.begin() + offsets[c],
-                                 names.begin() + offsets[c] + static_cast<Eigen::Index>(unknowns_of(
-                                                                  channels[c].sensor)));
+    std::vector<std::string> out(
+        names.begin() + offsets[c],
+        names.begin() + offsets[c] + static_cast<Eigen::Index>(unknowns_of(channels[c].sensor)));
     if (with_errors) out.insert(out.end(), names.end() - k, names.end());
     return out;
   };
@@ -268,10 +352,11 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
       p.terms = reduce_sensor_model_terms(reductions[c], current, options.reduce, channels[c],
                                           options.max_model_samples_per_dwell);
       const auto nc = static_cast<Eigen::Index>(unknowns_of(channels[c].sensor));
-      p.error_columns = plain || k == 0
-                            ? Eigen::MatrixXd(reductions[c].positions.size(), 0)
-                            : error_columns(reductions[c], channels[c], current, ps, values,
-                                            x.segment(offsets[c], nc), options);
+      const auto m = static_cast<Eigen::Index>(reductions[c].positions.size());
+      if (!plain && k > 0 && derivatives.size() < nch)
+        derivatives.push_back(row_derivatives(reductions[c], channels[c], current, ps, values, options));
+      p.error_columns = plain || k == 0 ? Eigen::MatrixXd(m, 0)
+                                        : error_columns(derivatives[c], x.segment(offsets[c], nc), m);
       p.weighted = weigh_channel(reductions[c], channels[c], p.terms, p.error_columns,
                                  channel_names(c, !plain), options);
     }
@@ -301,7 +386,8 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
       const double sd = std::sqrt(js.covariance(np + a, np + a));
       values[j] += step * ps[j].info().unit_to_si;
       const double typical = ps[j].info().typical_si / ps[j].info().unit_to_si;
-      if (!(std::abs(step) <= options.convergence * sd || std::abs(step) <= 1e-9 * typical)) converged = false;
+      if (!(std::abs(step) <= options.convergence * sd || std::abs(step) <= 1e-9 * typical))
+        converged = false;
     }
     for (Eigen::Index j = 0; j < np; ++j) {
       const double sd = std::sqrt(js.covariance(j, j));
@@ -329,6 +415,7 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
   // Each channel: its residuals and misfit test, then its coefficients.
   Eigen::Index at = 0;
   double worst_scale = 1.0;
+  std::vector<FittedTilts> tilts;
   for (std::size_t c = 0; c < nch; ++c) {
     const SensorChannel& ch = channels[c];
     const ChannelProblem& p = problems[c];
@@ -368,10 +455,11 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
             to_string(out.sensor)));
       out.misfit.scale = scale;
       worst_scale = std::max(worst_scale, scale);
-      out.warnings.push_back(fmt::format(
-          "its residuals are {:.3g} times the noise its dwells show (chi2 {:.4g} on {} degrees of freedom, p = "
-          "{:.2g}): every std of its coefficients is multiplied by that factor.",
-          scale, out.misfit.chi2, out.misfit.dof, out.misfit.p_value));
+      out.warnings.push_back(
+          fmt::format("its residuals are {:.3g} times the noise its dwells show (chi2 {:.4g} on {} degrees "
+                      "of freedom, p = "
+                      "{:.2g}): every std of its coefficients is multiplied by that factor.",
+                      scale, out.misfit.chi2, out.misfit.dof, out.misfit.p_value));
     }
     // Coefficients: the delta method on its products' block of the joint covariance.
     const Eigen::VectorXd u = x.segment(offsets[c], nc);
@@ -401,12 +489,30 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
       }
       const bool k1 = out.sensor == SensorKind::kAccelerometer && e.name == "K1";
       e.value = pe.values[q] * (k1 ? output_scale : 1.0);
+      // The input axis' tilts (an accelerometer's delta_p, delta_o in urad; a drift+rate gyro's input-axis
+      // misalignment about O and S in arcsec), in rad with their rows, for the triad's geometry.
+      const bool toward_second = e.name == "delta_p" || e.name == "input_axis_misalignment_O_arcsec";
+      const bool toward_third = e.name == "delta_o" || e.name == "input_axis_misalignment_S_arcsec";
+      if (toward_second || toward_third) {
+        const double to_rad = e.unit == "urad" ? 1e-6 : kArcsecToRad;
+        if (tilts.empty() || tilts.back().channel != c) {
+          tilts.push_back({});
+          tilts.back().channel = c;
+        }
+        FittedTilts& t = tilts.back();
+        (toward_second ? t.toward_second : t.toward_third) = e.value * to_rad;
+        (toward_second ? t.grad_second : t.grad_third) = row * to_rad;
+      }
       e.std = std::sqrt(row.dot(js.covariance * row)) * student(reductions, problems, js, row) *
               out.misfit.scale * (k1 ? std::abs(output_scale) : 1.0);
     }
     r.channels.push_back(std::move(out));
     at += mc;
   }
+  // The triad's geometry, from the channels whose two tilts are both fitted.
+  std::erase_if(tilts,
+                [](const FittedTilts& t) { return t.grad_second.size() == 0 || t.grad_third.size() == 0; });
+  r.input_axis_angles = input_axis_angles(channels, tilts, js.covariance);
   // The shared errors.
   for (std::size_t j = 0; j < ps.size(); ++j) {
     const auto a = static_cast<Eigen::Index>(j);
@@ -426,15 +532,12 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
   }
   // The record's quality: its rows and gaps are every channel's; outliers summed.
   const Reduction& first = reductions.front();
-  r.data_quality.rows_read = first.samples_read;
-  r.data_quality.rows_used = first.samples_used;
-  r.data_quality.gaps = first.gaps;
-  r.data_quality.encoder_glitch_rows = first.encoder_glitch_rows;
+  r.data_quality = data_quality_of(first);
+  r.data_quality.outliers = 0;
   for (const Reduction& red : reductions) r.data_quality.outliers += red.outliers;
-  for (const RejectedRun& rr : first.rejected)
-    r.data_quality.rejected.push_back({rr.start_s, rr.end_s, rr.reason});
   r.warnings.insert(r.warnings.begin(), first.warnings.begin(), first.warnings.end());
-  r.g_level = radial_level_g(model.site(), model.geometry().radius_m, identify_detail::first_spinning_rate(first.positions));
+  r.g_level = radial_level_g(model.site(), model.geometry().radius_m,
+                             identify_detail::first_spinning_rate(first.positions));
   return r;
 }
 

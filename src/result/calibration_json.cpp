@@ -4,6 +4,8 @@
 
 #include "gyrocal/plan/positions.hpp"
 
+#include "result_parts.hpp"
+
 namespace gyrocal {
 namespace {
 
@@ -21,13 +23,12 @@ nlohmann::ordered_json named_estimate_to_json(const NamedEstimate& c) {
 
 }  // namespace
 
-nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
-  nlohmann::ordered_json j;
+nlohmann::ordered_json coefficients_to_json(const std::vector<CoefficientEstimate>& estimates) {
   nlohmann::ordered_json coefficients = nlohmann::ordered_json::object();
   // The sensor's own table's coefficients (docs/contract.md, "Result" and "Accelerometers"): the gyro's ten,
   // with drift+rate its rate errors too (docs/physics.md section 15), each with the reason where it is not
   // identifiable; an accelerometer's K1 as fitted on the record's output, in its units per g.
-  for (const CoefficientEstimate& c : r.coefficients) {
+  for (const CoefficientEstimate& c : estimates) {
     coefficients[c.name] = {
         {"value", c.identifiable ? number_or_null(c.value) : nlohmann::ordered_json(nullptr)},
         {"std", c.identifiable ? number_or_null(c.std) : nlohmann::ordered_json(nullptr)},
@@ -35,39 +36,119 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
         {"identifiable", c.identifiable}};
     if (!c.identifiable && !c.reason.empty()) coefficients[c.name]["reason"] = c.reason;
   }
-  j["coefficients"] = coefficients;
-  j["combinations"] = nlohmann::ordered_json::array();
-  for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
-  j["alternatives"] = nlohmann::ordered_json::array();
-  for (const NamedEstimate& c : r.alternatives) j["alternatives"].push_back(named_estimate_to_json(c));
+  return coefficients;
+}
+
+nlohmann::ordered_json positions_to_json(const std::vector<ReducedPosition>& positions,
+                                         const std::vector<double>& residuals, SensorKind sensor,
+                                         const std::string& channel) {
   // Positions keyed for any sensor (docs/contract.md, "Result"): mean, std_err and residual in `unit`, the
-  // sensor's output unit as the reader gives it (deg/h, g). A gyro's also keep their earlier keys
+  // sensor's output unit as the reader gives it (deg/h, g). A lone gyro's also keep their earlier keys
   // mean_deg_h, std_err_deg_h and residual_deg_h for one version, for readers of older results.
-  const bool gyro = r.sensor == SensorKind::kGyro;
+  const bool gyro = sensor == SensorKind::kGyro;
+  const bool old_keys = gyro && channel.empty();
   const std::string position_unit = gyro ? "deg/h" : std::string(Accelerometer::output_unit);
-  j["positions"] = nlohmann::ordered_json::array();
-  for (std::size_t i = 0; i < r.positions.size(); ++i) {
-    const ReducedPosition& p = r.positions[i];
-    nlohmann::ordered_json e = {{"index", p.index},
-                                {"beta_deg", p.beta_rad * kRadToDeg},
-                                {"gamma_deg", p.gamma_rad * kRadToDeg},
-                                {"rate_rad_s", p.rate_rad_s},
-                                {"mean", p.mean},
-                                {"std_err", number_or_null(p.std_err)},
-                                {"unit", position_unit}};
-    if (gyro) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const ReducedPosition& p = positions[i];
+    nlohmann::ordered_json e;
+    if (!channel.empty()) e["channel"] = channel;
+    e["index"] = p.index;
+    e["beta_deg"] = p.beta_rad * kRadToDeg;
+    e["gamma_deg"] = p.gamma_rad * kRadToDeg;
+    e["rate_rad_s"] = p.rate_rad_s;
+    e["mean"] = p.mean;
+    e["std_err"] = number_or_null(p.std_err);
+    e["unit"] = position_unit;
+    if (old_keys) {
       e["mean_deg_h"] = p.mean;
       e["std_err_deg_h"] = number_or_null(p.std_err);
     }
     e["samples"] = p.samples;
     e["outliers"] = p.outliers;
     if (p.counter_rate_offset_rad_s != 0.0) e["counter_rate_offset_rad_s"] = p.counter_rate_offset_rad_s;
-    if (i < r.residuals.size()) {
-      e["residual"] = number_or_null(r.residuals[i]);
-      if (gyro) e["residual_deg_h"] = number_or_null(r.residuals[i]);
+    if (i < residuals.size()) {
+      e["residual"] = number_or_null(residuals[i]);
+      if (old_keys) e["residual_deg_h"] = number_or_null(residuals[i]);
     }
-    j["positions"].push_back(e);
+    out.push_back(e);
   }
+  return out;
+}
+
+nlohmann::ordered_json misfit_to_json(const MisfitTest& misfit) {
+  // The misfit test (docs/calibration.md, "When the residuals misfit"): std_scale multiplied every std.
+  return {{"tested", misfit.tested},
+          {"p_value", misfit.tested ? number_or_null(misfit.p_value) : nlohmann::ordered_json(nullptr)},
+          {"weight_dof", number_or_null(misfit.weight_dof)},
+          {"std_scale", misfit.scale}};
+}
+
+nlohmann::ordered_json data_quality_to_json(const DataQuality& q) {
+  nlohmann::ordered_json j = {{"rows_read", q.rows_read},
+                              {"rows_used", q.rows_used},
+                              {"outliers", q.outliers},
+                              {"gaps", q.gaps},
+                              {"encoder_glitch_rows", q.encoder_glitch_rows}};
+  nlohmann::ordered_json dwells = nlohmann::ordered_json::array(), rejected = nlohmann::ordered_json::array();
+  for (const DataQuality::Dwell& d : q.dwells) {
+    nlohmann::ordered_json j_d = {{"static", d.is_static},
+                                  {"rate_rad_s", d.rate_rad_s},
+                                  {"measured_rate_rad_s", d.measured_rate_rad_s},
+                                  {"beta_deg", d.beta_deg},
+                                  {"start_s", d.start_s},
+                                  {"end_s", d.end_s},
+                                  {"rows", d.rows},
+                                  {"rows_used", d.rows_used},
+                                  {"dropped",
+                                   {{"settle", d.settle_rows},
+                                    {"beyond_planned", d.beyond_planned_rows},
+                                    {"encoder_glitches", d.encoder_glitch_rows},
+                                    {"before_leaving", d.before_leaving_rows},
+                                    {"outliers", d.outliers}}},
+                                  {"gaps", d.gaps},
+                                  {"ended", d.ended}};
+    if (d.is_static) j_d["gamma_deg"] = d.gamma_deg;
+    dwells.push_back(std::move(j_d));
+  }
+  for (const DataQuality::Rejected& x : q.rejected)
+    rejected.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"reason", x.reason}});
+  j["dwells"] = std::move(dwells);
+  j["rejected"] = std::move(rejected);
+  return j;
+}
+
+nlohmann::ordered_json machine_errors_to_json(const std::vector<MachineErrorEstimate>& estimates) {
+  // The self-calibration's estimated machine errors (docs/contract.md, machine_errors).
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const MachineErrorEstimate& e : estimates) {
+    nlohmann::ordered_json m = {
+        {"error", e.error},
+        {"harmonic", e.harmonic},
+        {"value", e.identifiable ? number_or_null(e.value) : nlohmann::ordered_json(nullptr)},
+        {"std", e.identifiable ? number_or_null(e.std) : nlohmann::ordered_json(nullptr)},
+        {"unit", e.unit},
+        {"configured", e.configured},
+        {"identifiable", e.identifiable}};
+    if (!e.part.empty()) m["part"] = e.part;
+    if (!e.identifiable) m["reason"] = e.reason;
+    nlohmann::ordered_json correlations = nlohmann::ordered_json::object();
+    for (const auto& [name, r_value] : e.correlations)
+      if (std::isfinite(r_value)) correlations[name] = r_value;
+    m["correlations"] = correlations;
+    out.push_back(m);
+  }
+  return out;
+}
+
+nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
+  nlohmann::ordered_json j;
+  j["coefficients"] = coefficients_to_json(r.coefficients);
+  j["combinations"] = nlohmann::ordered_json::array();
+  for (const NamedEstimate& c : r.combinations) j["combinations"].push_back(named_estimate_to_json(c));
+  j["alternatives"] = nlohmann::ordered_json::array();
+  for (const NamedEstimate& c : r.alternatives) j["alternatives"].push_back(named_estimate_to_json(c));
+  j["positions"] = positions_to_json(r.positions, r.residuals, r.sensor, "");
   j["method"] = to_string(r.method);
   j["compensation"] = to_string(r.compensation);
   if (r.sensor == SensorKind::kGyro)
@@ -82,68 +163,12 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
     j["uncertainty_amplification"] = number_or_null(r.uncertainty_amplification);
   j["chi2"] = number_or_null(r.chi2);
   j["dof"] = r.dof;
-  // The misfit test (docs/calibration.md, "When the residuals misfit"): std_scale multiplied every std above.
-  j["misfit"] = {
-      {"tested", r.misfit.tested},
-      {"p_value", r.misfit.tested ? number_or_null(r.misfit.p_value) : nlohmann::ordered_json(nullptr)},
-      {"weight_dof", number_or_null(r.misfit.weight_dof)},
-      {"std_scale", r.misfit.scale}};
+  j["misfit"] = misfit_to_json(r.misfit);
   // A record's (a prediction reads none).
-  if (r.data_quality.rows_read > 0)
-    j["data_quality"] = {{"rows_read", r.data_quality.rows_read},
-                         {"rows_used", r.data_quality.rows_used},
-                         {"outliers", r.data_quality.outliers},
-                         {"gaps", r.data_quality.gaps},
-                         {"encoder_glitch_rows", r.data_quality.encoder_glitch_rows}};
-  if (r.data_quality.rows_read > 0) {
-    nlohmann::ordered_json dwells = nlohmann::ordered_json::array(),
-                           rejected = nlohmann::ordered_json::array();
-    for (const DataQuality::Dwell& d : r.data_quality.dwells) {
-      nlohmann::ordered_json j_d = {{"static", d.is_static},
-                                    {"rate_rad_s", d.rate_rad_s},
-                                    {"measured_rate_rad_s", d.measured_rate_rad_s},
-                                    {"beta_deg", d.beta_deg},
-                                    {"start_s", d.start_s},
-                                    {"end_s", d.end_s},
-                                    {"rows", d.rows},
-                                    {"rows_used", d.rows_used},
-                                    {"dropped",
-                                     {{"settle", d.settle_rows},
-                                      {"beyond_planned", d.beyond_planned_rows},
-                                      {"encoder_glitches", d.encoder_glitch_rows},
-                                      {"before_leaving", d.before_leaving_rows},
-                                      {"outliers", d.outliers}}},
-                                    {"gaps", d.gaps},
-                                    {"ended", d.ended}};
-      if (d.is_static) j_d["gamma_deg"] = d.gamma_deg;
-      dwells.push_back(std::move(j_d));
-    }
-    for (const DataQuality::Rejected& x : r.data_quality.rejected)
-      rejected.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"reason", x.reason}});
-    j["data_quality"]["dwells"] = std::move(dwells);
-    j["data_quality"]["rejected"] = std::move(rejected);
-  }
+  if (r.data_quality.rows_read > 0) j["data_quality"] = data_quality_to_json(r.data_quality);
   j["unidentifiable"] = r.unidentifiable;
-  // The self-calibration's estimated machine errors (docs/contract.md, machine_errors).
   if (!r.machine_errors.empty()) {
-    j["machine_errors"] = nlohmann::ordered_json::array();
-    for (const MachineErrorEstimate& e : r.machine_errors) {
-      nlohmann::ordered_json m = {
-          {"error", e.error},
-          {"harmonic", e.harmonic},
-          {"value", e.identifiable ? number_or_null(e.value) : nlohmann::ordered_json(nullptr)},
-          {"std", e.identifiable ? number_or_null(e.std) : nlohmann::ordered_json(nullptr)},
-          {"unit", e.unit},
-          {"configured", e.configured},
-          {"identifiable", e.identifiable}};
-      if (!e.part.empty()) m["part"] = e.part;
-      if (!e.identifiable) m["reason"] = e.reason;
-      nlohmann::ordered_json correlations = nlohmann::ordered_json::object();
-      for (const auto& [name, r_value] : e.correlations)
-        if (std::isfinite(r_value)) correlations[name] = r_value;
-      m["correlations"] = correlations;
-      j["machine_errors"].push_back(m);
-    }
+    j["machine_errors"] = machine_errors_to_json(r.machine_errors);
     j["iterations"] = r.iterations;
   }
   return j;

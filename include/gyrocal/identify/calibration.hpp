@@ -153,6 +153,10 @@ struct DataQuality {
   std::vector<Rejected> rejected;
 };
 
+/// What a record's reduction tells of its quality (rows read and used, outliers, gaps, each dwell's rows and
+/// what was dropped, the runs rejected): the result's data_quality.
+DataQuality data_quality_of(const Reduction& reduction);
+
 struct CalibrationResult {
   Method method = Method::kLeastSquares;
   SensorKind sensor = SensorKind::kGyro;  ///< whose coefficients these are

@@ -21,30 +21,44 @@ namespace gyrocal {
 
 /// One channel's part of an IMU's calibration.
 struct ImuChannelResult {
-  std::string name;                ///< the channel's name ("gx")
+  std::string name;  ///< the channel's name ("gx")
   SensorKind sensor = SensorKind::kGyro;
   /// Its coefficients, named and unitted as the lone sensor's (an accelerometer's K1 in the channel's
   /// output units per g: its output_scale times the fitted ratio), std from the joint solve.
   std::vector<CoefficientEstimate> coefficients;
-  std::vector<double> products;               ///< the fitted products, in the sensor's design-row order
-  std::vector<ReducedPosition> positions;     ///< its reduced positions (each with its channel's number)
-  std::vector<double> residuals;              ///< per position: reduced output - fitted model, output unit
-  MisfitTest misfit;                          ///< its own misfit test (chi2 of its whitened residuals)
-  std::size_t outliers = 0;                   ///< its samples rejected as outliers
-  std::vector<std::string> warnings;          ///< warnings of this channel's reduction and fit
+  std::vector<double> products;            ///< the fitted products, in the sensor's design-row order
+  std::vector<ReducedPosition> positions;  ///< its reduced positions (each with its channel's number)
+  std::vector<double> residuals;           ///< per position: reduced output - fitted model, output unit
+  MisfitTest misfit;                       ///< its own misfit test (chi2 of its whitened residuals)
+  std::size_t outliers = 0;                ///< its samples rejected as outliers
+  std::vector<std::string> warnings;       ///< warnings of this channel's reduction and fit
+};
+
+/// The angle between two channels' fitted input axes (docs/imu.md, "The triad's geometry"): each axis is the
+/// channel's nominal input axis tilted by its fitted tilts (an accelerometer's delta_p and delta_o, a
+/// drift+rate gyro's input-axis misalignment about O and S), in the IMU's body axes, which the mount defines.
+struct InputAxisAngle {
+  std::string first, second;    ///< the channels' names
+  double angle_deg = 0.0;       ///< the angle between the fitted input axes, deg
+  double nominal_deg = 0.0;     ///< between the configured input axes (90 for a triad), deg
+  double deviation_urad = 0.0;  ///< angle - nominal, urad (the unit's non-orthogonality)
+  double std_urad = 0.0;        ///< its standard uncertainty, urad (the tilts' joint covariance)
 };
 
 /// An IMU's calibration: every channel's result and the shared machine errors.
 struct ImuCalibrationResult {
-  std::vector<ImuChannelResult> channels;          ///< in the configuration's order
+  std::vector<ImuChannelResult> channels;            ///< in the configuration's order
   std::vector<MachineErrorEstimate> machine_errors;  ///< the shared errors estimated (--estimate)
   DataQuality data_quality;  ///< of the record (rows, gaps); outliers summed over the channels
   std::vector<std::string> warnings;
-  double g_level = 0.0;         ///< Ar of the first spinning rate, g
-  int rank = 0;                 ///< of the joint design
-  int unknowns = 0;             ///< every channel's products and the estimated errors
+  double g_level = 0.0;  ///< Ar of the first spinning rate, g
+  int rank = 0;          ///< of the joint design
+  int unknowns = 0;      ///< every channel's products and the estimated errors
   double condition_number = 0.0;
-  int iterations = 0;           ///< Gauss-Newton iterations (0 without --estimate)
+  int iterations = 0;  ///< Gauss-Newton iterations (0 without --estimate)
+  /// The angles between the input axes of every two channels of one sensor kind whose tilts are fitted (the
+  /// accelerometers; the gyros with gyro_model = "drift+rate").
+  std::vector<InputAxisAngle> input_axis_angles;
   /// The joint covariance of every unknown (the channels' products in order, then the errors), the sandwich
   /// of the channels' own levels, in the unknowns' units; and their names ("gx.dF", ..., "radius_error").
   Eigen::MatrixXd covariance;
