@@ -3,6 +3,7 @@
 // exact model sampled at each instant, not the simulator), with machine errors of every kind.
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -103,7 +104,9 @@ Scenario imu_scenario(double sample_rate_hz = 100.0, double static_hold_s = 4.0,
 /// the channel's inputs on its axes, its sensor's model), plus white noise of `sigma` per sample in each
 /// channel's unit (deg/h for a gyro, g for an accelerometer); reduced channel by channel in one pass.
 std::vector<Reduction> reduce_generated(const Scenario& s, std::uint64_t seed, double gyro_sigma,
-                                        double accel_sigma) {
+                                        double accel_sigma,
+                                        const std::function<double(std::size_t, double)>& fault = {},
+                                        std::vector<OutputRange>* ranges = nullptr) {
   const CentrifugeModel model = s.model();
   const Timeline timeline = make_timeline(s.test, model);
   const std::vector<SensorChannel> channels = s.channels();
@@ -128,6 +131,8 @@ std::vector<Reduction> reduce_generated(const Scenario& s, std::uint64_t seed, d
       const bool gyro = kind_of(channels[c].sensor) == SensorKind::kGyro;
       row.outputs[c] = sensor_output(channels[c].sensor, channel_inputs(model, motion, channels[c])) +
                        rng.normal() * (gyro ? gyro_sigma : accel_sigma);
+      if (fault) row.outputs[c] = fault(c, row.outputs[c]);
+      if (ranges) (*ranges)[c].push(row.outputs[c]);
     }
     reducer.push(row);
   }
@@ -199,6 +204,37 @@ TEST(ImuCalibration, NoiseFreeRatesRecoverEveryChannelAndTheRadius) {
   ASSERT_EQ(r.machine_errors.size(), 2u);
   EXPECT_NEAR(r.machine_errors[0].value, 20e-6, 1e-9);  // m
   EXPECT_NEAR(r.machine_errors[1].value, 1e-7, 1e-11);  // m/(rad/s)^2
+}
+
+/// The refusal's message for a record whose channel `bad` is changed by `fault`.
+std::string refusal(std::size_t bad, const std::function<double(double)>& fault) {
+  const Scenario s = imu_scenario(30.0, 2.0, 4);
+  std::vector<OutputRange> ranges(s.imu_channels.size());
+  const std::vector<Reduction> reductions = reduce_generated(
+      s, 7, 0.5, 1e-4, [&](std::size_t c, double v) { return c == bad ? fault(v) : v; }, &ranges);
+  try {
+    identify_imu(reductions, s.channels(), configured_machine(s), estimating_radius(), ranges);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "not refused";
+}
+
+// A channel that cannot be trusted is refused by its name: dead (a constant), sign-flipped (a gyro against
+// its known rate, an accelerometer against its output_scale), clipped (a flat top).
+TEST(ImuCalibration, ADeadFlippedOrClippedChannelIsRefusedByName) {
+  const std::string dead = refusal(4, [](double) { return 0.25; });
+  EXPECT_NE(dead.find("channel ay"), std::string::npos) << dead;
+  EXPECT_NE(dead.find("dead channel"), std::string::npos) << dead;
+  const std::string flipped_gyro = refusal(1, [](double v) { return -v; });
+  EXPECT_NE(flipped_gyro.find("channel gy"), std::string::npos) << flipped_gyro;
+  EXPECT_NE(flipped_gyro.find("sign-flipped"), std::string::npos) << flipped_gyro;
+  const std::string flipped_accel = refusal(5, [](double v) { return -v; });
+  EXPECT_NE(flipped_accel.find("channel az"), std::string::npos) << flipped_accel;
+  EXPECT_NE(flipped_accel.find("sign-flipped"), std::string::npos) << flipped_accel;
+  const std::string clipped = refusal(3, [](double v) { return std::min(v, 0.5); });
+  EXPECT_NE(clipped.find("channel ax"), std::string::npos) << clipped;
+  EXPECT_NE(clipped.find("clipped"), std::string::npos) << clipped;
 }
 
 /// The std and mean of a sample of z-scores.

@@ -49,6 +49,24 @@ double noise_free_level(const SensorChannel& c) {
   return kind_of(c.sensor) == SensorKind::kGyro ? kGyroNoiseFreeDegH : kAccelerometerNoiseFreeRelative;
 }
 
+/// A channel that reads the same at every position is dead (or its column holds something else): gravity
+/// turns an accelerometer's reading by 2 g over the positions and the earth's rate and gravity move a gyro's,
+/// so the spread of its reduced outputs is far above its noise-free level. Refused naming the channel: its
+/// coefficients would be fitted to nothing (a noise-free-looking record whose misfit is not tested).
+void refuse_dead_channel(const Reduction& reduction, const SensorChannel& channel) {
+  if (reduction.positions.empty()) return;
+  double lo = reduction.positions.front().mean, hi = lo;
+  for (const ReducedPosition& p : reduction.positions) {
+    lo = std::min(lo, p.mean);
+    hi = std::max(hi, p.mean);
+  }
+  if (hi - lo > 1e3 * noise_free_level(channel)) return;
+  throw Error(fmt::format(
+      "channel {} (column {}) reads {:.6g} {} at every position (spread {:.3g}): a dead channel, or a "
+      "column that holds no sensor's output; check the record and the channel's column.",
+      channel.name, channel.output.column, lo, channel.output.unit(), hi - lo));
+}
+
 /// Everything the joint solve keeps of one channel at one Gauss-Newton step.
 struct ChannelProblem {
   std::vector<PositionModelTerms> terms;  ///< its model terms at the current machine
@@ -292,7 +310,7 @@ const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) con
 
 ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
                                   const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
-                                  const CalibrationOptions& options) {
+                                  const CalibrationOptions& options, std::span<const OutputRange> ranges) {
   if (channels.empty() || reductions.size() != channels.size())
     throw Error(
         fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
@@ -315,6 +333,15 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
           "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
           p.error_name()));
   const std::size_t nch = channels.size();
+  for (std::size_t c = 0; c < nch; ++c) {
+    refuse_dead_channel(reductions[c], channels[c]);
+    if (c >= ranges.size() || !options.test_misfit) continue;
+    const std::string flat = saturation_cause(reductions[c], ranges[c], channels[c].output.unit(),
+                                              to_string(kind_of(channels[c].sensor)));
+    if (!flat.empty())
+      throw Error(
+          fmt::format("channel {} (column {}): {}.", channels[c].name, channels[c].output.column, flat));
+  }
   const auto k = static_cast<Eigen::Index>(ps.size());
   // The unknowns: each channel's products ("gx.dF"), then the errors.
   std::vector<Eigen::Index> offsets;
@@ -488,6 +515,15 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
         continue;
       }
       const bool k1 = out.sensor == SensorKind::kAccelerometer && e.name == "K1";
+      // An accelerometer's scale factor has the sign of its output_scale: a fitted ratio below zero is a
+      // channel whose sign is flipped (a cable, a convention) against its configuration.
+      if (k1 && options.test_misfit && pe.values[q] < 0.0)
+        throw Error(fmt::format(
+            "channel {} (column {}): its output falls where its input rises (the fitted scale is {:.6g} "
+            "times "
+            "its output_scale {:g}): a sign-flipped channel; if it is inverted by design, give it a negative "
+            "output_scale.",
+            ch.name, ch.output.column, pe.values[q], ch.output.scale));
       e.value = pe.values[q] * (k1 ? output_scale : 1.0);
       // The input axis' tilts (an accelerometer's delta_p, delta_o in urad; a drift+rate gyro's input-axis
       // misalignment about O and S in arcsec), in rad with their rows, for the triad's geometry.
@@ -555,9 +591,15 @@ ImuCalibrationResult calibrate_imu_record(RecordReader& reader, const std::vecto
   });
   const TestSpec reduce_plan = reduction_plan(
       plan, any_accelerometer ? SensorKind::kAccelerometer : SensorKind::kGyro, options.reduce);
+  // Each channel's range, for a flat top (identify/misfit.hpp).
+  std::vector<OutputRange> ranges(channels.size());
   const std::vector<Reduction> reductions =
-      reduce_record_channels(reader, reduce_plan, options.reduce, model.geometry().rate_rad_s);
-  return identify_imu(reductions, channels, model, options);
+      reduce_record_channels(reader, reduce_plan, options.reduce, model.geometry().rate_rad_s,
+                             [&ranges](std::span<const RecordSample> rows) {
+                               for (const RecordSample& s : rows)
+                                 for (std::size_t c = 0; c < ranges.size(); ++c) ranges[c].push(s.outputs[c]);
+                             });
+  return identify_imu(reductions, channels, model, options, ranges);
 }
 
 }  // namespace gyrocal

@@ -284,7 +284,8 @@ void OutputRange::push(double value) {
   if (value == min_) ++at_min_;
 }
 
-std::string saturation_cause(const Reduction& reduction, const OutputRange& range) {
+std::string saturation_cause(const Reduction& reduction, const OutputRange& range, std::string_view unit,
+                             std::string_view sensor) {
   const auto many = [&](std::size_t n) {
     return n >= 10 && static_cast<double>(n) > 0.005 * static_cast<double>(range.count());
   };
@@ -292,11 +293,11 @@ std::string saturation_cause(const Reduction& reduction, const OutputRange& rang
     const bool top = range.at_max() >= range.at_min();
     const std::size_t n = top ? range.at_max() : range.at_min();
     return fmt::format(
-        "{} of the record's {} samples ({:.1f} %) sit exactly at its {} output, {} deg/h, which noise never "
-        "does: a saturated or clipped channel (a flat top); use a range of the gyro and its acquisition that "
+        "{} of the record's {} samples ({:.1f} %) sit exactly at its {} output, {} {}, which noise never "
+        "does: a saturated or clipped channel (a flat top); use a range of the {} and its acquisition that "
         "holds the largest output",
         n, range.count(), 100.0 * static_cast<double>(n) / static_cast<double>(range.count()),
-        top ? "largest" : "smallest", number(top ? range.max() : range.min()));
+        top ? "largest" : "smallest", number(top ? range.max() : range.min()), unit, sensor);
   }
   const auto where = [&](std::size_t d) {
     const Dwell& w = reduction.dwells[d];
@@ -315,9 +316,9 @@ std::string saturation_cause(const Reduction& reduction, const OutputRange& rang
   if (worst < reduction.dwells.size())
     return fmt::format(
         "{:.0f} % of the samples of {} were rejected as outliers, which spikes never do: a saturated or "
-        "clipped channel (flat tops cut off the output); use a range of the gyro and its acquisition that "
+        "clipped channel (flat tops cut off the output); use a range of the {} and its acquisition that "
         "holds the largest output",
-        100.0 * worst_fraction, where(worst));
+        100.0 * worst_fraction, where(worst), sensor);
   return {};
 }
 

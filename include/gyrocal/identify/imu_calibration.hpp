@@ -5,6 +5,7 @@
 // least squares holds every channel's products beside the shared machine errors (the radius error, the
 // stretch, ...): the x and z accelerometers fix the radius, and through it the y accelerometer's scale, which
 // on its own is confounded with it (docs/physics.md section 17). Each channel is judged by its own misfit.
+#include <span>
 #include <string>
 #include <vector>
 
@@ -74,9 +75,12 @@ struct ImuCalibrationResult {
 /// (docs/self_calibration.md). Throws gyrocal::Error, naming the channel, for a channel whose residuals are
 /// many times its noise (a dead, clipped or sign-flipped channel) and for the mount's misalignment among the
 /// errors estimated (each channel's tilts are measured against the mount: docs/imu.md).
+/// `ranges`, when given (one per channel, over the record's samples), let a channel's flat top (saturated or
+/// clipped) be refused by its name before anything is fitted.
 ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
                                   const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
-                                  const CalibrationOptions& options);
+                                  const CalibrationOptions& options,
+                                  std::span<const OutputRange> ranges = {});
 
 /// Reads and reduces every channel of a record in one pass (`reader` through a layout with one output column
 /// per channel, Scenario::reading_layout()), then identify_imu.

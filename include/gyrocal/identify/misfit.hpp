@@ -125,7 +125,9 @@ void refuse_constant_output(const Reduction& reduction, const OutputConfiguratio
 
 /// A cause read from the data rather than a refit, for a misfitting record: more than 0.5 % of the record's
 /// samples (and at least 10) exactly at its largest or smallest output (a flat top: saturated or clipped), or
-/// a dwell that lost more than 5 % of its samples as outliers. One sentence, empty when none.
-std::string saturation_cause(const Reduction& reduction, const OutputRange& range);
+/// a dwell that lost more than 5 % of its samples as outliers. One sentence, empty when none, naming the
+/// output in `unit` and the `sensor` whose range to widen.
+std::string saturation_cause(const Reduction& reduction, const OutputRange& range,
+                             std::string_view unit = "deg/h", std::string_view sensor = "gyro");
 
 }  // namespace gyrocal
