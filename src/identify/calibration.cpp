@@ -86,6 +86,7 @@ CalibrationResult identify(const Reduction& record_reduction,
   r.data_quality.outliers = reduction.outliers;
   r.data_quality.gaps = reduction.gaps;
   r.data_quality.encoder_glitch_rows = reduction.encoder_glitch_rows;
+  r.data_quality.increments_dropped = reduction.increments_dropped;
   for (const Dwell& d : reduction.dwells) {
     DataQuality::Dwell q;
     q.is_static = d.is_static;

@@ -95,6 +95,9 @@ nlohmann::ordered_json calibration_to_json(const CalibrationResult& r) {
                          {"outliers", r.data_quality.outliers},
                          {"gaps", r.data_quality.gaps},
                          {"encoder_glitch_rows", r.data_quality.encoder_glitch_rows}};
+  // Only for a record with an increment column: a lone sensor's result stays as it was.
+  if (r.data_quality.rows_read > 0 && r.data_quality.increments_dropped)
+    j["data_quality"]["increments_dropped"] = *r.data_quality.increments_dropped;
   if (r.data_quality.rows_read > 0) {
     nlohmann::ordered_json dwells = nlohmann::ordered_json::array(),
                            rejected = nlohmann::ordered_json::array();
