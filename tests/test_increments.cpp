@@ -20,6 +20,7 @@
 #include "gyrocal/config/scenario.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/dwell_model_route.hpp"
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/plan/timeline.hpp"
 #include "gyrocal/record/increments.hpp"
@@ -97,7 +98,7 @@ Scenario increment_scenario(OutputForm form) {
   s.test.sample_rate_hz = 200.0;
   s.test.rates_rad_s = {12.0};
   s.test.beta_rad = {0.0, kPi / 2.0};
-  s.test.revolutions = 8;
+  s.test.revolutions = 24;  // long enough that the Fourier route is the cheaper one
   s.accelerometer.noise = AccelerometerNoise{};
   s.errors.counter_wobble_x_rad.terms.push_back({2, 2e-5, 0.3});
   s.errors.main_wobble_y_rad.terms.push_back({1, 1e-5, -0.7});
@@ -215,6 +216,10 @@ TEST_F(IncrementRecord, TheReductionOfDataAndOfTheModelAveragedOverTheIntervalsA
   EXPECT_GT(largest, 0.9 * first_harmonic);
   const SensorChannel& channel = s.imu_channels.front();
   // Both routes of the model's side: the Fourier closed forms and every sample by Gauss-Legendre.
+  std::vector<DwellModelTermsRoute> routes;
+  reduce_sensor_model_terms(r, s.model(), s.reduce, channel, 0, ModelTermsRoute::kExact, &routes);
+  ASSERT_FALSE(routes.empty());
+  for (const DwellModelTermsRoute& route : routes) EXPECT_TRUE(route.fourier);
   EXPECT_LT(worst_misfit(s, r, channel), 1e-10 * first_harmonic);
   EXPECT_LT(worst_misfit(s, r, channel, ModelTermsRoute::kEverySample), 1e-10 * first_harmonic);
   // The same data taken for rates at the stamps misses by the half interval's lag of the first harmonic
