@@ -76,16 +76,23 @@ RecordWriter::RecordWriter(std::ostream& out, const RecordMetadata& metadata,
 }
 
 RecordWriter::RecordWriter(std::ostream& out, const RecordMetadata& metadata,
-                           const std::vector<OutputColumn>& outputs)
+                           const std::vector<OutputColumn>& outputs,
+                           const std::vector<std::string>& extra_columns)
     : out_(out),
       columns_(kRecordColumns.begin(), kRecordColumns.begin() + 4),
-      extra_count_(0),
+      extra_count_(extra_columns.size()),
       buffer_(kBufferBytes) {
+  if (extra_columns.size() > kMaxExtraColumns) {
+    throw Error(fmt::format("A record holds at most {} extra columns; {} were given.", kMaxExtraColumns,
+                            extra_columns.size()));
+  }
   if (outputs.empty() || outputs.size() > limits::kMaxOutputColumns)
     throw Error(fmt::format("A record holds 1 to {} output columns (limits::kMaxOutputColumns), not {}.",
                             limits::kMaxOutputColumns, outputs.size()));
-  for (const OutputColumn& output : outputs) {
-    const std::string& name = output.column;
+  std::vector<std::string> names;
+  for (const OutputColumn& output : outputs) names.push_back(output.column);
+  names.insert(names.end(), extra_columns.begin(), extra_columns.end());
+  for (const std::string& name : names) {
     if (!is_column_name(name) || std::find(columns_.begin(), columns_.end(), name) != columns_.end())
       throw Error(
           fmt::format("Output column '{}' is not allowed: a name is letters, digits and '_', and appears "

@@ -167,7 +167,7 @@ RecordWriter make_writer(std::ostream& out, const Scenario& scenario,
   if (scenario.is_imu()) {
     std::vector<OutputColumn> columns;
     for (const SensorChannel& c : channels) columns.push_back(c.output);
-    return RecordWriter(out, metadata, columns);
+    return RecordWriter(out, metadata, columns, {});
   }
   const std::string_view column =
       std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());

@@ -92,10 +92,13 @@ class RecordWriter {
   /// A record of several output columns (an IMU's, docs/contract.md "IMUs"): the magic line, `metadata`, then
   /// the header time_s, the three angle columns and the `outputs`' column names (1 to
   /// limits::kMaxOutputColumns names of letters, digits and '_', each once, none a column before it; else
-  /// gyrocal::Error); each row writes sample.outputs' first outputs.size() values as they are (in the
-  /// columns' own units: the caller converts). Read it through a layout of those outputs
-  /// (Scenario::reading_layout()).
-  RecordWriter(std::ostream& out, const RecordMetadata& metadata, const std::vector<OutputColumn>& outputs);
+  /// gyrocal::Error), then `extra_columns` as above; each row writes sample.outputs' first outputs.size()
+  /// values as they are (in the columns' own units: the caller converts). Read it through a layout of those
+  /// outputs (Scenario::reading_layout()). (extra_columns has no default, so that a call RecordWriter(out,
+  /// {},
+  /// {}) stays the lone sensor's.)
+  RecordWriter(std::ostream& out, const RecordMetadata& metadata, const std::vector<OutputColumn>& outputs,
+               const std::vector<std::string>& extra_columns);
   /// Flushes what finish() has not (errors are ignored here; call finish() to see them).
   ~RecordWriter();
   RecordWriter(const RecordWriter&) = delete;
