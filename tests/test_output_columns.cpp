@@ -104,10 +104,6 @@ TEST(OutputColumns, ALayoutThatCannotBeReadIsRefusedNamingTheColumn) {
   RecordLayout angle = three_columns();
   angle.outputs[1].column = "pos";
   EXPECT_NE(error_of(angle).find("both name the column 'pos'"), std::string::npos);
-  RecordLayout increments = three_columns();
-  increments.outputs[1].form = OutputForm::kIncrement;
-  EXPECT_NE(error_of(increments).find("record.outputs[1] ('ax') holds increments"), std::string::npos)
-      << error_of(increments);
   RecordLayout zero = three_columns();
   zero.outputs[2].scale = 0.0;
   EXPECT_NE(error_of(zero).find("record.outputs[2].scale must be a finite non-zero number"),

@@ -179,6 +179,7 @@ DataQuality data_quality_of(const Reduction& reduction) {
   q.outliers = reduction.outliers;
   q.gaps = reduction.gaps;
   q.encoder_glitch_rows = reduction.encoder_glitch_rows;
+  q.increments_dropped = reduction.increments_dropped;
   for (const Dwell& d : reduction.dwells) {
     DataQuality::Dwell w;
     w.is_static = d.is_static;

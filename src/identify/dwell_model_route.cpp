@@ -12,6 +12,7 @@
 #include "gyrocal/core/parallel.hpp"
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/planned_model_terms.hpp"
+#include "gyrocal/record/increments.hpp"
 
 namespace gyrocal {
 
@@ -55,10 +56,13 @@ bool follows_measured_rate(const CentrifugeModel& model, const Dwell& d) {
   return measured_rate_effect_g(model, d) > kMeasuredRateFloorG;
 }
 
-JointState measured_joints(const Dwell& d, std::size_t si, std::size_t i) {
+namespace {
+
+/// measured_joints at the place k (in the stretch's sample intervals from its first sample, fractional
+/// inside an increment's interval) of stretch si.
+JointState measured_joints_at(const Dwell& d, std::size_t si, double k) {
   const TimeStretch& s = d.stretches[si];
   const MeasuredMotion& m = d.measured;
-  const double k = static_cast<double>(i);
   const MeasuredState x = m.at(m.stretch_phase[si], s.first_time_s + k * m.grid_interval_s);
   // The spline's abscissa advances by the planned interval a sample, the stretch's clock by its mean one.
   const double scale = s.interval_s > 0.0 ? m.grid_interval_s / s.interval_s : 1.0;
@@ -73,6 +77,12 @@ JointState measured_joints(const Dwell& d, std::size_t si, std::size_t i) {
   j.counter_accel_rad_s2 = -j.main_accel_rad_s2;
   j.position_angle_rad = d.beta_rad;
   return j;
+}
+
+}  // namespace
+
+JointState measured_joints(const Dwell& d, std::size_t si, std::size_t i) {
+  return measured_joints_at(d, si, static_cast<double>(i));
 }
 
 double measured_rate_effect_g(const CentrifugeModel& model, const Dwell& d) {
@@ -196,8 +206,8 @@ DwellModelValues reduce_dwell_model(const CentrifugeModel& model, const Dwell& d
   out.route.measured_rate = follow;
   // A planned dwell (no stretches: evenly spaced samples on the lines) summed on every sample or for a
   // prediction: in closed form, at a cost independent of its length (identify/planned_model_terms.hpp).
-  if (route.planned_closed_form && closed_forms == ModelTermsRoute::kExact && d.stretches.empty() &&
-      (options.model_samples_per_revolution == 0 || max_samples_per_dwell > 0) &&
+  if (route.planned_closed_form && !route.interval_mean && closed_forms == ModelTermsRoute::kExact &&
+      d.stretches.empty() && (options.model_samples_per_revolution == 0 || max_samples_per_dwell > 0) &&
       planned_dwell_model_terms(d, options, columns, on_lines, out.columns))
     return out;
   // Every sample asked for: the same sums by closed forms when the series' check holds (the joints on the
@@ -205,7 +215,8 @@ DwellModelValues reduce_dwell_model(const CentrifugeModel& model, const Dwell& d
   const bool exact_requested = options.model_samples_per_revolution == 0 &&
                                (d.is_static || options.method == ReduceOptions::Method::kHarmonicFit);
   if (!follow && exact_requested && closed_forms == ModelTermsRoute::kExact &&
-      reduce_dwell_by_fourier(model, d, options, acc, columns, route.rate_columns, on_lines, out.route)) {
+      reduce_dwell_by_fourier(model, d, options, acc, columns, route.rate_columns, on_lines, out.route,
+                              route.interval_mean ? d.sample_interval_s : 0.0)) {
     for (int c = 0; c < columns; ++c) out.columns.push_back(acc.finish(c));
     return out;
   }
@@ -215,13 +226,36 @@ DwellModelValues reduce_dwell_model(const CentrifugeModel& model, const Dwell& d
       d, options, columns,
       route.per_revolution && follow && std::holds_alternative<HarmonicFit>(acc.reduction()));
   std::vector<double> v(static_cast<std::size_t>(columns));
-  const auto add = [&](double t, const JointState& j, double gamma_rad) {
-    evaluate(d, j, v.data());
+  // An increment's model (route.interval_mean): the columns' mean over the sample's interval [t - dt, t] by
+  // Gauss-Legendre, with enough nodes for 1e-13 at twice the Fourier route's first band (record/
+  // increments.hpp); `back(s)` gives the joints s seconds before the stamp.
+  const double mean_dt = route.interval_mean ? d.sample_interval_s : 0.0;
+  const IntervalRule rule = interval_rule(
+      mean_dt > 0.0 ? interval_nodes(2.0 * fourier_harmonics(model) *
+                                     (std::abs(d.main.rate_rad_s) + std::abs(d.counter.rate_rad_s)) * mean_dt)
+                    : 1);
+  std::vector<double> node(static_cast<std::size_t>(columns));
+  const auto add = [&](double t, const JointState& j, const auto& back, double gamma_rad) {
+    if (mean_dt > 0.0) {
+      std::fill(v.begin(), v.end(), 0.0);
+      for (std::size_t k = 0; k < rule.back.size(); ++k) {
+        evaluate(d, back(rule.back[k] * mean_dt), node.data());
+        for (std::size_t c = 0; c < v.size(); ++c) v[c] += rule.weight[k] * node[c];
+      }
+    } else {
+      evaluate(d, j, v.data());
+    }
     acc.add(t, gamma_rad, v.data());
     revolutions.add(acc.samples(), gamma_rad, v.data());
   };
   const auto add_on_lines = [&](double t, double main_rad, double counter_rad) {
-    add(t, line_joints(d, main_rad, counter_rad), -counter_rad);
+    add(
+        t, line_joints(d, main_rad, counter_rad),
+        [&](double back_s) {
+          return line_joints(d, main_rad - d.main.rate_rad_s * back_s,
+                             counter_rad - d.counter.rate_rad_s * back_s);
+        },
+        -counter_rad);
   };
   const std::size_t stride = model_stride(d, options, max_samples_per_dwell, route);
   if (d.stretches.empty()) {
@@ -245,7 +279,13 @@ DwellModelValues reduce_dwell_model(const CentrifugeModel& model, const Dwell& d
         if (follow)
           // The joints follow the measured motion, and the operator's gamma is the output's own
           // (Dwell::basis_angle), which a ripple bends window by window: the dwell's one line is not it.
-          add(s.first_time_s + dt, measured_joints(d, si, i),
+          add(
+              s.first_time_s + dt, measured_joints(d, si, i),
+              [&](double back_s) {
+                // An increment's interval reaches back across the stretch's start: the spline is held at its
+                // first knot there (MeasuredMotion::at).
+                return measured_joints_at(d, si, static_cast<double>(i) - back_s / s.interval_s);
+              },
               d.basis_angle.empty() ? -counter_line : -basis.at(first_sample + i, s.first_time_s + dt));
         else
           add_on_lines(s.first_time_s + dt, s.main_at_first_rad + d.main.rate_rad_s * dt, counter_line);

@@ -8,6 +8,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/dwell_model_route.hpp"
 #include "gyrocal/model/machine_errors.hpp"
+#include "gyrocal/record/increments.hpp"
 
 namespace gyrocal {
 
@@ -52,7 +53,7 @@ std::pair<Complex, Complex> power_sums(double f, double n) {
 }
 
 /// The highest harmonic of any of the configured errors' series (0 without any).
-int highest_error_harmonic(const CentrifugeErrors& errors) {
+int highest_error_harmonic_of(const CentrifugeErrors& errors) {
   int highest = 0;
   for (const MachineErrorField& f : machine_error_fields()) {
     if (f.kind != MachineErrorKind::kSeries) continue;
@@ -134,6 +135,20 @@ class FourierModelTerms {
           const Complex* f = &along[(index(n) * m + b) * columns];
           for (std::size_t col = 0; col < columns; ++col) out[col] += times(w, f[col]);
         }
+      }
+  }
+
+  /// Each coefficient C_nm times the mean over a sample's interval of e^{j (n theta + m psi)} relative to its
+  /// value at the stamp (interval_mean_factor), the angles turning at the main and counter rates wm, wc.
+  void average_over_interval(double wm, double wc, double interval_s) {
+    const auto columns = static_cast<std::size_t>(columns_);
+    for (int n = -h_; n <= h_; ++n)
+      for (int k = -h_; k <= h_; ++k) {
+        // n wm + k wc, as add_run writes it (no loss where wc ~ -wm).
+        const double f = static_cast<double>(n) * (wm + wc) + static_cast<double>(k - n) * wc;
+        const Complex factor = interval_mean_factor(f, interval_s);
+        Complex* c = &coefficients_[(index(n) * static_cast<std::size_t>(size_) + index(k)) * columns];
+        for (std::size_t col = 0; col < columns; ++col) c[col] = times(c[col], factor);
       }
   }
 
@@ -223,13 +238,18 @@ constexpr int kMaxFourierHarmonic = 64;
 
 }  // namespace
 
+int fourier_harmonics(const CentrifugeModel& model) {
+  return std::max(12, 8 * highest_error_harmonic_of(model.errors()) + 4);
+}
+
 bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
                              DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
-                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route) {
+                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route,
+                             double interval_s) {
   const std::vector<Run> runs = runs_of(d);
   if (runs.empty()) return false;
   const int order = d.is_static ? 0 : options.harmonic_order;
-  int harmonics = std::max(12, 8 * highest_error_harmonic(model.errors()) + 4);
+  int harmonics = fourier_harmonics(model);
   // The closed forms cost about (2H+1)^2 (order + 2) columns operations a stretch; every sample about a
   // model evaluation (~1000 operations) a sample: the cheaper route is taken.
   std::size_t total = 0;
@@ -239,7 +259,7 @@ bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const
     const double closed_cost =
         width * width * (static_cast<double>(runs.size()) * (order + 2.0) * columns + 1000.0);
     if (closed_cost > 1000.0 * static_cast<double>(total)) return false;
-    const FourierModelTerms fourier(evaluate, columns, harmonics);
+    FourierModelTerms fourier(evaluate, columns, harmonics);
     std::vector<double> outer, all;
     const double outer_count = fourier.tails(outer, all);
     const double rates_deg_h =
@@ -255,6 +275,7 @@ bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const
     route.outer_tail = outer;
     route.scale = all;
     if (!holds) continue;
+    if (interval_s > 0.0) fourier.average_over_interval(d.main.rate_rad_s, d.counter.rate_rad_s, interval_s);
     // Sums over every run's samples: q[k][col] = sum e^{j k gamma} c, tsum[col] = sum tau c; and the basis'
     // own sums for the normal matrix: e0[p] = sum e^{j p gamma} (p <= 2 order), e1[p] = sum tau e^{j p
     // gamma}, tt = sum tau^2.

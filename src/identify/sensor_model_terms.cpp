@@ -60,6 +60,9 @@ std::vector<PositionModelTerms> reduce_sensor_model_terms(
   // docs/accelerometer_internals.md).
   design.stride_bound = ModelStrideBound::kEvenSpread;
   design.per_revolution = true;
+  // An output written as increments is the mean over each sample's interval: so is its model
+  // (docs/records.md, "Increments"). A rate's stays the value at the stamp.
+  design.interval_mean = channel.output.form == OutputForm::kIncrement;
   const std::vector<DwellModelValues> per_dwell = reduce_dwells_model(
       reduction, model, options, max_samples_per_dwell, route, design,
       [&](const Dwell&, const JointState& j, double* row) { design_columns(channel, model, j, row); });

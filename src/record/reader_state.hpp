@@ -124,6 +124,12 @@ struct RecordReader::State {
   std::size_t output_count = 0;  ///< outputs.size(), read every row
   std::array<double, limits::kMaxOutputColumns> output_offset{};
   std::array<double, limits::kMaxOutputColumns> output_divisor{};
+  /// Per output: it holds increments (OutputForm::kIncrement), read divided by the row's interval; and
+  /// whether any does. The previous row's time, s, for that interval (NaN before the first row: the first
+  /// row's increment has no interval and reads as NaN).
+  std::array<bool, limits::kMaxOutputColumns> output_increment{};
+  bool any_increment = false;
+  double interval_start_s = std::numeric_limits<double>::quiet_NaN();
   fast_float::parse_options number_options{fast_float::chars_format::general, '.'};
   char decimal = '.';
   // gyrocal's own format with only the time and the output (time_s,gyro_deg_h or time_s,accel_g).
@@ -194,6 +200,8 @@ struct RecordReader::State {
     for (std::size_t i = 0; i < outputs.size(); ++i) {
       output_offset[i] = outputs[i].offset;
       output_divisor[i] = outputs[i].scale;
+      output_increment[i] = outputs[i].form == OutputForm::kIncrement;
+      any_increment = any_increment || output_increment[i];
     }
     decimal = l.decimal;
     number_options = fast_float::parse_options{fast_float::chars_format::general, l.decimal};
@@ -435,8 +443,8 @@ struct RecordReader::State {
         : layout->outputs.empty()
             ? fmt::format(", which reads as {} {} ((value - record.output_offset) / record.{})", output, unit,
                           outputs[k].scale_key())
-            : fmt::format(", which reads as {} {} ((value - offset) / scale of record.outputs[{}])", output,
-                          unit, k);
+            : fmt::format(", which reads as {} {} ((value - offset) / scale of record.outputs[{}]{})", output,
+                          unit, k, output_increment[k] ? ", an increment divided by its interval" : "");
     fail(fmt::format(
         "column {} ({}) is {}{}; an output is at most {} {} in magnitude (limits::kOutputMagnitude): no "
         "sensor "

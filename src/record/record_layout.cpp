@@ -162,11 +162,6 @@ bool RecordLayout::IsValid(std::string* error, std::string* key) const {
                          o.unit(), o.scale));
     if (!std::isfinite(o.offset))
       return fail(k, fmt::format("record.{}.offset must be a finite number, not {}", k, o.offset));
-    if (o.form != OutputForm::kRate)
-      return fail(k,
-                  fmt::format("record.{} ('{}') holds increments, which gyrocal does not read yet: give its "
-                              "values as rates (an increment divided by its interval)",
-                              k, o.column));
     if (auto problem = unit_name_problem(k + ".unit_name", o.unit_name)) return fail(k, *problem);
   }
   const std::array<std::pair<std::string_view, double>, 4> offsets = {{

@@ -136,6 +136,18 @@ bool RecordReader::next(RecordSample& sample) {
     if (!(std::abs(sample.outputs[k]) <= limits::kOutputMagnitude)) [[unlikely]]
       s.fail_output(values[4 + k], sample.outputs[k], k);
   }
+  if (s.any_increment) [[unlikely]] {
+    // An increment over the interval that ends at this row's stamp, divided by that interval: the mean over
+    // it (docs/records.md, "Increments"). The first row has no interval: NaN, never used.
+    const double interval_s = values[0] - s.interval_start_s;
+    s.interval_start_s = values[0];
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!s.output_increment[k]) continue;
+      sample.outputs[k] /= interval_s;
+      if (!(std::abs(sample.outputs[k]) <= limits::kOutputMagnitude) && !std::isnan(interval_s))
+        s.fail_output(values[4 + k], sample.outputs[k], k);
+    }
+  }
   return true;
 }
 

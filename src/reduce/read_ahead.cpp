@@ -114,6 +114,9 @@ class ReadAhead {
 void push_record(Reducer& reducer, RecordReader& reader,
                  const std::function<void(std::span<const RecordSample>)>& observe) {
   reducer.set_record_layout(reader.layout());
+  if (reader.layout())
+    for (const OutputColumn& o : reader.layout()->output_columns())
+      if (o.form == OutputForm::kIncrement) reducer.set_increments(true);
   RecordSummary summary;  // of every row read
   ReadAhead ahead(reader);
   for (auto rows = ahead.next(); !rows.empty(); rows = ahead.next()) {

@@ -56,6 +56,11 @@ void Reducer::set_output_columns(const std::vector<std::string>& names) {
   state_->output_names = names.size() > 1 ? names : std::vector<std::string>{};
 }
 
+void Reducer::set_increments(bool increments) {
+  if (state_->rows > 0) throw Error("Reducer::set_increments: only before the first row.");
+  state_->increments = increments;
+}
+
 void Reducer::set_record_layout(const std::optional<RecordLayout>& layout) {
   state_->layout = layout;
 }
@@ -139,7 +144,11 @@ Reduction Reducer::State::finish_first_column() {
     out.outliers += out.dwells.back().output.outliers;
     out.gaps += out.dwells.back().gaps;
     out.encoder_glitch_rows += out.dwells.back().quality.encoder_glitch_rows;
+    if (st.increments)
+      out.increments_dropped =
+          out.increments_dropped.value_or(0) + out.dwells.back().quality.increments_dropped;
   }
+  if (st.increments && !out.increments_dropped) out.increments_dropped = 0;
   st.dwells.clear();
   st.more_outputs.clear();
   st.dwell_of_key.clear();

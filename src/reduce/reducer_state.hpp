@@ -286,6 +286,9 @@ struct Run {
   // sample count, times and revolutions are the dwell's.
   std::vector<DwellAccumulator> accs;
   bool measuring = false;  // the first row of the measured part has been measured
+  // A record with increments: the row after a gap was left out (its interval unknown), so the next row
+  // measured takes the gap's place (a new stretch and phase).
+  bool gap_pending = false;
   double t_first = 0.0, theta_first = 0.0, psi_first = 0.0;
   std::vector<LineSums> phase_theta, phase_psi, phase_rel;  // rel: psi_r + theta
   // Successive differences of the main encoder's deviations inside stretches: the white part of its scatter
@@ -339,6 +342,8 @@ struct Reducer::State {
   /// messages.
   std::size_t outputs = 1;
   std::vector<std::string> output_names;
+  /// The record holds an increment column (Reducer::set_increments).
+  bool increments = false;
   /// With several output columns: the values of the columns after the first of every row still held
   /// (window, a run's held rows and guard), by serial from more_front on. Memory: the rows held, no more.
   std::deque<std::array<double, limits::kMaxOutputColumns - 1>> more_outputs_of_rows;

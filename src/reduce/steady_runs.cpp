@@ -386,6 +386,17 @@ void Reducer::State::measure(const Row& u, bool gap, bool dropped, double t_reco
     ++r.quality.beyond_planned_rows;
     return;
   }
+  if (increments) [[unlikely]] {
+    // An increment over an unknown interval (Reducer::set_increments): the row is left out of every column,
+    // and the next one measured starts the stretch the gap would have.
+    if (gap || u.serial == 0) {
+      ++r.quality.increments_dropped;
+      r.gap_pending = r.measuring;
+      return;
+    }
+    gap = r.gap_pending;
+    r.gap_pending = false;
+  }
   if (!r.measuring) {
     r.measuring = true;
     r.t_first = u.t;

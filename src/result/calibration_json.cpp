@@ -90,6 +90,8 @@ nlohmann::ordered_json data_quality_to_json(const DataQuality& q) {
                               {"outliers", q.outliers},
                               {"gaps", q.gaps},
                               {"encoder_glitch_rows", q.encoder_glitch_rows}};
+  // Only for a record with an increment column: a lone sensor's result stays as it was.
+  if (q.increments_dropped) j["increments_dropped"] = *q.increments_dropped;
   nlohmann::ordered_json dwells = nlohmann::ordered_json::array(), rejected = nlohmann::ordered_json::array();
   for (const DataQuality::Dwell& d : q.dwells) {
     nlohmann::ordered_json j_d = {{"static", d.is_static},

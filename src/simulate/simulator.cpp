@@ -1,6 +1,7 @@
 #include "gyrocal/simulate/simulator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -13,6 +14,8 @@
 #include "gyrocal/core/limits.hpp"
 #include "gyrocal/core/random.hpp"
 #include "gyrocal/model/gyro.hpp"
+#include "gyrocal/model/machine_errors.hpp"
+#include "gyrocal/record/increments.hpp"
 #include "gyrocal/sensor/channel.hpp"
 #include "gyrocal/sensor/sensor.hpp"
 #include "gyrocal/simulate/accelerometer_noise.hpp"
@@ -70,9 +73,36 @@ std::vector<SensorChannel> record_channels(const Scenario& scenario, double fs, 
   return channels;
 }
 
-/// The row at time t: the encoders' readings and each channel's output with its generator's next noise.
+/// How the channels written as increments are integrated over each row's interval (docs/records.md,
+/// "Increments"): the Gauss-Legendre rule of record/increments.hpp, its nodes enough for 1e-13 on a harmonic
+/// of twice the model route's first band (2 max(12, 8 x the errors' highest harmonic + 4)) of the test's
+/// fastest joint (twice its fastest main rate plus a counter offset) over one sample interval. No rule (nodes
+/// empty) when no channel is an increment.
+IntervalRule increment_rule(const Scenario& scenario, const std::vector<SensorChannel>& channels) {
+  bool any = false;
+  for (const SensorChannel& c : channels) any = any || c.output.form == OutputForm::kIncrement;
+  if (!any) return {};
+  int highest = 0;
+  for (const MachineErrorField& f : machine_error_fields()) {
+    if (f.kind != MachineErrorKind::kSeries) continue;
+    for (const HarmonicTerm& term : (scenario.errors.*f.series).terms)
+      if (term.amplitude != 0.0) highest = std::max(highest, std::abs(term.harmonic));
+  }
+  double fastest = 0.0, offset = 0.0;
+  for (double r : scenario.test.rates_rad_s) fastest = std::max(fastest, std::abs(r));
+  for (double o : scenario.test.counter_rate_offsets_rad_s) offset = std::max(offset, std::abs(o));
+  const double band = 2.0 * std::max(12, 8 * highest + 4);
+  return interval_rule(interval_nodes(band * (2.0 * fastest + offset) / scenario.test.sample_rate_hz));
+}
+
+/// The row at time t (the k-th, t = k / fs): the encoders' readings and each channel's output with its
+/// generator's next noise. A channel written as increments gets the mean of its noise-free output over the
+/// row's interval [t - dt, t] (dt = t less the previous row's time, 1 / fs before the first), by `rule`, plus
+/// its generator's noise for the row (white noise per sample is the mean of a rate's white noise over the
+/// interval: the same variance).
 void sample_at(const CentrifugeModel& model, const std::vector<SensorChannel>& channels,
-               const Timeline& timeline, double t, std::vector<NoiseGenerator>& noise, RecordSample& sample) {
+               const Timeline& timeline, double t, std::vector<NoiseGenerator>& noise, RecordSample& sample,
+               const IntervalRule& rule = {}, double interval_s = 0.0) {
   const JointState joints = joint_state_at(timeline, t);
   // The output stamped at t was sensed the acquisition's delay earlier ([record] output_delay_s): the
   // machine's own motion at that instant (the encoders are read at t). The platform's motion once, then
@@ -88,12 +118,65 @@ void sample_at(const CentrifugeModel& model, const std::vector<SensorChannel>& c
   // sensed rate (1 + e)(omega_I + dO omega_O + dS omega_S) plus the drift, omega_I bit for bit with no rate
   // errors; Accelerometer: docs/accelerometer.md's IEEE 1293 model), then its noise.
   for (std::size_t k = 0; k < channels.size(); ++k) {
+    if (channels[k].output.form == OutputForm::kIncrement) continue;
     const double clean = sensor_output(channels[k].sensor, channel_inputs(model, motion, channels[k]));
+    sample.outputs[k] = std::visit([clean](auto& generator) { return generator.next(clean); }, noise[k]);
+  }
+  if (rule.back.empty()) return;
+  // The increments: the exact output at every node of the interval (the motion at each, once for all
+  // channels), never the rate at the stamp.
+  std::array<double, limits::kMaxOutputColumns> mean{};
+  for (std::size_t n = 0; n < rule.back.size(); ++n) {
+    const double at = t - delay_s - rule.back[n] * interval_s;
+    const PlatformFrameMotion m = platform_motion(model, joint_state_at(timeline, at));
+    for (std::size_t k = 0; k < channels.size(); ++k)
+      if (channels[k].output.form == OutputForm::kIncrement)
+        mean[k] += rule.weight[n] * sensor_output(channels[k].sensor, channel_inputs(model, m, channels[k]));
+  }
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    if (channels[k].output.form != OutputForm::kIncrement) continue;
+    const double clean = mean[k];
     sample.outputs[k] = std::visit([clean](auto& generator) { return generator.next(clean); }, noise[k]);
   }
 }
 
-/// The simulation loop; `sink` is a template parameter so that the record writer's call is direct.
+/// A row as an IMU's record writes it (docs/records.md): each channel's column in its own units, reading =
+/// offset + scale x value, an increment's value times the row's interval.
+RecordSample in_column_units(const std::vector<SensorChannel>& channels, RecordSample sample,
+                             double interval_s) {
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    const OutputColumn& o = channels[k].output;
+    const double value =
+        o.form == OutputForm::kIncrement ? sample.outputs[k] * interval_s : sample.outputs[k];
+    sample.outputs[k] = o.offset + o.scale * value;
+  }
+  return sample;
+}
+
+/// The interval that ends at the k-th row's stamp k / fs: the stamp less the previous one (1 / fs for the
+/// first row, whose interval lies before the test).
+double row_interval(std::uint64_t k, double fs) {
+  const double t = static_cast<double>(k) / fs;
+  return k == 0 ? 1.0 / fs : t - static_cast<double>(k - 1) / fs;
+}
+
+/// The record's writer: a lone sensor's gyrocal format (its native column), an IMU's with one column per
+/// channel.
+RecordWriter make_writer(std::ostream& out, const Scenario& scenario,
+                         const std::vector<SensorChannel>& channels, const RecordMetadata& metadata) {
+  if (scenario.is_imu()) {
+    std::vector<OutputColumn> columns;
+    for (const SensorChannel& c : channels) columns.push_back(c.output);
+    return RecordWriter(out, metadata, columns, {});
+  }
+  const std::string_view column =
+      std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());
+  return RecordWriter(out, metadata, {}, column);
+}
+
+/// The simulation loop; `sink` is a template parameter so that the record writer's call is direct. It takes
+/// each row (outputs in the sensors' units, an increment's as the mean over its interval) and the row's
+/// interval, s.
 template <typename Sink>
 SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::uint64_t seed,
                       const SimulationOptions& options, Sink&& sink) {
@@ -101,11 +184,13 @@ SimulationSummary run(const Scenario& scenario, const Timeline& timeline, std::u
   const double fs = scenario.test.sample_rate_hz;
   std::vector<NoiseGenerator> noise;
   const std::vector<SensorChannel> channels = record_channels(scenario, fs, seed, noise);
+  const IntervalRule rule = increment_rule(scenario, channels);
   const std::uint64_t n = sample_count(timeline, fs);
   RecordSample sample;
   for (std::uint64_t k = 0; k < n; ++k) {
-    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample);
-    sink(sample);
+    const double interval_s = row_interval(k, fs);
+    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample, rule, interval_s);
+    sink(sample, interval_s);
     if (options.progress && (k + 1) % kProgressEverySamples == 0) {
       options.progress(static_cast<double>(k + 1) / static_cast<double>(n));
     }
@@ -144,6 +229,16 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
   // record is what it always was.
   if (scenario.errors.output_delay_s != 0.0)
     m.emplace_back("output_delay_s", fmt::format("{}", scenario.errors.output_delay_s));
+  if (scenario.is_imu()) {
+    // An IMU's record: its channels, each as name:column:form (the configuration holds their truth).
+    std::string channels;
+    for (const SensorChannel& c : scenario.imu_channels)
+      channels += fmt::format("{}{}:{}:{}", channels.empty() ? "" : ", ", c.name, c.output.column,
+                              c.output.form == OutputForm::kIncrement ? "increment" : "rate");
+    m.emplace_back("sensor", "imu");
+    m.emplace_back("channels", "[" + channels + "]");
+    return m;
+  }
   if (scenario.sensor_kind == SensorKind::kAccelerometer) {
     // An accelerometer's record: its kind, noise ([accelerometer.noise] keys) and truth (parameter table).
     const Accelerometer& a = scenario.accelerometer;
@@ -186,18 +281,24 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
 SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& options,
                            const SampleSink& sink) {
   const Timeline timeline = make_timeline(scenario.test, scenario.model());
-  return run(scenario, timeline, options.seed.value_or(scenario.test.seed), options, sink);
+  return run(scenario, timeline, options.seed.value_or(scenario.test.seed), options,
+             [&sink](const RecordSample& s, double) { sink(s); });
 }
 
 SimulationSummary simulate_record(const Scenario& scenario, const SimulationOptions& options,
                                   std::ostream& out) {
   const Timeline timeline = make_timeline(scenario.test, scenario.model());
   const std::uint64_t seed = options.seed.value_or(scenario.test.seed);
-  const std::string_view column =
-      std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());
-  RecordWriter writer(out, simulation_metadata(scenario, timeline, seed), {}, column);
+  const std::vector<SensorChannel> channels = scenario.channels();
+  RecordWriter writer = make_writer(out, scenario, channels, simulation_metadata(scenario, timeline, seed));
+  const bool imu = scenario.is_imu();
   const SimulationSummary summary =
-      run(scenario, timeline, seed, options, [&writer](const RecordSample& s) { writer.write(s); });
+      run(scenario, timeline, seed, options, [&](const RecordSample& s, double interval_s) {
+        if (imu)
+          writer.write(in_column_units(channels, s, interval_s));
+        else
+          writer.write(s);
+      });
   writer.finish();
   return summary;
 }
@@ -208,25 +309,27 @@ RecordSize estimate_record_size(const Scenario& scenario) {
   RecordSize size;
   size.rows = sample_count(timeline, fs);
   size.duration_s = timeline.duration_s;
-  const std::string_view column =
-      std::visit([](const auto& s) { return s.native_column; }, scenario.sensor());
   // The head exactly, then up to kSampledRows rows spread evenly over the test, written as simulate writes
   // them: the mean row's length times the rows.
   constexpr std::uint64_t kSampledRows = 2000;
   std::ostringstream head;
-  RecordWriter(head, simulation_metadata(scenario, timeline, scenario.test.seed), {}, column).finish();
+  make_writer(head, scenario, scenario.channels(),
+              simulation_metadata(scenario, timeline, scenario.test.seed))
+      .finish();
   const std::uint64_t stride = std::max<std::uint64_t>(1, size.rows / kSampledRows);
   std::ostringstream rows;
-  RecordWriter writer(rows, {}, {}, column);
+  RecordWriter writer = make_writer(rows, scenario, scenario.channels(), {});
   const std::size_t rows_head = rows.str().size();
   const CentrifugeModel model = scenario.model();
   std::vector<NoiseGenerator> noise;
   const std::vector<SensorChannel> channels = record_channels(scenario, fs, scenario.test.seed, noise);
+  const IntervalRule rule = increment_rule(scenario, channels);
   RecordSample sample;
   std::uint64_t written = 0;
   for (std::uint64_t k = 0; k < size.rows; k += stride, ++written) {
-    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample);
-    writer.write(sample);
+    const double interval_s = row_interval(k, fs);
+    sample_at(model, channels, timeline, static_cast<double>(k) / fs, noise, sample, rule, interval_s);
+    writer.write(scenario.is_imu() ? in_column_units(channels, sample, interval_s) : sample);
   }
   writer.finish();
   const auto row_bytes = static_cast<double>(rows.str().size() - rows_head);

@@ -132,6 +132,9 @@ struct DataQuality {
   std::size_t outliers = 0;   ///< of those, rejected as outliers (replaced by the dwell's fit)
   std::size_t gaps = 0;       ///< breaks in the time series inside those dwells
   std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside those dwells: their encoders left the line
+  /// A record with an increment column: rows inside those dwells whose increments had no known interval
+  /// (after a gap or a lost row), left out (Reduction::increments_dropped); nullopt for a record without one.
+  std::optional<std::size_t> increments_dropped;
   /// Per dwell used, in time order: what its steady run held, what was dropped and why.
   struct Dwell {
     bool is_static = false;

@@ -64,9 +64,18 @@ using DwellModelTermsEvaluator = std::function<void(double main_rad, double coun
 /// floor is the rate's rounding where rate_column[c] (deg/h), a regressor's otherwise. `route` says what was
 /// tried: H, the outer band's and the whole series' sums of |C_nm| per column, the operator's gains.
 /// (identify/fourier_model_terms.cpp)
+/// interval_s > 0: the columns' means over each sample's interval [t - interval_s, t] are summed instead of
+/// their values at t (an increment's model, docs/records.md "Increments"): each term C_nm e^{j (n theta + m
+/// psi)} times interval_mean_factor(n w_main + m w_counter, interval_s) (record/increments.hpp), exact for
+/// the dwell's constant rates.
 bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const ReduceOptions& options,
                              DwellAccumulator& acc, int columns, const std::vector<bool>& rate_column,
-                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route);
+                             const DwellModelTermsEvaluator& evaluate, DwellModelTermsRoute& route,
+                             double interval_s = 0.0);
+
+/// The harmonics H the Fourier route tries first for `model`'s configured errors: 8 x their highest harmonic
+/// + 4, at least 12 (it doubles H once where the series' check fails).
+int fourier_harmonics(const CentrifugeModel& model);
 
 /// Below this, in g, what a dwell's constant-rate line misses of the specific force (measured_rate_effect_g)
 /// is not worth following the measured motion: 1e-4 ug, the exactness asked of a noise-free accelerometer
@@ -146,6 +155,13 @@ struct DwellModelRoute {
   /// Where the dwell follows its measured motion and is reduced by the harmonic fit: the columns also
   /// reduced revolution by revolution by the output's per-revolution fit (DwellModelValues::revolutions).
   bool per_revolution = false;
+  /// The columns are the means over each sample's interval [t - dt, t], dt the dwell's sample interval
+  /// (Dwell::sample_interval_s), not their values at t: the model of an output written as increments
+  /// (docs/records.md, "Increments"). The Fourier route multiplies each term by its interval factor; every
+  /// sample takes the Gauss-Legendre rule (record/increments.hpp) of enough nodes for 1e-13 at twice the
+  /// Fourier route's first band, fourier_harmonics x (|main rate| + |counter rate|); the planned closed form
+  /// is not taken.
+  bool interval_mean = false;
 };
 
 /// A sensor's model columns (DwellModelRoute::columns values into `columns`) at joint state `j` of dwell

@@ -56,9 +56,10 @@ inline constexpr std::size_t kMaxExtraColumns = 8;
 /// Ordered `# key = value` metadata lines.
 using RecordMetadata = std::vector<std::pair<std::string, std::string>>;
 
-/// One row of a record, in gyrocal's units whatever the record's layout. A column that the layout leaves
-/// absent (an angle column named "", or left at its default name and missing from the header), or that a
-/// record of the output alone lacks, reads as NaN.
+/// One row of a record, in gyrocal's units whatever the record's layout; an increment column's value divided
+/// by the row's interval (docs/records.md, "Increments"), NaN on the first row, which has none. A column that
+/// the layout leaves absent (an angle column named "", or left at its default name and missing from the
+/// header), or that a record of the output alone lacks, reads as NaN.
 struct RecordSample {
   double time_s = 0.0;              ///< time since the start of the test, s
   double main_angle_deg = 0.0;      ///< main axis encoder θ, deg (wrapped or unwrapped)
@@ -88,6 +89,16 @@ class RecordWriter {
   RecordWriter(std::ostream& out, const RecordMetadata& metadata,
                const std::vector<std::string>& extra_columns,
                std::string_view output_column = kRecordColumns[4]);
+  /// A record of several output columns (an IMU's, docs/contract.md "IMUs"): the magic line, `metadata`, then
+  /// the header time_s, the three angle columns and the `outputs`' column names (1 to
+  /// limits::kMaxOutputColumns names of letters, digits and '_', each once, none a column before it; else
+  /// gyrocal::Error), then `extra_columns` as above; each row writes sample.outputs' first outputs.size()
+  /// values as they are (in the columns' own units: the caller converts). Read it through a layout of those
+  /// outputs (Scenario::reading_layout()). (extra_columns has no default, so that a call RecordWriter(out,
+  /// {},
+  /// {}) stays the lone sensor's.)
+  RecordWriter(std::ostream& out, const RecordMetadata& metadata, const std::vector<OutputColumn>& outputs,
+               const std::vector<std::string>& extra_columns);
   /// Flushes what finish() has not (errors are ignored here; call finish() to see them).
   ~RecordWriter();
   RecordWriter(const RecordWriter&) = delete;
@@ -107,7 +118,8 @@ class RecordWriter {
   void flush_buffer();
 
   std::ostream& out_;
-  std::vector<std::string> columns_;  ///< all names, required then extra
+  std::vector<std::string> columns_;  ///< all names, required (or the outputs') then extra
+  std::size_t output_count_ = 1;      ///< output columns after the angles
   std::size_t extra_count_;
   std::vector<char> buffer_;
   std::size_t used_ = 0;

@@ -21,13 +21,16 @@ enum class OutputQuantity { kRate, kSpecificForce };
 
 /// How an output column's values stand for the sensor's input: a rate (or specific force) at the row's stamp,
 /// or an increment, its integral over the interval that ends at the stamp (an IMU's angle and velocity
-/// increments, docs/records.md). Increments are not read yet: RecordLayout::IsValid refuses them.
+/// increments, docs/records.md "Increments"; record/increments.hpp). The reader gives an increment divided by
+/// its interval (the row's time less the previous row's): the mean over the interval.
 enum class OutputForm { kRate, kIncrement };
 
 /// One output column of a record: one channel's values and how they convert into the sensor's unit (deg/h
-/// for a rate, g for a specific force): value = (reading - offset) / scale. A lone sensor's is the one that
-/// [record]'s output keys describe (RecordLayout::output_columns()); a unit of several channels holds one per
-/// channel (RecordLayout::outputs).
+/// for a rate, g for a specific force): value = (reading - offset) / scale; for an increment that value is
+/// then divided by the row's interval, s (so `scale` is output units per the sensor's unit once an increment
+/// is divided by its interval, e.g. rad/s per deg/h, and `offset` what an increment reads at zero input). A
+/// lone sensor's is the one that [record]'s output keys describe (RecordLayout::output_columns()); a unit of
+/// several channels holds one per channel (RecordLayout::outputs).
 struct OutputColumn {
   std::string column = "gyro_deg_h";  ///< its name in the header
   OutputQuantity quantity = OutputQuantity::kRate;

@@ -62,6 +62,9 @@ struct DwellQuality {
   std::size_t encoder_glitch_rows = 0;        ///< dropped: encoders left the line for a few rows
   /// dropped: the last ReduceOptions::leave_guard_s before the machine left the steady state
   std::size_t before_leaving_rows = 0;
+  /// dropped: rows of the measured part whose increments have no known interval (a record with an increment
+  /// column: the row after a gap or a lost row; Reducer::set_increments)
+  std::size_t increments_dropped = 0;
   std::string ended;  ///< why the run ended
 };
 
@@ -155,7 +158,11 @@ struct Reduction {
   std::size_t outliers = 0;      ///< of those, rejected as outliers in this column (and left out of its fit)
   std::size_t gaps = 0;          ///< breaks in the time series inside the dwells used (Dwell::gaps)
   std::size_t encoder_glitch_rows = 0;  ///< rows dropped inside the dwells used: encoders off their line
-  std::vector<RejectedRun> rejected;    ///< steady runs that gave no dwell (the longest kRejectedKept)
+  /// A record with an increment column (Reducer::set_increments): the rows inside the dwells used that were
+  /// left out of every column because an increment's interval was unknown (after a gap or a lost row; the
+  /// record's first row). nullopt for a record without increments.
+  std::optional<std::size_t> increments_dropped;
+  std::vector<RejectedRun> rejected;  ///< steady runs that gave no dwell (the longest kRejectedKept)
 };
 
 /// The test the reducer expects: the configured plan and the rate that sizes a static hold when the plan
@@ -198,6 +205,15 @@ class Reducer {
   /// limits::kMaxOutputColumns; one by default), each reduced beside the others in the one pass with its own
   /// outlier rule and standard errors; `names` name them in messages. Only before the first push.
   void set_output_columns(const std::vector<std::string>& names);
+  /// The record holds an output column of increments (OutputForm::kIncrement, read divided by its interval:
+  /// docs/records.md, "Increments"). Then a row of a dwell's measured part whose interval is unknown, the
+  /// row after a gap (an interval longer than ReduceOptions::gap_intervals planned sample intervals: a break
+  /// in the record or a lost row, whose increment covers an interval the stamps do not give) and the record's
+  /// first row (no interval), is left out of every output column, so that every column and the model terms
+  /// are reduced by one operator on the same samples; it is counted (DwellQuality::increments_dropped,
+  /// Reduction::increments_dropped) and the next row starts a new stretch as after the gap. Only before the
+  /// first push; false by default.
+  void set_increments(bool increments);
   Reducer(const Reducer&) = delete;
   Reducer& operator=(const Reducer&) = delete;
 
