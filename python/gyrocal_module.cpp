@@ -341,8 +341,11 @@ PYBIND11_MODULE(_gyrocal, m) {
       .def_property_readonly("sample_rate_hz", [](const Scenario& s) { return s.test.sample_rate_hz; })
       .def_property_readonly("seed", [](const Scenario& s) { return s.test.seed; })
       .def_property_readonly(
-          "sensor_kind", [](const Scenario& s) { return std::string(to_string(s.sensor_kind)); },
-          "[sensor] kind: \"gyro\" or \"accelerometer\".")
+          "sensor_kind",
+          [](const Scenario& s) {
+            return s.is_imu() ? std::string("imu") : std::string(to_string(s.sensor_kind));
+          },
+          "[sensor] kind: \"gyro\", \"accelerometer\" or \"imu\".")
       .def_property_readonly(
           "output_column", [](const Scenario& s) { return native_output_column(s.sensor_kind); },
           "gyrocal's own output column of the scenario's sensor: gyro_deg_h (deg/h) or accel_g (g).");
@@ -355,4 +358,6 @@ PYBIND11_MODULE(_gyrocal, m) {
   m.def("_noise_arrays", &noise_arrays_py);
   m.def("_check_output_column", &check_output_column_py);
   m.def("_history", &history_py, py::arg("db"), py::arg("unit"));
+  // The functions that do not serve an IMU configuration yet refuse one with the command line's sentence.
+  m.def("_refuse_imu", &refuse_imu, py::arg("scenario"), py::arg("function"));
 }

@@ -570,7 +570,8 @@ TEST(AccelerometerConfig, TheOtherSensorsKeysAreRefusedByName) {
                 .find("accelerometer.noise.quantization_ug is an accelerometer key"),
             std::string::npos);
   EXPECT_EQ(refusal("[sensor]\nkind = \"magnetometer\"\n"),
-            "accel.toml, line 2: sensor.kind must be \"gyro\" or \"accelerometer\", not \"magnetometer\".");
+            "accel.toml, line 2: sensor.kind must be \"gyro\", \"accelerometer\" or \"imu\", not "
+            "\"magnetometer\".");
   EXPECT_EQ(
       refusal(accel + "[accelerometer]\nK1 = 0\n"),
       "accel.toml, line 4: accelerometer.K1 must be a non-zero scale factor (output units per g), not 0.");

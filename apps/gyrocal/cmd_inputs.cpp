@@ -95,6 +95,7 @@ void register_inputs(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
+    refuse_imu(s, "inputs");
     // An instant lies within a test (a larger time would also overflow theta = omega t into inf and every
     // input into NaN).
     if (time->count()) check_time_within_test(opt->time_s, s.test, "--time-s");

@@ -119,6 +119,7 @@ void register_montecarlo(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
+    refuse_imu(scenario, "montecarlo");
     MonteCarloOptions options;
     options.trials = opt->trials;
     options.seed = seed->count() ? opt->seed : scenario.test.seed;

@@ -43,6 +43,7 @@ void register_noise(CLI::App& app) {
     check_output(opt->html, OutputKind::kReport, opt->force, "--html");
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
+    refuse_imu(s, "noise");
     // With a configuration, its sensor's output is characterised (a record of the other sensor is refused);
     // without one, the record's output column says which sensor (accel_g: an accelerometer).
     RecordNoiseOptions noise_options;

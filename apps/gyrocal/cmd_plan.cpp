@@ -118,6 +118,7 @@ void register_plan(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
+    refuse_imu(s, "plan");
     // The options as the library builds them for every caller (identify/scenario_options.hpp); the
     // prediction models [reduce] and [calibration] reduction.
     CalibrationChoices choices;

@@ -235,6 +235,7 @@ void register_sensitivity(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
+    refuse_imu(scenario, "sensitivity");
     SensitivityOptions options;
     options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
     options.threshold = opt->threshold;

@@ -253,6 +253,7 @@ def exact_inputs(scenario, time_s, beta_deg):
     the I, O, S components, rad/s and g. time_s is a number or a one-dimensional array; an array of more
     dimensions, or a value that is not finite (as beta_deg), raises ValueError as the command line refuses
     it."""
+    _gyrocal._refuse_imu(scenario, "gyrocal.exact_inputs")
     t = _numbers(time_s, "time_s")
     if t.ndim == 0:
         t = t.reshape(1)
@@ -264,6 +265,7 @@ def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
     record's columns (RECORD_COLUMNS; an accelerometer's output is keyed accel_g, in g, as its record's header). seed=None takes the scenario's [test] seed, as without --seed; any other
     seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
+    _gyrocal._refuse_imu(scenario, "gyrocal.simulate")
     return _gyrocal._simulate(scenario, seed)
 
 
@@ -285,6 +287,7 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     accelerometer's scenario ([sensor] kind) gives its eleven in its table's order (K0 K1 K2 K3 Kip Kio Kpo
     Kpp Koo delta_p delta_o), from a record whose output column is accel_g. method and compensation left None
     take their defaults, as the command line without --method and --compensation."""
+    _gyrocal._refuse_imu(scenario, "gyrocal.calibrate")
     options = (method, compensation, reduction, estimate, gyro_model)
     if isinstance(rec, str):
         return _gyrocal._calibrate_path(rec, scenario, *options)
@@ -301,6 +304,8 @@ def noise(rec, scenario=None):
     A record's path is read through the scenario's [record] layout when it has one (as `gyrocal noise
     --config`), and the scenario's [sensor] kind says whose output it must hold; without a scenario the
     record's output column says. The noise itself does not depend on the scenario."""
+    if scenario is not None:
+        _gyrocal._refuse_imu(scenario, "gyrocal.noise")
     if isinstance(rec, str):
         return _gyrocal._noise_path(rec, scenario)
     if scenario is not None:

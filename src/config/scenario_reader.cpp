@@ -12,6 +12,7 @@
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/bounded_read.hpp"
 #include "gyrocal/core/error.hpp"
+#include "imu_channels.hpp"
 #include "sensor_sections.hpp"
 #include "toml_prescan.hpp"
 #include "toml_reader.hpp"
@@ -307,19 +308,9 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
 
   Section gyro(reader, top.table("gyro"), "gyro");
   const toml::table* noise_table = gyro.table("noise");
-  for (std::size_t i = 0; i < kNumGyroCoefficients; ++i)
-    gyro.number(kCoefficientNames[i], 1.0, kGyroCoefficientRange, s.gyro.values[i]);
-  // docs/physics.md section 15: the scale-factor error and the input axis' tilts toward O and S.
-  gyro.number("scale_factor_error_ppm", 1.0, kRateError, s.gyro_rate.scale_factor_error_ppm);
-  if (const toml::node* node = gyro.find("input_axis_misalignment_arcsec")) {
-    const std::vector<double> v =
-        reader.numbers(*node, gyro.path("input_axis_misalignment_arcsec"), kRateError, 2);
-    s.gyro_rate.input_axis_misalignment_O_arcsec = v[0];
-    s.gyro_rate.input_axis_misalignment_S_arcsec = v[1];
-  }
-  gyro.reject_unknown();
+  read_gyro_truth(reader, gyro, s.gyro, s.gyro_rate);
   Section noise(reader, noise_table, "gyro.noise");
-  read_numbers(noise, kNoiseKeys, s.noise);
+  read_gyro_noise(noise, s.noise);
 
   // Without rates of its own, the test runs at the configured centrifuge rate (see config_io.hpp).
   s.test.rates_rad_s = {s.centrifuge.rate_rad_s};
@@ -382,13 +373,24 @@ Scenario parse_scenario(std::string_view toml_text, const std::string& source_na
   const toml::table* reduce_table = top.table("reduce");
   Section reduce(reader, reduce_table, "reduce");
   read_reduce(reader, reduce, reduce_table, s.reduce);
-  read_sensor(reader, top, s);
-  refuse_other_sensor_keys(reader, root, s.sensor_kind);
-  // After [sensor]: the record's output is the sensor's, in its unit.
+  const toml::node* imu = read_sensor(reader, top, s);
+  // An IMU's channels (docs/imu.md) after [calibration], whose gyro_model its gyros take; a lone sensor's
+  // file holds no [[channel]].
+  const toml::node* channels = top.find("channel");
+  if (imu != nullptr) {
+    refuse_lone_sensor_keys(reader, root);
+    s.imu_channels = read_imu_channels(reader, *imu, channels, s.gyro_model);
+  } else {
+    refuse_other_sensor_keys(reader, root, s.sensor_kind);
+    if (channels != nullptr) refuse_channels_without_imu(reader, *channels, s.sensor_kind);
+  }
+  // After [sensor]: the record's output is the sensor's, in its unit (an IMU's, its channels').
   if (const toml::table* record_table = top.table("record")) {
     Section record(reader, record_table, "record");
+    if (imu != nullptr) refuse_lone_output_keys(reader, *record_table);
     s.record = read_record(reader, record, *record_table, s.sensor_kind, s.errors);
   }
+  if (imu != nullptr) check_imu_layout(reader, s, channels);
 
   top.reject_unknown();
   return s;

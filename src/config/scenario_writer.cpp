@@ -10,6 +10,7 @@
 #include "config_keys.hpp"
 #include "gyrocal/config/config_io.hpp"
 #include "gyrocal/core/error.hpp"
+#include "imu_channels.hpp"
 #include "sensor_sections.hpp"
 #include "toml_writer.hpp"
 
@@ -65,28 +66,9 @@ std::string series_text(const HarmonicSeries& series, const ErrorKey& key) {
   return text + " ]";
 }
 
-/// A TOML basic string: quotes, backslashes and control characters escaped.
-std::string toml_string(std::string_view text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char code[8];
-      std::snprintf(code, sizeof code, "\\u%04X", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += code;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-/// The keys of [record] with their values and meanings.
-void write_record_keys(TomlWriter& w, const RecordLayout& l) {
+/// The keys of [record] with their values and meanings; `output`: with the lone sensor's output keys (an
+/// IMU's channels name their own columns).
+void write_record_keys(TomlWriter& w, const RecordLayout& l, bool output) {
   w.key("delimiter", toml_string(std::string(1, l.delimiter)),
         "one character; \" \" means any run of spaces or tabs");
   w.key("comment", toml_string(l.comment), "lines starting with it are metadata (key = value) or comments");
@@ -103,7 +85,9 @@ void write_record_keys(TomlWriter& w, const RecordLayout& l) {
         "> 0 (>= 2): the column holds encoder counts, wrapped or not");
   w.key("counter_counts_per_revolution", std::to_string(l.counter_counts_per_revolution), "likewise");
   w.key("position_counts_per_revolution", std::to_string(l.position_counts_per_revolution), "likewise");
-  if (l.output_quantity == OutputQuantity::kSpecificForce) {
+  if (!output) {
+    // An IMU: each [[channel]] names its column, scale and unit.
+  } else if (l.output_quantity == OutputQuantity::kSpecificForce) {
     w.key("output_column", toml_string(l.output_column), "the accelerometer's output");
     w.key("output_scale_per_g", toml_number(l.output_scale_per_g),
           "output units per g (e.g. mV per g), non-zero, negative for an inverted output");
@@ -241,25 +225,16 @@ std::string scenario_to_toml(const Scenario& s) {
   w.section("centrifuge.errors", "Machine errors, names as in docs/physics.md section 3.");
   write_errors(w, s.errors, ErrorKeys::kMachine, s.sensor_kind);
 
-  if (s.sensor_kind == SensorKind::kAccelerometer) write_accelerometer(w, s);
-  if (s.sensor_kind == SensorKind::kGyro) {
+  if (s.is_imu()) {
+    write_imu_channels(w, s);
+  } else if (s.sensor_kind == SensorKind::kAccelerometer) {
+    write_accelerometer(w, s);
+  } else {
     w.section("gyro",
               "The gyro's drift coefficients (docs/physics.md section 6): the truth, for simulation.");
-    for (std::size_t i = 0; i < kNumGyroCoefficients; ++i) {
-      w.key(kCoefficientNames[i], toml_number(s.gyro.values[i]),
-            std::string(kCoefficientMeanings[i]) + ", " + std::string(kCoefficientUnits[i]));
-    }
-
-    w.key("scale_factor_error_ppm", toml_number(s.gyro_rate.scale_factor_error_ppm),
-          "e: sensed rate (1 + e)(wI + dO wO + dS wS) (physics.md section 15), ppm");
-    w.key("input_axis_misalignment_arcsec",
-          number_array(
-              {s.gyro_rate.input_axis_misalignment_O_arcsec, s.gyro_rate.input_axis_misalignment_S_arcsec},
-              1.0),
-          "[dO, dS]: the input axis tilted toward O and toward S, arcsec");
-
+    write_gyro_truth(w, s.gyro, s.gyro_rate);
     w.section("gyro.noise", "");
-    write_numbers(w, kNoiseKeys, s.noise, s.sensor_kind);
+    write_gyro_noise(w, s.noise);
   }
 
   const TestSpec& t = s.test;
@@ -370,7 +345,7 @@ std::string scenario_to_toml(const Scenario& s) {
       "defaults are gyrocal's own format.";
   if (s.record) {
     w.section("record", kRecordNote);
-    write_record_keys(w, *s.record);
+    write_record_keys(w, *s.record, !s.is_imu());
     write_errors(w, s.errors, ErrorKeys::kRecord, s.sensor_kind);
   } else if (s.errors.output_delay_s != 0.0) {
     // The acquisition's delay alone: the section (gyrocal's own format then needs no magic line).
@@ -385,7 +360,7 @@ std::string scenario_to_toml(const Scenario& s) {
       layout.output_column = std::string(Accelerometer::native_column);
       layout.output_unit_name = std::string(Accelerometer::output_unit);  // shown, commented out
     }
-    write_record_keys(keys, layout);
+    write_record_keys(keys, layout, !s.is_imu());
     write_errors(keys, s.errors, ErrorKeys::kRecord, s.sensor_kind);
     w.section_commented("record", kRecordNote, keys.text());
   }

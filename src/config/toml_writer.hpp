@@ -2,11 +2,32 @@
 // The writer of `init`'s commented configuration, private to src/config: lines "key = value  # comment".
 #include <algorithm>
 #include <cstddef>
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <string_view>
 
 namespace gyrocal::config_detail {
+
+/// A TOML basic string: quotes, backslashes and control characters escaped.
+inline std::string toml_string(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\u%04X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += code;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
 
 /// Lines "key = value  # comment", the comments aligned.
 class TomlWriter {
@@ -21,6 +42,10 @@ class TomlWriter {
       begin = end + 1;
     }
     out_ << "[" << name << "]\n";
+  }
+  /// An array-of-tables header ("[[name]]", one element) after a blank line, its note above it.
+  void array_section(std::string_view name, std::string_view note) {
+    section("[" + std::string(name) + "]", note);
   }
   /// A table header and its key lines (as another writer wrote them), all commented out.
   void section_commented(std::string_view name, std::string_view note, std::string_view keys) {

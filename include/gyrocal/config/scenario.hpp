@@ -110,6 +110,27 @@ Scenario default_scenario();
 /// set of 10 s holds), 6 and 12 rad/s, beta 0, 180, 90, 270 deg, eight gamma every 45 deg, 100 revolutions.
 Scenario default_accelerometer_scenario();
 
+/// The default IMU scenario (`gyrocal init --sensor imu`; docs/imu.md, "The default IMU"): the default
+/// accelerometer scenario's machine, site and test (rates 0, 6 and 12 rad/s, four beta, eight gamma) with
+/// [sensor] kind = "imu" and six channels gx gy gz ax ay az, the usual triad (gx: I = +x, O = +y; gy: I = +y,
+/// O = +z; gz: I = +z, O = +x; ax, ay, az alike with i and p), written as increments as high-grade units
+/// write them: the gyros' in rad (output_scale 4.84813681109536e-6 rad/s per deg/h), the accelerometers' in
+/// m/s (9.80665 m/s^2 per g), each with its own truth (a few deg/h of drift terms; the default
+/// accelerometer's coefficients varied per axis) and noise (0.003 deg/sqrt(h); 10 ug/sqrt(Hz)), and
+/// [calibration] estimate = ["radius_error", "radius_stretch"]: one mounting identifies every channel with
+/// the radius error and stretch (docs/physics.md section 17).
+Scenario default_imu_scenario();
+
+/// Throws Error "<command> does not serve an IMU configuration yet ([sensor] kind = "imu"); gyrocal
+/// calibrate and simulate do (docs/imu.md)." when `scenario` describes a whole IMU (is_imu()); nothing for a
+/// lone sensor. The one check at the entry of every command that does not serve an IMU yet (plan,
+/// sensitivity, montecarlo, noise, inputs, the Python module's functions).
+void refuse_imu(const Scenario& scenario, std::string_view command);
+
+/// The sentence refuse_imu throws, for `command` and what it was given (`input`: "configuration", or
+/// "result" for a report of an IMU's result).
+std::string imu_not_served(std::string_view command, std::string_view input = "configuration");
+
 /// What `gyrocal demo` runs: the default scenario, with a standard uncertainty of 10% of each configured
 /// machine error in [uncertainty] (docs/physics.md gives none; only the Monte Carlo budget uses them).
 Scenario demo_scenario();
@@ -118,5 +139,10 @@ Scenario demo_scenario();
 /// than nominal that stretches by 1e-7 m/(rad/s)^2, with the demo's [uncertainty] (10% of each machine error;
 /// the radius error known to 5 um, the stretch to 20%).
 Scenario demo_accelerometer_scenario();
+
+/// What `gyrocal demo --sensor imu` runs: the default IMU scenario on the arm of
+/// demo_accelerometer_scenario (20 um longer than nominal, stretching by 1e-7 m/(rad/s)^2) with the same
+/// [uncertainty] (10% of each machine error; the radius error known to 5 um, the stretch to 20%).
+Scenario demo_imu_scenario();
 
 }  // namespace gyrocal

@@ -85,6 +85,14 @@ inline constexpr double kOutputMagnitude = 1e50;
 /// two): each is reduced beside the others in the one pass over the record, so the bound is one of memory per
 /// row (reduce/reducer.hpp) and of the reader's value slots.
 inline constexpr std::size_t kMaxOutputColumns = 8;
+/// The most [[channel]] tables of an IMU configuration ([sensor] kind = "imu"; docs/imu.md):
+/// kMaxOutputColumns, since each channel is one output column of the one record (a six-channel IMU and two
+/// spare, such as a second triad's temperature-compensated outputs); more could not be read in the one pass.
+inline constexpr std::size_t kMaxImuChannels = kMaxOutputColumns;
+/// The longest name of an IMU channel ([[channel]] name), bytes: 32. It keys the channel in every result
+/// (JSON, the calibration history's tables) and heads its report section and table rows; "gx", "accel_z",
+/// "gyro_x_fog" are a few characters, so a longer text is a mistake (a sentence typed there).
+inline constexpr std::size_t kChannelNameBytes = 32;
 /// The largest magnitude of an encoder angle, deg (a layout's counts or radians after their conversion):
 /// 1e10 deg, 2.8e7 turns, which an unwrapped angle or an accumulating counter reaches after 200 days of
 /// spinning at 10 rad/s; a double still resolves 2e-6 deg (0.007 arcsec) there, below any encoder's count.
