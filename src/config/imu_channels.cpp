@@ -330,10 +330,7 @@ void refuse_lone_output_keys(const Reader& reader, const toml::table& record) {
 }
 
 void check_imu_layout(const Reader& reader, const Scenario& s, const toml::node* channels) {
-  std::optional<RecordLayout> layout = s.reading_layout();
-  // The form is the record reader's to accept (it reads an increment with its interval, docs/records.md):
-  // the layout is checked here for its columns, names and units.
-  for (OutputColumn& o : layout->outputs) o.form = OutputForm::kRate;
+  const std::optional<RecordLayout> layout = s.reading_layout();
   std::string error, key;
   if (layout->IsValid(&error, &key)) return;
   const toml::array& items = *channels->as_array();
