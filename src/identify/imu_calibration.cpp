@@ -67,6 +67,27 @@ void refuse_dead_channel(const Reduction& reduction, const SensorChannel& channe
       channel.name, channel.output.column, lo, channel.output.unit(), hi - lo));
 }
 
+/// What an IMU's calibration cannot do, refused before the record is read: the closed forms, a partial
+/// compensation, the mount's misalignment beside the channels' tilts.
+void refuse_imu_options(const CalibrationOptions& options) {
+  if (options.method != Method::kLeastSquares)
+    throw Error(
+        "an IMU is calibrated by least squares (--method least-squares): the closed forms are the lone "
+        "gyro's 16-position formulas.");
+  if (options.compensation != Compensation::kFull)
+    throw Error(
+        "an IMU is calibrated with --compensation full: its channels' inputs are the exact model's "
+        "(docs/imu.md).");
+  for (const MachineErrorParameter& p : options.estimate)
+    if (p.info().vector == &CentrifugeErrors::mount_misalignment_rad)
+      throw Error(fmt::format(
+          "--estimate {}: an IMU's mount misalignment cannot be estimated beside its channels' tilts: each "
+          "channel's input-axis tilts are measured against the mount, which the lab's fixture defines, so "
+          "the "
+          "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
+          p.error_name()));
+}
+
 /// Everything the joint solve keeps of one channel at one Gauss-Newton step.
 struct ChannelProblem {
   std::vector<PositionModelTerms> terms;  ///< its model terms at the current machine
@@ -315,23 +336,8 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
     throw Error(
         fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
                     channels.size(), reductions.size()));
-  if (options.method != Method::kLeastSquares)
-    throw Error(
-        "an IMU is calibrated by least squares (--method least-squares): the closed forms are the lone "
-        "gyro's 16-position formulas.");
-  if (options.compensation != Compensation::kFull)
-    throw Error(
-        "an IMU is calibrated with --compensation full: its channels' inputs are the exact model's "
-        "(docs/imu.md).");
+  refuse_imu_options(options);
   const std::vector<MachineErrorParameter>& ps = options.estimate;
-  for (const MachineErrorParameter& p : ps)
-    if (p.info().vector == &CentrifugeErrors::mount_misalignment_rad)
-      throw Error(fmt::format(
-          "--estimate {}: an IMU's mount misalignment cannot be estimated beside its channels' tilts: each "
-          "channel's input-axis tilts are measured against the mount, which the lab's fixture defines, so "
-          "the "
-          "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
-          p.error_name()));
   const std::size_t nch = channels.size();
   for (std::size_t c = 0; c < nch; ++c) {
     refuse_dead_channel(reductions[c], channels[c]);
@@ -580,6 +586,7 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
 ImuCalibrationResult calibrate_imu_record(RecordReader& reader, const std::vector<SensorChannel>& channels,
                                           const CentrifugeModel& model, const TestSpec& plan,
                                           const CalibrationOptions& options) {
+  refuse_imu_options(options);
   reader.require_angles();
   if (reader.output_count() != channels.size())
     throw Error(fmt::format("the record is read with {} output columns for an IMU of {} channels.",

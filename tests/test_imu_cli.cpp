@@ -1,0 +1,97 @@
+// A whole IMU through the command line, as a lab runs it (docs/imu.md): `init --sensor imu` writes the
+// default IMU, `simulate` writes its six columns as increments, `calibrate --json` states every channel, the
+// shared radius error and stretch and the triad's geometry. The test is shortened (fewer revolutions, shorter
+// holds, 50 Hz) so that it runs in seconds; the plan and the unit are the default's.
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/cli_run.hpp"
+
+namespace gyrocal {
+namespace {
+
+using test::fresh_test_folder;
+using test::run_cli;
+using test::slurp;
+
+/// A file's path in the test's folder, as the command line takes it.
+std::string at(const std::filesystem::path& dir, const std::string& name) {
+  return (dir / name).string();
+}
+
+TEST(ImuCli, InitSimulateCalibrateStatesEveryChannelAndTheRadius) {
+  const std::filesystem::path dir = fresh_test_folder("imu_cli");
+  ASSERT_EQ(run_cli("init --sensor imu " + at(dir, "imu.toml"), dir).status, 0);
+  std::string config = slurp(dir / "imu.toml");
+  config = std::regex_replace(config, std::regex("revolutions = 100"), "revolutions = 6");
+  config = std::regex_replace(config, std::regex("static_hold_s = 10\\.0"), "static_hold_s = 2.0");
+  config = std::regex_replace(config, std::regex("sample_rate_hz = 200\\.0"), "sample_rate_hz = 50.0");
+  std::ofstream(dir / "short.toml") << config;
+  const auto sim = run_cli(
+      "simulate --config " + at(dir, "short.toml") + " --out " + at(dir, "imu.csv") + " --seed 3", dir);
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const std::string header = [&] {
+    std::ifstream in(dir / "imu.csv");
+    std::string line;
+    while (std::getline(in, line) && line.starts_with("#")) {
+    }
+    return line;
+  }();
+  EXPECT_EQ(header, "time_s,main_angle_deg,counter_angle_deg,position_angle_deg,gx,gy,gz,ax,ay,az");
+  const auto cal = run_cli("calibrate " + at(dir, "imu.csv") + " --config " + at(dir, "short.toml") +
+                               " --json " + at(dir, "imu.json"),
+                           dir);
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir / "imu.json"));
+  EXPECT_EQ(j.at("sensor"), "imu");
+  const std::vector<std::string> names = {"gx", "gy", "gz", "ax", "ay", "az"};
+  ASSERT_EQ(j.at("channels").size(), 6u);
+  for (const std::string& n : names) {
+    const nlohmann::json& c = j.at("channels").at(n);
+    const bool gyro = n[0] == 'g';
+    EXPECT_EQ(c.at("sensor"), gyro ? "gyro" : "accelerometer") << n;
+    EXPECT_EQ(c.at("coefficients").size(), gyro ? 10u : 11u) << n;
+    for (const auto& [name, e] : c.at("coefficients").items())
+      EXPECT_TRUE(e.at("identifiable").get<bool>()) << n << " " << name;
+  }
+  // An accelerometer's K1 in its output units per g: m/s^2 per g, 9.80665 times a ratio near 1.
+  EXPECT_NEAR(j.at("channels").at("ax").at("coefficients").at("K1").at("value").get<double>(), 9.80665, 0.01);
+  EXPECT_EQ(j.at("channels").at("ax").at("coefficients").at("K1").at("unit"), "m/s^2/g");
+  // The default IMU's arm has no error: the estimates within 4.5 sigma of zero.
+  ASSERT_EQ(j.at("machine_errors").size(), 2u);
+  for (const nlohmann::json& e : j.at("machine_errors")) {
+    EXPECT_LE(std::abs(e.at("value").get<double>()), 4.5 * e.at("std").get<double>()) << e.at("error");
+  }
+  // Every position names its channel; the first row's increment has no interval and is counted.
+  EXPECT_EQ(j.at("positions").front().at("channel"), "gx");
+  EXPECT_EQ(j.at("positions").back().at("channel"), "az");
+  EXPECT_GE(j.at("data_quality").at("increments_dropped").get<int>(), 0);
+  EXPECT_EQ(j.at("input_axis_angles").size(), 3u);
+}
+
+TEST(ImuCli, MountMisalignmentBesideTheChannelsTiltsIsRefused) {
+  const std::filesystem::path dir = fresh_test_folder("imu_cli_mount");
+  ASSERT_EQ(run_cli("init --sensor imu " + at(dir, "imu.toml"), dir).status, 0);
+  std::string config = slurp(dir / "imu.toml");
+  config = std::regex_replace(config, std::regex("revolutions = 100"), "revolutions = 3");
+  config = std::regex_replace(config, std::regex("static_hold_s = 10\\.0"), "static_hold_s = 1.0");
+  config = std::regex_replace(config, std::regex("sample_rate_hz = 200\\.0"), "sample_rate_hz = 50.0");
+  std::ofstream(dir / "short.toml") << config;
+  ASSERT_EQ(
+      run_cli("simulate --config " + at(dir, "short.toml") + " --out " + at(dir, "imu.csv"), dir).status, 0);
+  const auto cal = run_cli("calibrate " + at(dir, "imu.csv") + " --config " + at(dir, "short.toml") +
+                               " --estimate mount_misalignment --json " + at(dir, "r.json"),
+                           dir);
+  EXPECT_EQ(cal.status, 1);
+  EXPECT_NE(cal.err.find("mount_misalignment"), std::string::npos) << cal.err;
+  EXPECT_NE(cal.err.find("zero by definition"), std::string::npos) << cal.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "r.json"));
+}
+
+}  // namespace
+}  // namespace gyrocal
