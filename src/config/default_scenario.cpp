@@ -1,5 +1,7 @@
 #include "gyrocal/config/scenario.hpp"
 
+#include "imu_channels.hpp"
+
 #include <array>
 #include <cmath>
 #include <string>
@@ -70,12 +72,8 @@ SensorChannel imu_channel(std::string name, Sensor sensor, const Eigen::Vector3d
   const bool gyro = std::holds_alternative<Gyro>(sensor);
   c.name = std::move(name);
   c.sensor = std::move(sensor);
-  c.axes.col(0) = input;
-  c.axes.col(1) = second;
-  c.axes.col(2) = input.cross(second);
+  config_detail::place_on_axes(c, gyro ? SensorKind::kGyro : SensorKind::kAccelerometer, input, second);
   OutputColumn& o = c.output;
-  o.column = c.name;
-  o.quantity = gyro ? OutputQuantity::kRate : OutputQuantity::kSpecificForce;
   o.form = OutputForm::kIncrement;
   // An angle increment in rad divided by its interval is rad/s: 1 deg/h = pi / 180 / 3600 rad/s. A velocity
   // increment in m/s divided by its interval is m/s^2: 1 g = 9.80665 m/s^2 (the standard gravity, the unit

@@ -139,15 +139,8 @@ SensorChannel read_channel(const Reader& reader, const toml::table& table, std::
                                     (gyro ? "the gyro's O" : "the accelerometer's p") +
                                     ") must be perpendicular to the input axis");
   }
-  c.axes.col(0) = input;
-  c.axes.col(1) = second;
-  c.axes.col(2) = input.cross(second);
-
+  place_on_axes(c, *kind, input, second);
   OutputColumn& o = c.output;
-  o.column = c.name;
-  o.quantity = gyro ? OutputQuantity::kRate : OutputQuantity::kSpecificForce;
-  o.form = OutputForm::kRate;
-  o.scale = 1.0;
   if (const toml::node* node = section.find("output")) {
     const std::string text = reader.string(*node, section.path("output"));
     if (text != "rate" && text != "increment")
@@ -231,6 +224,16 @@ std::optional<std::string> body_axis_name(const Eigen::Vector3d& axis) {
   for (const auto& [axis_name, v] : kBodyAxes)
     if (axis == Eigen::Vector3d(v[0], v[1], v[2])) return std::string(axis_name);
   return std::nullopt;
+}
+
+void place_on_axes(SensorChannel& c, SensorKind kind, const Eigen::Vector3d& input,
+                   const Eigen::Vector3d& second) {
+  c.axes.col(0) = input;
+  c.axes.col(1) = second;
+  c.axes.col(2) = input.cross(second);
+  c.output = OutputColumn{};
+  c.output.column = c.name;
+  c.output.quantity = kind == SensorKind::kGyro ? OutputQuantity::kRate : OutputQuantity::kSpecificForce;
 }
 
 std::vector<SensorChannel> read_imu_channels(const Reader& reader, const toml::node& kind,

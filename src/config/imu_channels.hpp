@@ -21,6 +21,13 @@ std::optional<Eigen::Vector3d> parse_body_axis(std::string_view name);
 /// The name of a unit vector along a body axis ("+x", ...); nullopt for any other vector.
 std::optional<std::string> body_axis_name(const Eigen::Vector3d& axis);
 
+/// Puts channel `c` (named, of a sensor of `kind`) on the body axes `input` and `second` (unit vectors,
+/// perpendicular; the third axis is input x second) with its output a rate in the sensor's unit in the
+/// column of its name: what a [[channel]] table states before its output keys, and where the default IMU's
+/// channels start from.
+void place_on_axes(SensorChannel& c, SensorKind kind, const Eigen::Vector3d& input,
+                   const Eigen::Vector3d& second);
+
 /// The [[channel]] tables of an IMU configuration as channels, in the file's order. `kind`: the node of
 /// [sensor] kind = "imu"; `channels`: the node of the key `channel` (nullptr when absent); `gyro_model`: the
 /// model of every gyro channel ([calibration] gyro_model). A channel's truth and noise default to the lone

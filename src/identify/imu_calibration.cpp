@@ -23,6 +23,7 @@
 
 #include "closed_form_identify.hpp"
 #include "position_covariance.hpp"
+#include "self_calibration.hpp"
 #include "weighted_positions.hpp"
 
 namespace gyrocal {
@@ -30,14 +31,7 @@ namespace {
 
 using identify_detail::weigh_positions;
 using identify_detail::WeightedPositions;
-
-/// `model` with the parameters `ps` set to `values_si`.
-CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
-                            const std::vector<double>& values_si) {
-  CentrifugeErrors e = model.errors();
-  for (std::size_t i = 0; i < ps.size(); ++i) ps[i].set(e, values_si[i]);
-  return CentrifugeModel(model.site(), model.geometry(), e);
-}
+using identify_detail::with_errors;
 
 std::size_t unknowns_of(const Sensor& s) {
   return std::visit([](const auto& x) { return x.num_unknowns(); }, s);

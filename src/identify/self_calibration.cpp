@@ -54,14 +54,6 @@ Eigen::MatrixXd coefficient_error_covariance(const Sensor& sensor, const std::ve
   return jacobian * cov * jacobian.transpose();
 }
 
-/// `model` with the parameters `ps` set to `values_si`.
-CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
-                            const std::vector<double>& values_si) {
-  CentrifugeErrors e = model.errors();
-  for (std::size_t i = 0; i < ps.size(); ++i) ps[i].set(e, values_si[i]);
-  return CentrifugeModel(model.site(), model.geometry(), e);
-}
-
 /// The columns of the parameters `which` (indices into ps): the derivative of each reduced model output,
 /// known + sum_j c_j x_j (the gyro's omega_I + its regressors), with respect to the error, in the output's
 /// unit per the error's unit, by a central difference
@@ -128,6 +120,13 @@ std::string error_advice(const MachineErrorParameter& p, const Reduction& reduct
 }
 
 }  // namespace
+
+CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
+                            const std::vector<double>& values_si) {
+  CentrifugeErrors e = model.errors();
+  for (std::size_t i = 0; i < ps.size(); ++i) ps[i].set(e, values_si[i]);
+  return CentrifugeModel(model.site(), model.geometry(), e);
+}
 
 CalibrationResult self_calibrate(const Reduction& reduction,
                                  const std::vector<PositionModelTerms>& model_terms,

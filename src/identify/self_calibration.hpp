@@ -8,6 +8,11 @@
 
 namespace gyrocal::identify_detail {
 
+/// `model` with the estimated errors `ps` set to `values_si` (their SI values, in ps' order): the machine a
+/// Gauss-Newton step evaluates (a lone sensor's self-calibration, an IMU's joint solve).
+CentrifugeModel with_errors(const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
+                            const std::vector<double>& values_si);
+
 /// `base` (a result holding the record's data quality and g-level) with the coefficients and the estimated
 /// machine errors of options.estimate; the errors the plan does not identify are reported with their reason
 /// and kept at their configured value.
