@@ -92,7 +92,7 @@ TEST(Increments, TheReaderDividesAnIncrementByItsIntervalAndLeavesTheFirstRowWit
 }
 
 /// An accelerometer written as velocity increments (m/s per sample) on an arm spinning at 12 rad/s, sampled
-/// at 200 Hz, with machine errors: the increment's lag matters there (MODEL.md section 17).
+/// at 200 Hz, with machine errors: the increment's lag matters there (docs/records.md, "Increments").
 Scenario increment_scenario(OutputForm form) {
   Scenario s = default_accelerometer_scenario();
   s.test.sample_rate_hz = 200.0;
@@ -223,7 +223,7 @@ TEST_F(IncrementRecord, TheReductionOfDataAndOfTheModelAveragedOverTheIntervalsA
   EXPECT_LT(worst_misfit(s, r, channel), 1e-10 * first_harmonic);
   EXPECT_LT(worst_misfit(s, r, channel, ModelTermsRoute::kEverySample), 1e-10 * first_harmonic);
   // The same data taken for rates at the stamps misses by the half interval's lag of the first harmonic
-  // (MODEL.md section 17: omega dt / 2 = 0.03 rad, 0.44 g of a 14.7 g first harmonic).
+  // (docs/records.md, "Increments": omega dt / 2 = 0.03 rad, 0.44 g of a 14.7 g first harmonic).
   SensorChannel as_rates = channel;
   as_rates.output.form = OutputForm::kRate;
   const double lag = first_harmonic * 12.0 / s.test.sample_rate_hz / 2.0;

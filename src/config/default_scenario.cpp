@@ -123,8 +123,8 @@ Scenario default_imu_scenario() {
   // docs/imu.md, "The default IMU": the default accelerometer's test, whose static set and two speeds
   // identify every accelerometer coefficient, serves the gyros too (their g-sensitive drift needs the same
   // reversals of gravity and the centripetal force); one mounting identifies all 63 coefficients with the
-  // radius error and stretch (docs/physics.md section 17). Each channel's truth differs, so that a channel
-  // read from another's column is seen.
+  // radius error and stretch (docs/imu.md, "What one mounting identifies"). Each channel's truth differs, so
+  // that a channel read from another's column is seen.
   Scenario s = default_accelerometer_scenario();
   s.sensor_kind = SensorKind::kGyro;  // unused by an IMU: the lone sensor's default
   s.accelerometer = Accelerometer{};
@@ -170,7 +170,7 @@ Scenario demo_accelerometer_scenario() {
 Scenario demo_imu_scenario() {
   Scenario s = default_imu_scenario();
   // The arm of demo_accelerometer_scenario: 20 um longer than nominal, stretching by 1e-7 m/(rad/s)^2,
-  // known to 5 um and 20% (the IMU's x and z accelerometers measure both, docs/physics.md section 17).
+  // known to 5 um and 20% (the IMU's x and z accelerometers measure both, docs/imu.md).
   const Scenario arm = demo_accelerometer_scenario();
   s.errors = arm.errors;
   s.uncertainty = arm.uncertainty;

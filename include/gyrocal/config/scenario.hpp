@@ -118,7 +118,7 @@ Scenario default_accelerometer_scenario();
 /// m/s (9.80665 m/s^2 per g), each with its own truth (a few deg/h of drift terms; the default
 /// accelerometer's coefficients varied per axis) and noise (0.003 deg/sqrt(h); 10 ug/sqrt(Hz)), and
 /// [calibration] estimate = ["radius_error", "radius_stretch"]: one mounting identifies every channel with
-/// the radius error and stretch (docs/physics.md section 17).
+/// the radius error and stretch (docs/imu.md, "What one mounting identifies").
 Scenario default_imu_scenario();
 
 /// Throws Error "<command> does not serve an IMU configuration yet ([sensor] kind = "imu"); gyrocal

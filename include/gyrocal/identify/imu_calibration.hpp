@@ -4,7 +4,8 @@
 // its model terms are its sensor's design rows on its own axes reduced by the same operator, and one weighted
 // least squares holds every channel's products beside the shared machine errors (the radius error, the
 // stretch, ...): the x and z accelerometers fix the radius, and through it the y accelerometer's scale, which
-// on its own is confounded with it (docs/physics.md section 17). Each channel is judged by its own misfit.
+// on its own is confounded with it (docs/imu.md, "What one mounting identifies"). Each channel is judged by
+// its own misfit.
 #include <span>
 #include <string>
 #include <vector>

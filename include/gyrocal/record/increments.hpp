@@ -1,5 +1,5 @@
 #pragma once
-// Increments (docs/records.md, "Increments"; MODEL.md section 17): an output column written as increments
+// Increments (docs/records.md, "Increments"): an output column written as increments
 // (OutputForm::kIncrement: an IMU's angle and velocity increments) holds, per row, the integral of the
 // sensor's output over the interval that ends at the row's stamp. Divided by that interval it is the output's
 // mean over the interval, not its value at the stamp. What the reader, the simulator and the model's side of
@@ -38,7 +38,7 @@ int interval_nodes(double max_phase_rad);
 
 /// The mean over [t - dt, t] of e^{j f s} divided by its value at the stamp t, for a harmonic of angular
 /// frequency f (rad/s): sinc(f dt / 2) e^{-j f dt / 2}, sinc(x) = sin(x) / x (exact for a constant f). The
-/// gain 1 - (f dt)^2 / 24 and the lag of half an interval of MODEL.md section 17.
+/// gain 1 - (f dt)^2 / 24 and the lag of half an interval of docs/records.md, "Increments".
 std::complex<double> interval_mean_factor(double f_rad_s, double dt_s);
 
 }  // namespace gyrocal
