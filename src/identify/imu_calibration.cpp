@@ -440,7 +440,6 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
     if (w.rfind("chi2 = ", 0) != 0) r.warnings.push_back("least squares: " + w);
 
   // Each channel: its residuals and misfit test, then its coefficients.
-  Eigen::Index at = 0;
   double worst_scale = 1.0;
   std::vector<FittedTilts> tilts;
   for (std::size_t c = 0; c < nch; ++c) {
@@ -543,7 +542,6 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
               out.misfit.scale * (k1 ? std::abs(output_scale) : 1.0);
     }
     r.channels.push_back(std::move(out));
-    at += mc;
   }
   // The triad's geometry, from the channels whose two tilts are both fitted.
   std::erase_if(tilts,
