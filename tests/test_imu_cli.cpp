@@ -24,14 +24,22 @@ std::string at(const std::filesystem::path& dir, const std::string& name) {
   return (dir / name).string();
 }
 
-TEST(ImuCli, InitSimulateCalibrateStatesEveryChannelAndTheRadius) {
-  const std::filesystem::path dir = fresh_test_folder("imu_cli");
+/// `init --sensor imu` into DIR/imu.toml, and DIR/short.toml: the same with `revolutions` revolutions, static
+/// holds of `hold_s` s and 50 Hz (the plan and the unit unchanged).
+void write_short_default_imu(const std::filesystem::path& dir, int revolutions, double hold_s) {
   ASSERT_EQ(run_cli("init --sensor imu " + at(dir, "imu.toml"), dir).status, 0);
   std::string config = slurp(dir / "imu.toml");
-  config = std::regex_replace(config, std::regex("revolutions = 100"), "revolutions = 6");
-  config = std::regex_replace(config, std::regex("static_hold_s = 10\\.0"), "static_hold_s = 2.0");
+  config = std::regex_replace(config, std::regex("revolutions = 100"),
+                              "revolutions = " + std::to_string(revolutions));
+  config = std::regex_replace(config, std::regex("static_hold_s = 10\\.0"),
+                              "static_hold_s = " + std::to_string(hold_s));
   config = std::regex_replace(config, std::regex("sample_rate_hz = 200\\.0"), "sample_rate_hz = 50.0");
   std::ofstream(dir / "short.toml") << config;
+}
+
+TEST(ImuCli, InitSimulateCalibrateStatesEveryChannelAndTheRadius) {
+  const std::filesystem::path dir = fresh_test_folder("imu_cli");
+  write_short_default_imu(dir, 6, 2.0);
   const auto sim = run_cli(
       "simulate --config " + at(dir, "short.toml") + " --out " + at(dir, "imu.csv") + " --seed 3", dir);
   ASSERT_EQ(sim.status, 0) << sim.err;
@@ -76,12 +84,7 @@ TEST(ImuCli, InitSimulateCalibrateStatesEveryChannelAndTheRadius) {
 
 TEST(ImuCli, MountMisalignmentBesideTheChannelsTiltsIsRefused) {
   const std::filesystem::path dir = fresh_test_folder("imu_cli_mount");
-  ASSERT_EQ(run_cli("init --sensor imu " + at(dir, "imu.toml"), dir).status, 0);
-  std::string config = slurp(dir / "imu.toml");
-  config = std::regex_replace(config, std::regex("revolutions = 100"), "revolutions = 3");
-  config = std::regex_replace(config, std::regex("static_hold_s = 10\\.0"), "static_hold_s = 1.0");
-  config = std::regex_replace(config, std::regex("sample_rate_hz = 200\\.0"), "sample_rate_hz = 50.0");
-  std::ofstream(dir / "short.toml") << config;
+  write_short_default_imu(dir, 3, 1.0);
   ASSERT_EQ(
       run_cli("simulate --config " + at(dir, "short.toml") + " --out " + at(dir, "imu.csv"), dir).status, 0);
   const auto cal = run_cli("calibrate " + at(dir, "imu.csv") + " --config " + at(dir, "short.toml") +
