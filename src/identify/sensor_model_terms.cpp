@@ -44,11 +44,17 @@ std::vector<PositionModelTerms> reduce_sensor_model_terms(
     std::vector<DwellModelTermsRoute>* routes) {
   const DesignRow probe = sensor_design_row(channel.sensor, exact_inputs(model, JointState{}));
   const int columns = 1 + static_cast<int>(probe.size);
-  // The design row's known part and regressors are in the output's unit and its powers (g, g^2, g^3): no
-  // column is a difference of the joints' rates.
+  // An accelerometer's design row is in the output's unit and its powers (g, g^2, g^3): no column is a
+  // difference of the joints' rates. A gyro's known part is its input rate omega_I in deg/h: a difference of
+  // the arm's and the counter platform's rates (2.5e6 deg/h each at 12 rad/s), whose rounding the Fourier
+  // route's check measures against the rates (kRateRounding), as the gyro's own columns are
+  // (reduce_model_terms); measured against its own small size it failed the check at every spinning dwell
+  // and took every sample. Its regressors (g and its products; a drift+rate gyro's rate terms scaled by 1e-6
+  // and 1 arcsec) stay regressors.
   DwellModelRoute design;
   design.columns = columns;
   design.rate_columns.assign(static_cast<std::size_t>(columns), false);
+  if (kind_of(channel.sensor) == SensorKind::kGyro) design.rate_columns[0] = true;
   // Where the route's choices differ by sensor, a sensor keeps those it had before the route was one: each
   // other choice moves an accelerometer's plans' or calibrations' numbers (the two closed forms agree to
   // ~1e-11, not bit for bit; the two strides take other samples). Planned dwells by the Fourier closed forms
