@@ -97,34 +97,36 @@ double model_output(const DesignRow& row, const Eigen::VectorXd& u) {
 }
 
 /// How one channel's reduced design rows move with each estimated error: per error, per position, the
-/// central difference of the known part and of each regressor, with the error's typical magnitude as the step
-/// (as self_calibration.cpp), per unit of the error. Taken once, at the configured machine: the rows are
-/// smooth in the errors (their curvature is of relative order 1e-5 per typical magnitude), so the columns
-/// they give at any products are the Jacobian Gauss-Newton needs, while each step's residuals are those of
-/// the current machine.
+/// forward difference of the known part and of each regressor from `at` (the rows at the configured
+/// machine, already reduced for the first step), with the error's typical magnitude as the step, per unit of
+/// the error. Taken once, at the configured machine: the rows are smooth in the errors (their curvature is of
+/// relative order 1e-5 per typical magnitude), so the columns they give at any products are the Jacobian
+/// Gauss-Newton needs, to ~1e-5 of themselves (a forward difference's error is half the curvature times the
+/// step), while each step's residuals are those of the current machine: the solution is where those
+/// residuals are least, whatever the Jacobian's last digits; its covariance moves by ~1e-5 of itself. One
+/// reduction of the model terms per error (a central difference took two: the model terms are the
+/// calibration's cost after the reading, issue 27's speed).
 struct RowDerivatives {
   std::vector<std::vector<DesignRow>> per_error;  ///< [error][position]
 };
 
 RowDerivatives row_derivatives(const Reduction& reduction, const SensorChannel& channel,
                                const CentrifugeModel& model, const std::vector<MachineErrorParameter>& ps,
-                               const std::vector<double>& values_si, const CalibrationOptions& options) {
+                               const std::vector<double>& values_si,
+                               const std::vector<PositionModelTerms>& at, const CalibrationOptions& options) {
   RowDerivatives out;
   for (std::size_t a = 0; a < ps.size(); ++a) {
     const MachineErrorField& f = ps[a].info();
     const double h = f.typical_si;
-    std::vector<double> plus = values_si, minus = values_si;
+    std::vector<double> plus = values_si;
     plus[a] += h;
-    minus[a] -= h;
     const auto up = reduce_sensor_model_terms(reduction, with_errors(model, ps, plus), options.reduce,
                                               channel, options.max_model_samples_per_dwell);
-    const auto down = reduce_sensor_model_terms(reduction, with_errors(model, ps, minus), options.reduce,
-                                                channel, options.max_model_samples_per_dwell);
     std::vector<DesignRow> rows(up.size());
-    const double per_unit = f.unit_to_si / (2.0 * h);
+    const double per_unit = f.unit_to_si / h;
     for (std::size_t i = 0; i < up.size(); ++i) {
       const DesignRow& ru = up[i].sensor_exact;
-      const DesignRow& rd = down[i].sensor_exact;
+      const DesignRow& rd = at[i].sensor_exact;
       rows[i].size = ru.size;
       rows[i].known = (ru.known - rd.known) * per_unit;
       for (std::size_t j = 0; j < ru.size; ++j)
@@ -362,6 +364,7 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   std::vector<ChannelProblem> problems(nch);
   std::vector<RowDerivatives> derivatives;  // per channel, at the configured machine
+  std::vector<double> reduced_at;           // the errors' values the channels' model terms were reduced at
   JointSolution js;
   ImuCalibrationResult r;
   const auto channel_names = [&](std::size_t c, bool with_errors) {
@@ -374,14 +377,19 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
   for (int iteration = 0;; ++iteration) {
     const bool plain = iteration == 0 && k > 0;  // the start, without the errors' columns
     const CentrifugeModel current = with_errors(model, ps, values);
+    // The plain start leaves the machine as configured: its model terms serve the first step as they are.
+    const bool machine_moved = iteration == 0 || values != reduced_at;
+    reduced_at = values;
     for (std::size_t c = 0; c < nch; ++c) {
       ChannelProblem& p = problems[c];
-      p.terms = reduce_sensor_model_terms(reductions[c], current, options.reduce, channels[c],
-                                          options.max_model_samples_per_dwell);
+      if (machine_moved)
+        p.terms = reduce_sensor_model_terms(reductions[c], current, options.reduce, channels[c],
+                                            options.max_model_samples_per_dwell);
       const auto nc = static_cast<Eigen::Index>(unknowns_of(channels[c].sensor));
       const auto m = static_cast<Eigen::Index>(reductions[c].positions.size());
       if (!plain && k > 0 && derivatives.size() < nch)
-        derivatives.push_back(row_derivatives(reductions[c], channels[c], current, ps, values, options));
+        derivatives.push_back(
+            row_derivatives(reductions[c], channels[c], current, ps, values, p.terms, options));
       p.error_columns = plain || k == 0 ? Eigen::MatrixXd(m, 0)
                                         : error_columns(derivatives[c], x.segment(offsets[c], nc), m);
       p.weighted = weigh_channel(reductions[c], channels[c], p.terms, p.error_columns,
