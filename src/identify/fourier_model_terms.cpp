@@ -262,11 +262,17 @@ bool reduce_dwell_by_fourier(const CentrifugeModel& model, const Dwell& d, const
   if (d.is_static && d.main.rate_rad_s == 0.0 && d.counter.rate_rad_s == 0.0) {
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(1, columns);
     std::vector<double> v(static_cast<std::size_t>(columns));
+    // The series is its constant term alone: no tail; its size the largest value of a run.
+    route.outer_tail.assign(static_cast<std::size_t>(columns), 0.0);
+    route.scale.assign(static_cast<std::size_t>(columns), 0.0);
     std::size_t total = 0;
     for (const Run& r : runs) {
       evaluate(r.main_rad, r.counter_rad, v.data());
-      for (int c = 0; c < columns; ++c)
-        rhs(0, c) += static_cast<double>(r.count) * v[static_cast<std::size_t>(c)];
+      for (int c = 0; c < columns; ++c) {
+        const auto k = static_cast<std::size_t>(c);
+        rhs(0, c) += static_cast<double>(r.count) * v[k];
+        route.scale[k] = std::max(route.scale[k], std::abs(v[k]));
+      }
       total += r.count;
     }
     const Run& last = runs.back();
