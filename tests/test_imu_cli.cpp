@@ -96,5 +96,64 @@ TEST(ImuCli, MountMisalignmentBesideTheChannelsTiltsIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir / "r.json"));
 }
 
+// `plan` of an IMU predicts, from each channel's configured white noise through the reduction operator, the
+// uncertainties calibrate then states from a simulated record's own scatter (an independent route: the
+// reduced values' standard errors measured, not predicted). The stated ones carry the scatter's own
+// imprecision: a 2 s hold at 50 Hz measures its level from 100 samples (7 %, 1/sqrt(2 x 99)), and a
+// coefficient that rests on two or three holds moves by up to ~25 % between seeds (seeds 5-7: 0.75-1.25).
+// So per channel the geometric mean of predicted / stated over its coefficients within 10 %, each one within
+// [0.6, 1.6] (a wrong noise unit or a missing factor would move them all by its size), the shared errors
+// (every channel's dwells) within 10 %, and the plan's estimates the configured truth.
+TEST(ImuCli, PlanPredictsTheUncertaintiesCalibrateStates) {
+  const std::filesystem::path dir = fresh_test_folder("imu_cli_plan");
+  write_short_default_imu(dir, 6, 2.0);
+  ASSERT_EQ(
+      run_cli("simulate --config " + at(dir, "short.toml") + " --out " + at(dir, "imu.csv") + " --seed 5",
+              dir)
+          .status,
+      0);
+  const auto cal = run_cli("calibrate " + at(dir, "imu.csv") + " --config " + at(dir, "short.toml") +
+                               " --json " + at(dir, "cal.json"),
+                           dir);
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const auto plan =
+      run_cli("plan --config " + at(dir, "short.toml") + " --json " + at(dir, "plan.json"), dir);
+  ASSERT_EQ(plan.status, 0) << plan.err;
+  EXPECT_NE(plan.out.find("channel ay (accelerometer)"), std::string::npos) << plan.out;
+  const nlohmann::json c = nlohmann::json::parse(slurp(dir / "cal.json"));
+  const nlohmann::json p = nlohmann::json::parse(slurp(dir / "plan.json"));
+  EXPECT_EQ(p.at("sensor"), "imu");
+  ASSERT_EQ(p.at("channels").size(), 6u);
+  int compared = 0;
+  for (const auto& [name, channel] : p.at("channels").items()) {
+    double log_sum = 0.0;
+    int count = 0;
+    for (const auto& [coefficient, e] : channel.at("coefficients").items()) {
+      ASSERT_TRUE(e.at("identifiable").get<bool>()) << name << " " << coefficient;
+      const double predicted = e.at("std").get<double>();
+      const double stated =
+          c.at("channels").at(name).at("coefficients").at(coefficient).at("std").get<double>();
+      EXPECT_GT(predicted, 0.6 * stated) << name << " " << coefficient;
+      EXPECT_LT(predicted, 1.6 * stated) << name << " " << coefficient;
+      log_sum += std::log(predicted / stated);
+      ++count;
+    }
+    const double mean_ratio = std::exp(log_sum / count);
+    EXPECT_GT(mean_ratio, 0.9) << name;
+    EXPECT_LT(mean_ratio, 1.1) << name;
+    compared += count;
+  }
+  EXPECT_EQ(compared, 3 * 10 + 3 * 11);
+  ASSERT_EQ(p.at("machine_errors").size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const nlohmann::json& e = p.at("machine_errors")[k];
+    const double stated = c.at("machine_errors")[k].at("std").get<double>();
+    EXPECT_GT(e.at("std").get<double>(), 0.9 * stated) << e.at("error");
+    EXPECT_LT(e.at("std").get<double>(), 1.1 * stated) << e.at("error");
+    // The plan's outputs are the truth's: the estimate is the configured (zero) error, to rounding.
+    EXPECT_LE(std::abs(e.at("value").get<double>()), 1e-6 * e.at("std").get<double>()) << e.at("error");
+  }
+}
+
 }  // namespace
 }  // namespace gyrocal

@@ -544,16 +544,17 @@ TEST(ImuConfig, ALoneSensorsSectionsAreRefusedInAnImu) {
 
 TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   const std::string expected_tail =
-      " does not serve an IMU configuration yet ([sensor] kind = \"imu\"); gyrocal calibrate and simulate do "
-      "(docs/imu.md).";
+      " does not serve an IMU configuration yet ([sensor] kind = \"imu\"); docs/imu.md, \"What serves an "
+      "IMU\", "
+      "lists the commands that do.";
   try {
-    refuse_imu(default_imu_scenario(), "plan");
+    refuse_imu(default_imu_scenario(), "sensitivity");
     FAIL() << "an IMU was served";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "plan" + expected_tail);
+    EXPECT_EQ(std::string(e.what()), "sensitivity" + expected_tail);
   }
-  EXPECT_NO_THROW(refuse_imu(default_scenario(), "plan"));
-  EXPECT_NO_THROW(refuse_imu(default_accelerometer_scenario(), "plan"));
+  EXPECT_NO_THROW(refuse_imu(default_scenario(), "sensitivity"));
+  EXPECT_NO_THROW(refuse_imu(default_accelerometer_scenario(), "sensitivity"));
 
   const std::filesystem::path dir = fresh_test_folder("imu-unserved");
   const std::string config = (dir / "imu.toml").string();
@@ -566,7 +567,6 @@ TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   }
   const std::string json = (dir / "out.json").string();
   const std::vector<std::pair<std::string, std::string>> commands = {
-      {"plan", "plan --config " + config + " --json " + json},
       {"sensitivity", "sensitivity --config " + config + " --json " + json},
       {"montecarlo", "montecarlo --trials 2 --config " + config + " --json " + json},
       {"noise", "noise " + record + " --config " + config + " --json " + json},

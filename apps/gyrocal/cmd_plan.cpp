@@ -3,11 +3,13 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/analysis/predict_imu.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
 #include "gyrocal/result/calibration_json.hpp"
+#include "gyrocal/result/imu_calibration_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 #include "tables.hpp"
 
@@ -43,7 +45,7 @@ bool has_spinning_dwell(const TestSpec& t) {
 /// (only the static holds follow it); the window reduction and the gyro's read each dwell at gamma_deg.
 std::string reduction_text(const Scenario& s, const ReduceOptions& reduce, std::size_t reduced) {
   const bool harmonic = reduce.method == ReduceOptions::Method::kHarmonicFit;
-  const TestSpec plan = reduction_plan(s.test, s.sensor_kind, reduce);
+  const TestSpec plan = reduction_plan(s.test, reduction_kind(s.channels()), reduce);
   std::string text = fmt::format(
       "Reduced by the {} reduction, as calibrate reduces the record (--reduction, [calibration] reduction): ",
       harmonic ? "harmonic" : "window");
@@ -73,7 +75,7 @@ std::string g_levels_text(const Scenario& s) {
 /// The reduction of reduction_text as JSON: method, reduced positions, a spinning dwell's gamma (deg).
 nlohmann::ordered_json reduction_to_json(const Scenario& s, const ReduceOptions& reduce,
                                          std::size_t reduced) {
-  const TestSpec plan = reduction_plan(s.test, s.sensor_kind, reduce);
+  const TestSpec plan = reduction_plan(s.test, reduction_kind(s.channels()), reduce);
   nlohmann::ordered_json j;
   j["method"] = reduce.method == ReduceOptions::Method::kHarmonicFit ? "harmonic" : "window";
   j["positions"] = reduced;
@@ -81,6 +83,40 @@ nlohmann::ordered_json reduction_to_json(const Scenario& s, const ReduceOptions&
   for (const double g : spinning_gammas(plan)) gammas.push_back(g * kRadToDeg);
   j["spinning_gamma_deg"] = gammas;
   return j;
+}
+
+/// The test's duration and the record simulate writes of it, one line.
+std::string record_size_text(const Scenario& s) {
+  const RecordSize size = estimate_record_size(s);
+  return fmt::format("The test lasts {:.1f} s ({:.2f} h); simulate writes {} rows, about {}.\n",
+                     size.duration_s, size.duration_s / 3600.0, size.rows, size_text(size.bytes));
+}
+
+/// `plan` of an IMU (docs/imu.md, "Planning an IMU"): every channel's predicted uncertainties from the joint
+/// solve, as JSON (the calibration result's shape) and as calibrate's table.
+void plan_imu(const Scenario& s, const CalibrationOptions& options, const std::string& config,
+              const std::string& json, bool force) {
+  const ImuCalibrationResult r = predict_imu_calibration(s, options);
+  const std::size_t reduced = r.channels.empty() ? 0 : r.channels.front().positions.size();
+  if (!json.empty()) {
+    nlohmann::ordered_json j = imu_calibration_to_json(r);
+    j["config"] = config.empty() ? nlohmann::json(nullptr) : nlohmann::json(config);
+    j["plan"] = plan_to_json(s.test);
+    j["reduction"] = reduction_to_json(s, options.reduce, reduced);
+    write_result(json, std::move(j), "plan", force);
+  }
+  if (json == "-") return;
+  print_out(
+      "The configured test: {} positions ({}), {} revolutions per dwell at {} Hz; an IMU of {} channels.\n",
+      test_positions(s.test).size(), position_factors(s.test), s.test.revolutions, s.test.sample_rate_hz,
+      s.channels().size());
+  print_out("{}\n", reduction_text(s, options.reduce, reduced));
+  print_out("{}\n", g_levels_text(s));
+  print_out("{}", record_size_text(s));
+  print_out(
+      "Predicted from each channel's configured noise ([channel.noise]); estimates are the configured "
+      "truth.\n\n");
+  print_out("{}", imu_result_table(r));
 }
 
 }  // namespace
@@ -118,7 +154,6 @@ void register_plan(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
-    refuse_imu(s, "plan");
     // The options as the library builds them for every caller (identify/scenario_options.hpp); the
     // prediction models [reduce] and [calibration] reduction.
     CalibrationChoices choices;
@@ -129,6 +164,10 @@ void register_plan(CLI::App& app) {
     choices.reduction = opt->reduction;
     const CalibrationOptions options = calibration_options(s, choices);
     check_feasible(s, opt->config, options.reduce);
+    if (s.is_imu()) {
+      plan_imu(s, options, opt->config, opt->json, opt->force);
+      return;
+    }
     const CalibrationResult r = predict_calibration(s, options);
     if (!opt->json.empty()) {
       nlohmann::ordered_json j = calibration_to_json(r);
@@ -143,9 +182,7 @@ void register_plan(CLI::App& app) {
               s.test.sample_rate_hz);
     print_out("{}\n", reduction_text(s, options.reduce, r.positions.size()));
     print_out("{}\n", g_levels_text(s));
-    const RecordSize size = estimate_record_size(s);
-    print_out("The test lasts {:.1f} s ({:.2f} h); simulate writes {} rows, about {}.\n", size.duration_s,
-              size.duration_s / 3600.0, size.rows, size_text(size.bytes));
+    print_out("{}", record_size_text(s));
     if (s.sensor_kind == SensorKind::kAccelerometer)
       print_out(
           "Predicted from the configured noise (white {} ug/sqrt(Hz)); estimates are the configured "

@@ -27,7 +27,7 @@ std::optional<RecordLayout> Scenario::reading_layout() const {
 
 std::string imu_not_served(std::string_view command, std::string_view input) {
   return std::string(command) + " does not serve an IMU " + std::string(input) +
-         " yet ([sensor] kind = \"imu\"); gyrocal calibrate and simulate do (docs/imu.md).";
+         " yet ([sensor] kind = \"imu\"); docs/imu.md, \"What serves an IMU\", lists the commands that do.";
 }
 
 void refuse_imu(const Scenario& scenario, std::string_view command) {

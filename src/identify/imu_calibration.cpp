@@ -591,13 +591,7 @@ ImuCalibrationResult calibrate_imu_record(RecordReader& reader, const std::vecto
   if (reader.output_count() != channels.size())
     throw Error(fmt::format("the record is read with {} output columns for an IMU of {} channels.",
                             reader.output_count(), channels.size()));
-  // Every channel reduced to the harmonic content of a revolution when any is an accelerometer (its K3 and
-  // the radius need it; a gyro's reduction serves at any gamma).
-  const bool any_accelerometer = std::any_of(channels.begin(), channels.end(), [](const SensorChannel& c) {
-    return kind_of(c.sensor) == SensorKind::kAccelerometer;
-  });
-  const TestSpec reduce_plan = reduction_plan(
-      plan, any_accelerometer ? SensorKind::kAccelerometer : SensorKind::kGyro, options.reduce);
+  const TestSpec reduce_plan = reduction_plan(plan, reduction_kind(channels), options.reduce);
   // Each channel's range, for a flat top (identify/misfit.hpp).
   std::vector<OutputRange> ranges(channels.size());
   const std::vector<Reduction> reductions =

@@ -31,6 +31,13 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order) {
   return out;
 }
 
+SensorKind reduction_kind(const std::vector<SensorChannel>& channels) {
+  const bool any_accelerometer = std::any_of(channels.begin(), channels.end(), [](const SensorChannel& c) {
+    return kind_of(c.sensor) == SensorKind::kAccelerometer;
+  });
+  return any_accelerometer ? SensorKind::kAccelerometer : SensorKind::kGyro;
+}
+
 TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options) {
   TestSpec out = plan;
   if (sensor == SensorKind::kAccelerometer && options.method == ReduceOptions::Method::kHarmonicFit)

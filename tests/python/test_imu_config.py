@@ -20,8 +20,8 @@ input_axis = "+x"
 second_axis = "+y"
 """
 
-TAIL = ('does not serve an IMU configuration yet ([sensor] kind = "imu"); gyrocal calibrate and simulate do '
-        '(docs/imu.md).')
+TAIL = ('does not serve an IMU configuration yet ([sensor] kind = "imu"); docs/imu.md, "What serves an IMU", '
+        'lists the commands that do.')
 
 
 def test_an_imu_configuration_loads():

@@ -121,10 +121,10 @@ Scenario default_accelerometer_scenario();
 /// the radius error and stretch (docs/imu.md, "What one mounting identifies").
 Scenario default_imu_scenario();
 
-/// Throws Error "<command> does not serve an IMU configuration yet ([sensor] kind = "imu"); gyrocal
-/// calibrate and simulate do (docs/imu.md)." when `scenario` describes a whole IMU (is_imu()); nothing for a
-/// lone sensor. The one check at the entry of every command that does not serve an IMU yet (plan,
-/// sensitivity, montecarlo, noise, inputs, the Python module's functions).
+/// Throws Error "<command> does not serve an IMU configuration yet ([sensor] kind = "imu"); docs/imu.md,
+/// "What serves an IMU", lists the commands that do." when `scenario` describes a whole IMU (is_imu());
+/// nothing for a lone sensor. The one check at the entry of every command that does not serve an IMU yet
+/// (sensitivity, montecarlo, noise, inputs, the Python module's functions).
 void refuse_imu(const Scenario& scenario, std::string_view command);
 
 /// The sentence refuse_imu throws, for `command` and what it was given (`input`: "configuration", or

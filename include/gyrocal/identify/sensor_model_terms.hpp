@@ -26,6 +26,11 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
 /// spinning dwell reduced to harmonic_content_gammas_rad (TestSpec::spinning_gamma_rad) whatever [test]
 /// gamma_deg lists, since values at the seed's four gammas fold the third harmonic onto the first and lose
 /// K3 and the radius (docs/accelerometer.md). Static holds keep gamma_deg.
+/// The sensor whose reduction a record of `channels` takes (reduction_plan's `sensor`): a lone sensor's own;
+/// an IMU's an accelerometer's (a spinning dwell to the harmonic content of a revolution: its K3 and the
+/// radius need it) when any channel is one, a gyro's reduction serving at any gamma, else a gyro's.
+SensorKind reduction_kind(const std::vector<SensorChannel>& channels);
+
 TestSpec reduction_plan(const TestSpec& plan, SensorKind sensor, const ReduceOptions& options);
 
 /// Model terms of every position of `reduction`, in its order, for `channel`'s sensor on its axes on
