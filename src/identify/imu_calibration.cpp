@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <variant>
@@ -23,6 +24,7 @@
 
 #include "closed_form_identify.hpp"
 #include "position_covariance.hpp"
+#include "residual_levels.hpp"
 #include "self_calibration.hpp"
 #include "weighted_positions.hpp"
 
@@ -80,6 +82,34 @@ void refuse_imu_options(const CalibrationOptions& options) {
           "the "
           "mount's own misalignment is zero by definition (docs/imu.md, \"The triad's geometry\").",
           p.error_name()));
+}
+
+/// Each channel's reduction, an accelerometer's whose model terms follow the measured motion (a rippling
+/// drive) with its dwells' levels measured from the scatter between revolutions of its output less its model,
+/// as a lone accelerometer's (residual_levels.hpp; docs/accelerometer_internals.md, "The drive's ripple"):
+/// the ripple moves the centripetal input from one revolution to the next by far more than the noise, and
+/// that motion is in the model. The model is the channel's design rows at the configured machine, at the
+/// products of a first fit of the channel alone (what the shared errors change between revolutions is far
+/// less).
+std::vector<Reduction> releveled(const std::vector<Reduction>& reductions,
+                                 const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
+                                 const CalibrationOptions& options) {
+  std::vector<Reduction> out;
+  out.reserve(reductions.size());
+  for (std::size_t c = 0; c < reductions.size() && c < channels.size(); ++c) {
+    std::optional<Reduction> own;
+    if (kind_of(channels[c].sensor) == SensorKind::kAccelerometer) {
+      CalibrationOptions lone = options;
+      lone.sensor = SensorKind::kAccelerometer;
+      lone.estimate.clear();
+      lone.test_misfit = false;  // the first fit only gives the model its products; the joint fit is tested
+      const std::vector<PositionModelTerms> terms = reduce_sensor_model_terms(
+          reductions[c], model, options.reduce, channels[c], options.max_model_samples_per_dwell);
+      own = identify_detail::residual_levels(reductions[c], terms, model, lone);
+    }
+    out.push_back(own ? std::move(*own) : reductions[c]);
+  }
+  return out;
 }
 
 /// Everything the joint solve keeps of one channel at one Gauss-Newton step.
@@ -325,25 +355,26 @@ const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) con
   return nullptr;
 }
 
-ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
+ImuCalibrationResult identify_imu(const std::vector<Reduction>& record_reductions,
                                   const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
                                   const CalibrationOptions& options, std::span<const OutputRange> ranges) {
-  if (channels.empty() || reductions.size() != channels.size())
+  if (channels.empty() || record_reductions.size() != channels.size())
     throw Error(
         fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",
-                    channels.size(), reductions.size()));
+                    channels.size(), record_reductions.size()));
   refuse_imu_options(options);
   const std::vector<MachineErrorParameter>& ps = options.estimate;
   const std::size_t nch = channels.size();
   for (std::size_t c = 0; c < nch; ++c) {
-    refuse_dead_channel(reductions[c], channels[c]);
+    refuse_dead_channel(record_reductions[c], channels[c]);
     if (c >= ranges.size() || !options.test_misfit) continue;
-    const std::string flat = saturation_cause(reductions[c], ranges[c], channels[c].output.unit(),
+    const std::string flat = saturation_cause(record_reductions[c], ranges[c], channels[c].output.unit(),
                                               to_string(kind_of(channels[c].sensor)));
     if (!flat.empty())
       throw Error(
           fmt::format("channel {} (column {}): {}.", channels[c].name, channels[c].output.column, flat));
   }
+  const std::vector<Reduction> reductions = releveled(record_reductions, channels, model, options);
   const auto k = static_cast<Eigen::Index>(ps.size());
   // The unknowns: each channel's products ("gx.dF"), then the errors.
   std::vector<Eigen::Index> offsets;

@@ -112,127 +112,125 @@ inline RigImperfections every_imperfection() {
   return all;
 }
 
-/// Calls emit(row) for each row of a rig's record of `s`'s plan, in time order. A spinning rate is one dwell
-/// per beta; a rate of 0 one hold per beta and gamma (the rig's own gamma order), each lasting settle +
-/// the planned hold + extra.
-inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion,
-                     std::uint64_t seed, const std::function<void(const RigRow&)>& emit) {
-  using rig_detail::Phase;
-  const CentrifugeModel model = s.model();
-  const TestSpec& test = s.test;
-  const bool accelerometer = s.sensor_kind == SensorKind::kAccelerometer;
-  // The rig's own order: rates last to first, betas rotated by one and reversed, a static set's gammas
-  // reversed. Each entry: rate, beta, gamma (a static hold's; unused while spinning).
-  struct Visit {
-    double rate, beta, gamma;
-  };
-  std::vector<Visit> order;
-  for (auto r = test.rates_rad_s.rbegin(); r != test.rates_rad_s.rend(); ++r) {
-    std::vector<double> betas(test.beta_rad);
-    std::rotate(betas.begin(), betas.begin() + 1, betas.end());
-    std::reverse(betas.begin(), betas.end());
-    for (double b : betas) {
-      if (*r != 0.0) {
-        order.push_back({*r, b, 0.0});
+/// The machine's motion of a rig's record of a scenario's plan: the phases (rest, ramps, moves, dwells in
+/// the rig's own order) and the true joints at any instant. A spinning rate is one dwell per beta; a rate of
+/// 0 one hold per beta and gamma (the rig's own gamma order), each lasting settle + the planned hold + extra.
+class RigTrajectory {
+ public:
+  RigTrajectory(const Scenario& s, const RigImperfections& imp, const RigMotion& motion) : imp_(imp) {
+    using rig_detail::Phase;
+    const TestSpec& test = s.test;
+    // The rig's own order: rates last to first, betas rotated by one and reversed, a static set's gammas
+    // reversed. Each entry: rate, beta, gamma (a static hold's; unused while spinning).
+    struct Visit {
+      double rate, beta, gamma;
+    };
+    std::vector<Visit> order;
+    for (auto r = test.rates_rad_s.rbegin(); r != test.rates_rad_s.rend(); ++r) {
+      std::vector<double> betas(test.beta_rad);
+      std::rotate(betas.begin(), betas.begin() + 1, betas.end());
+      std::reverse(betas.begin(), betas.end());
+      for (double b : betas) {
+        if (*r != 0.0) {
+          order.push_back({*r, b, 0.0});
+          continue;
+        }
+        for (auto g = test.gamma_rad.rbegin(); g != test.gamma_rad.rend(); ++g) order.push_back({*r, b, *g});
+      }
+    }
+    const double hold_s = static_hold_duration_s(test, reference_rate_rad_s(test, s.centrifuge.rate_rad_s));
+    std::vector<Phase>& phases = phases_;
+    double t = 0.0, rate = 0.0, beta = order.front().beta, theta = 0.0;
+    // The counter platform starts servoed at rest with psi_r = psi0 - theta.
+    bool servoed = true;
+    double psi0 = 0.7, counter = psi0;  // rad
+    const auto add = [&](double duration, double rate1, double beta1, bool dwell,
+                         double counter1 = std::numeric_limits<double>::quiet_NaN()) {
+      Phase p;
+      p.t0 = t;
+      p.t1 = t + duration;
+      p.rate0 = rate;
+      p.rate1 = rate1;
+      p.beta0 = beta;
+      p.beta1 = beta1;
+      p.theta0 = theta;
+      // The servo engages when the main axis starts (keeping the counter platform where it is) and releases
+      // when it has stopped; an indexed platform moves to counter1.
+      if (!servoed && rate1 != 0.0) {
+        servoed = true;
+        psi0 = counter + theta;
+      } else if (servoed && rate == 0.0 && rate1 == 0.0) {
+        servoed = false;
+        counter = psi0 - theta;
+      }
+      p.servoed = servoed;
+      p.psi0 = psi0;
+      p.counter0 = counter;
+      p.counter1 = servoed || std::isnan(counter1) ? counter : counter1;  // NaN: the platform stays
+      if (!servoed) counter = p.counter1;
+      p.dwell = dwell;
+      if (dwell)
+        p.dwell_index = static_cast<int>(
+            std::count_if(phases.begin(), phases.end(), [](const Phase& q) { return q.dwell; }));
+      // The drive's angle at the end (without ripple: the ripple's angle is added where it is evaluated).
+      theta += rate * duration + (rate1 - rate) * 0.5 * duration;
+      if (dwell && imp.ripple != 0.0 && rate != 0.0) {
+        const double wr = 2.0 * kPi * imp.ripple_hz;
+        theta += rate * imp.ripple * (1.0 - std::cos(wr * duration)) / wr;
+      }
+      phases.push_back(p);
+      t = p.t1;
+      rate = rate1;
+      beta = beta1;
+    };
+    add(2.0, 0.0, beta, false);  // at rest
+    for (const Visit& v : order) {
+      const double drive = v.rate * (1.0 + imp.rate_offset);
+      if (drive != rate) add(motion.ramp_s, drive, beta, false);
+      if (v.beta != beta) add(motion.move_s, rate, v.beta, false);
+      if (v.rate == 0.0) {
+        // Stopped: the servo lets go, the counter platform is indexed to psi_r = -gamma (the shorter way
+        // round), then the hold.
+        if (servoed) add(0.5, 0.0, beta, false);
+        const double target = counter + wrap_deg((-v.gamma - counter) * kRadToDeg) * kDegToRad;
+        if (target != counter) add(motion.move_s, 0.0, beta, false, target);
+        add(test.settle_s + hold_s + motion.extra_dwell_s, 0.0, beta, true);
         continue;
       }
-      for (auto g = test.gamma_rad.rbegin(); g != test.gamma_rad.rend(); ++g) order.push_back({*r, b, *g});
+      const double planned = test.revolutions * 2.0 * kPi / std::abs(v.rate);
+      add(test.settle_s + planned + motion.extra_dwell_s, rate, beta, true);
     }
+    if (rate != 0.0) add(motion.ramp_s, 0.0, beta, false);
   }
-  const double hold_s = static_hold_duration_s(test, reference_rate_rad_s(test, s.centrifuge.rate_rad_s));
-  std::vector<Phase> phases;
-  double t = 0.0, rate = 0.0, beta = order.front().beta, theta = 0.0;
-  // The counter platform starts servoed at rest with psi_r = psi0 - theta.
-  bool servoed = true;
-  double psi0 = 0.7, counter = psi0;  // rad
-  const auto add = [&](double duration, double rate1, double beta1, bool dwell,
-                       double counter1 = std::numeric_limits<double>::quiet_NaN()) {
-    Phase p;
-    p.t0 = t;
-    p.t1 = t + duration;
-    p.rate0 = rate;
-    p.rate1 = rate1;
-    p.beta0 = beta;
-    p.beta1 = beta1;
-    p.theta0 = theta;
-    // The servo engages when the main axis starts (keeping the counter platform where it is) and releases
-    // when it has stopped; an indexed platform moves to counter1.
-    if (!servoed && rate1 != 0.0) {
-      servoed = true;
-      psi0 = counter + theta;
-    } else if (servoed && rate == 0.0 && rate1 == 0.0) {
-      servoed = false;
-      counter = psi0 - theta;
-    }
-    p.servoed = servoed;
-    p.psi0 = psi0;
-    p.counter0 = counter;
-    p.counter1 = servoed || std::isnan(counter1) ? counter : counter1;  // NaN: the platform stays
-    if (!servoed) counter = p.counter1;
-    p.dwell = dwell;
-    if (dwell)
-      p.dwell_index = static_cast<int>(
-          std::count_if(phases.begin(), phases.end(), [](const Phase& q) { return q.dwell; }));
-    // The drive's angle at the end (without ripple: the ripple's angle is added where it is evaluated).
-    theta += rate * duration + (rate1 - rate) * 0.5 * duration;
-    if (dwell && imp.ripple != 0.0 && rate != 0.0) {
-      const double wr = 2.0 * kPi * imp.ripple_hz;
-      theta += rate * imp.ripple * (1.0 - std::cos(wr * duration)) / wr;
-    }
-    phases.push_back(p);
-    t = p.t1;
-    rate = rate1;
-    beta = beta1;
-  };
-  add(2.0, 0.0, beta, false);  // at rest
-  for (const Visit& v : order) {
-    const double drive = v.rate * (1.0 + imp.rate_offset);
-    if (drive != rate) add(motion.ramp_s, drive, beta, false);
-    if (v.beta != beta) add(motion.move_s, rate, v.beta, false);
-    if (v.rate == 0.0) {
-      // Stopped: the servo lets go, the counter platform is indexed to psi_r = -gamma (the shorter way
-      // round), then the hold.
-      if (servoed) add(0.5, 0.0, beta, false);
-      const double target = counter + wrap_deg((-v.gamma - counter) * kRadToDeg) * kDegToRad;
-      if (target != counter) add(motion.move_s, 0.0, beta, false, target);
-      add(test.settle_s + hold_s + motion.extra_dwell_s, 0.0, beta, true);
-      continue;
-    }
-    const double planned = test.revolutions * 2.0 * kPi / std::abs(v.rate);
-    add(test.settle_s + planned + motion.extra_dwell_s, rate, beta, true);
-  }
-  if (rate != 0.0) add(motion.ramp_s, 0.0, beta, false);
 
-  // The output's noise and the acquisition's imperfections draw from separate streams: a record with and
-  // without jitter has the same noise.
-  std::mt19937_64 rng(seed), acquisition(seed ^ 0x9e3779b97f4a7c15ULL);
-  std::normal_distribution<double> noise(0.0, motion.noise_deg_h);
-  const double k1 = s.accelerometer.coefficients[AccelCoefficient::K1];
-  AccelerometerNoiseGenerator accelerometer_noise(s.accelerometer.noise, k1, test.sample_rate_hz, seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  std::bernoulli_distribution toggle(0.5);
-  const double fs = test.sample_rate_hz;
-  const auto n = static_cast<std::uint64_t>(std::floor(t * fs));
-  const auto spike_every = imp.spikes > 0 ? n / static_cast<std::uint64_t>(imp.spikes + 1) : 0;
-  const auto quantise = [](double a, double q) { return q > 0 ? q * std::round(a / q) : a; };
-  std::size_t pi = 0;
-  double jump = 0.0;
-  for (std::uint64_t k = 0; k < n; ++k) {
-    const double tk = static_cast<double>(k) / fs;  // the uniform clock
-    while (pi + 1 < phases.size() && tk >= phases[pi].t1) ++pi;
-    const Phase& p = phases[pi];
-    const double d = p.t1 - p.t0, tau = tk - p.t0, u = tau / d;
+  /// The phases in time order (the last ends at duration_s()).
+  const std::vector<rig_detail::Phase>& phases() const { return phases_; }
+  /// The record's length, s.
+  double duration_s() const { return phases_.back().t1; }
+
+  /// The index of the phase that holds time t, s (the first for t < 0, the last from its end on).
+  std::size_t phase_at(double t) const {
+    const auto it = std::upper_bound(phases_.begin(), phases_.end(), t,
+                                     [](double x, const rig_detail::Phase& p) { return x < p.t1; });
+    return std::min(static_cast<std::size_t>(it - phases_.begin()), phases_.size() - 1);
+  }
+
+  /// The machine's true joints at time t, s, inside phase `p` (phase_at(t)): angles rad, rates rad/s,
+  /// accelerations rad/s^2. The ripple rides on a spinning dwell; a move of beta inside the fourth dwell
+  /// (RigImperfections::beta_move_in_dwell_deg) is a true move.
+  JointState joints(const rig_detail::Phase& p, double t) const {
+    const double d = p.t1 - p.t0, tau = t - p.t0, u = tau / d;
     JointState j;
     // Main axis: a smooth ramp of the rate, then the ripple on top while the drive turns.
     const double dr = p.rate1 - p.rate0;
     double w = p.rate0 + dr * rig_detail::step(u);
     double th = p.theta0 + p.rate0 * tau + dr * (0.5 * tau - d / (2.0 * kPi) * std::sin(kPi * u));
     double acc = dr * rig_detail::step_rate(u) / d;
-    if (imp.ripple != 0.0 && p.dwell && p.rate0 != 0.0) {
-      const double wr = 2.0 * kPi * imp.ripple_hz;
-      w += p.rate0 * imp.ripple * std::sin(wr * tau);
-      th += p.rate0 * imp.ripple * (1.0 - std::cos(wr * tau)) / wr;
-      acc += p.rate0 * imp.ripple * wr * std::cos(wr * tau);
+    if (imp_.ripple != 0.0 && p.dwell && p.rate0 != 0.0) {
+      const double wr = 2.0 * kPi * imp_.ripple_hz;
+      w += p.rate0 * imp_.ripple * std::sin(wr * tau);
+      th += p.rate0 * imp_.ripple * (1.0 - std::cos(wr * tau)) / wr;
+      acc += p.rate0 * imp_.ripple * wr * std::cos(wr * tau);
     }
     j.main_angle_rad = th;
     j.main_rate_rad_s = w;
@@ -253,11 +251,53 @@ inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMo
     j.position_rate_rad_s = db * rig_detail::step_rate(u) / d;
     j.position_accel_rad_s2 =
         db * 0.5 * kPi * kPi * std::cos(kPi * u) / (d * d) * (u > 0 && u < 1 ? 1.0 : 0.0);
-    double beta_read_offset = 0.0;
-    if (p.dwell && p.dwell_index == 3 && imp.beta_move_in_dwell_deg != 0.0 && tau >= 0.5) {
+    if (p.dwell && p.dwell_index == 3 && imp_.beta_move_in_dwell_deg != 0.0 && tau >= 0.5) {
       // The platform really moves (and stays): the model sees it too.
-      j.position_angle_rad += imp.beta_move_in_dwell_deg * kDegToRad;
+      j.position_angle_rad += imp_.beta_move_in_dwell_deg * kDegToRad;
     }
+    return j;
+  }
+  /// The same at any time t, s.
+  JointState joints(double t) const { return joints(phases_[phase_at(t)], t); }
+
+ private:
+  RigImperfections imp_;
+  std::vector<rig_detail::Phase> phases_;
+};
+
+/// Calls emit(row) for each row of a rig's record of `s`'s plan, in time order, on RigTrajectory's motion.
+inline void rig_rows(const Scenario& s, const RigImperfections& imp, const RigMotion& motion,
+                     std::uint64_t seed, const std::function<void(const RigRow&)>& emit) {
+  using rig_detail::Phase;
+  const CentrifugeModel model = s.model();
+  const TestSpec& test = s.test;
+  const bool accelerometer = s.sensor_kind == SensorKind::kAccelerometer;
+  const RigTrajectory trajectory(s, imp, motion);
+  const std::vector<Phase>& phases = trajectory.phases();
+  const double t = trajectory.duration_s();
+
+  // The output's noise and the acquisition's imperfections draw from separate streams: a record with and
+  // without jitter has the same noise.
+  std::mt19937_64 rng(seed), acquisition(seed ^ 0x9e3779b97f4a7c15ULL);
+  std::normal_distribution<double> noise(0.0, motion.noise_deg_h);
+  const double k1 = s.accelerometer.coefficients[AccelCoefficient::K1];
+  AccelerometerNoiseGenerator accelerometer_noise(s.accelerometer.noise, k1, test.sample_rate_hz, seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::bernoulli_distribution toggle(0.5);
+  const double fs = test.sample_rate_hz;
+  const auto n = static_cast<std::uint64_t>(std::floor(t * fs));
+  const auto spike_every = imp.spikes > 0 ? n / static_cast<std::uint64_t>(imp.spikes + 1) : 0;
+  const auto quantise = [](double a, double q) { return q > 0 ? q * std::round(a / q) : a; };
+  std::size_t pi = 0;
+  double jump = 0.0;
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const double tk = static_cast<double>(k) / fs;  // the uniform clock
+    while (pi + 1 < phases.size() && tk >= phases[pi].t1) ++pi;
+    const Phase& p = phases[pi];
+    const double d = p.t1 - p.t0;
+    const JointState j = trajectory.joints(p, tk);
+    const double th = j.main_angle_rad;
+    double beta_read_offset = 0.0;
     const SensorInputs in = exact_inputs(model, j);
     double y = accelerometer ? accelerometer_noise.next(s.accelerometer.output(in))
                              : gyro_output_deg_h(s.gyro, in.rate_rad_s.x(), in.specific_force_g) + noise(rng);
