@@ -235,7 +235,9 @@ TEST(ImuNoise, RecordLackingAChannelsColumnIsRefusedNamingIt) {
   } catch (const Error& e) {
     message = e.what();
   }
-  EXPECT_NE(message.find("'az' is not a column of the header line"), std::string::npos) << message;
+  EXPECT_NE(message.find("[[channel]] 4's column = 'az' is not a column of the header line"),
+            std::string::npos)
+      << message;
   std::ofstream(dir / "imu.toml") << kConfig;
   const auto run = run_cli("noise " + (dir / "static.csv").string() + " --config " +
                                (dir / "imu.toml").string() + " --json " + (dir / "noise.json").string(),
