@@ -5,9 +5,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +25,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/history/read.hpp"
 #include "gyrocal/identify/calibration.hpp"
+#include "gyrocal/identify/imu_calibration.hpp"
 #include "gyrocal/identify/model_terms.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/identify/scenario_options.hpp"
@@ -32,6 +35,7 @@
 #include "gyrocal/reduce/reducer.hpp"
 #include "gyrocal/result/calibration_json.hpp"
 #include "gyrocal/result/history_json.hpp"
+#include "gyrocal/result/imu_calibration_json.hpp"
 #include "gyrocal/result/noise_json.hpp"
 #include "gyrocal/simulate/simulator.hpp"
 
@@ -57,6 +61,14 @@ constexpr const char* kScenarioName = "the scenario";
 /// gyrocal's own output column of a sensor: gyro_deg_h (deg/h) or accel_g (g).
 std::string native_output_column(SensorKind kind) {
   return std::string(kind == SensorKind::kAccelerometer ? Accelerometer::native_column : Gyro::native_column);
+}
+
+/// The IMU's functions are called only for an IMU's scenario (python/gyrocal/__init__.py chooses them).
+void refuse_lone(const Scenario& scenario) {
+  if (!scenario.is_imu())
+    throw Error(
+        "the scenario is not an IMU's ([sensor] kind = \"imu\"): the IMU's functions read an IMU's "
+        "channels.");
 }
 
 /// The options `gyrocal calibrate` builds, by the same library function (identify/scenario_options.hpp):
@@ -143,7 +155,33 @@ py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double
   return py::make_tuple(omega, force);
 }
 
+/// An IMU's record as `gyrocal simulate` writes it: time_s, the three angles, then every channel's column in
+/// its own units (simulate_written), keyed as its header.
+py::dict simulate_imu_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
+  const std::vector<SensorChannel> channels = scenario.channels();
+  std::vector<std::vector<double>> columns(4 + channels.size());
+  {
+    py::gil_scoped_release release;
+    SimulationOptions options;
+    options.seed = seed;
+    simulate_written(scenario, options, [&columns](const RecordSample& s) {
+      columns[0].push_back(s.time_s);
+      columns[1].push_back(s.main_angle_deg);
+      columns[2].push_back(s.counter_angle_deg);
+      columns[3].push_back(s.position_angle_deg);
+      for (std::size_t c = 4; c < columns.size(); ++c) columns[c].push_back(s.outputs[c - 4]);
+    });
+  }
+  py::dict out;
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    const std::string key = c < 4 ? std::string(kRecordColumns[c]) : channels[c - 4].output.column;
+    out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
+  }
+  return out;
+}
+
 py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
+  if (scenario.is_imu()) return simulate_imu_py(scenario, seed);
   std::vector<double> columns[5];
   {
     py::gil_scoped_release release;
@@ -256,6 +294,124 @@ py::object noise_arrays_py(const Column& time_s, const Column& output, const std
   return json_to_python(j);
 }
 
+// --- A whole IMU (docs/imu.md, docs/python.md "An IMU") ----------------------------------------------------
+
+/// The columns an IMU's record is read with through its scenario's layout (Scenario::reading_layout()), in
+/// order: the time, the angle columns the layout names (with `angles`; a noise needs none), then every
+/// channel's output column. A mapping given for the record holds them under these names, in the columns' own
+/// units (an increment as an increment), as the file holds them.
+std::vector<std::string> imu_columns(const Scenario& scenario, bool angles) {
+  refuse_lone(scenario);
+  const RecordLayout layout = *scenario.reading_layout();
+  std::vector<std::string> names = {layout.time_column};
+  if (angles)
+    for (const std::string* c :
+         {&layout.main_angle_column, &layout.counter_angle_column, &layout.position_angle_column})
+      if (!c->empty()) names.push_back(*c);
+  for (const OutputColumn& o : layout.outputs) names.push_back(o.column);
+  return names;
+}
+
+/// The reader of an IMU's record held in arrays (`columns`, named `names` as imu_columns gives them): the
+/// arrays, checked as a dict's columns are (check_columns), written as CSV text in the shortest form that
+/// reads back as the same doubles, and read through the scenario's layout, with a comma, '#' comments, no
+/// preamble or units row and a decimal point, and without the angle columns that `names` lacks. So every
+/// conversion (units, scales, offsets, an increment divided by its interval) and every refusal is the
+/// reader's, as for a file. `name` stands for the record in messages.
+RecordReader imu_arrays_reader(const std::vector<Column>& columns, const std::vector<std::string>& names,
+                               const Scenario& scenario, const std::string& name) {
+  std::vector<const Column*> pointers;
+  for (const Column& c : columns) pointers.push_back(&c);
+  if (pointers.empty() || pointers.size() != names.size())
+    throw Error(fmt::format("{}: {} columns given for the {} an IMU's record is read with.", name,
+                            pointers.size(), names.size()));
+  check_columns(pointers, names, name);
+  RecordLayout layout = *scenario.reading_layout();
+  layout.delimiter = ',';
+  layout.comment = "#";
+  layout.skip_rows = 0;
+  layout.units_row = false;
+  layout.decimal = '.';
+  const auto named = [&names](const std::string& c) {
+    return std::find(names.begin(), names.end(), c) != names.end();
+  };
+  for (std::string* c :
+       {&layout.main_angle_column, &layout.counter_angle_column, &layout.position_angle_column})
+    if (!named(*c)) c->clear();
+  fmt::memory_buffer text;
+  for (std::size_t c = 0; c < names.size(); ++c)
+    fmt::format_to(std::back_inserter(text), "{}{}", c ? "," : "", names[c]);
+  text.push_back('\n');
+  const py::ssize_t rows = columns.front().size();
+  for (py::ssize_t i = 0; i < rows; ++i) {
+    for (std::size_t c = 0; c < columns.size(); ++c)
+      fmt::format_to(std::back_inserter(text), "{}{}", c ? "," : "", columns[c].data()[i]);
+    text.push_back('\n');
+  }
+  return RecordReader::from_string(fmt::to_string(text), layout, name);
+}
+
+py::object calibrate_imu_path_py(const std::string& path, const Scenario& scenario, const std::string& method,
+                                 const std::string& compensation, const std::string& reduction,
+                                 const std::optional<std::vector<std::string>>& estimate,
+                                 const std::string& gyro_model) {
+  refuse_lone(scenario);
+  const CalibrationOptions options =
+      python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
+  nlohmann::ordered_json j;
+  {
+    py::gil_scoped_release release;
+    // As `gyrocal calibrate` of an IMU: every channel's column in one pass, one joint solve.
+    RecordReader reader(path, scenario.reading_layout());
+    j = imu_calibration_to_json(
+        calibrate_imu_record(reader, scenario.channels(), scenario.model(), scenario.test, options));
+  }
+  j["record"] = path;
+  return json_to_python(j);
+}
+
+py::object calibrate_imu_arrays_py(const std::vector<Column>& columns, const std::vector<std::string>& names,
+                                   const Scenario& scenario, const std::string& method,
+                                   const std::string& compensation, const std::string& reduction,
+                                   const std::optional<std::vector<std::string>>& estimate,
+                                   const std::string& gyro_model, const std::string& name) {
+  refuse_lone(scenario);
+  const CalibrationOptions options =
+      python_calibration_options(scenario, method, compensation, reduction, estimate, gyro_model);
+  nlohmann::ordered_json j;
+  RecordReader reader = imu_arrays_reader(columns, names, scenario, name);
+  {
+    py::gil_scoped_release release;
+    j = imu_calibration_to_json(
+        calibrate_imu_record(reader, scenario.channels(), scenario.model(), scenario.test, options));
+  }
+  j["record"] = name;
+  return json_to_python(j);
+}
+
+py::object noise_imu_path_py(const std::string& path, const Scenario& scenario) {
+  refuse_lone(scenario);
+  nlohmann::ordered_json j;
+  {
+    py::gil_scoped_release release;
+    j = imu_noise_to_json(
+        characterise_imu_record_noise(path, scenario.channels(), *scenario.reading_layout()));
+  }
+  return json_to_python(j);
+}
+
+py::object noise_imu_arrays_py(const std::vector<Column>& columns, const std::vector<std::string>& names,
+                               const Scenario& scenario, const std::string& name) {
+  refuse_lone(scenario);
+  nlohmann::ordered_json j;
+  RecordReader reader = imu_arrays_reader(columns, names, scenario, name);
+  {
+    py::gil_scoped_release release;
+    j = imu_noise_to_json(characterise_imu_record_noise(reader, scenario.channels()));
+  }
+  return json_to_python(j);
+}
+
 /// Refuses, as the command line does, a record whose output column is the other sensor's.
 void check_output_column_py(const std::string& column, const Scenario& scenario, const std::string& name) {
   require_output_column_for_sensor(column, scenario.sensor_kind, name, kScenarioName);
@@ -357,6 +513,11 @@ PYBIND11_MODULE(_gyrocal, m) {
   m.def("_noise_path", &noise_path_py);
   m.def("_noise_arrays", &noise_arrays_py);
   m.def("_check_output_column", &check_output_column_py);
+  m.def("_imu_columns", &imu_columns, py::arg("scenario"), py::arg("angles"));
+  m.def("_calibrate_imu_path", &calibrate_imu_path_py);
+  m.def("_calibrate_imu_arrays", &calibrate_imu_arrays_py);
+  m.def("_noise_imu_path", &noise_imu_path_py);
+  m.def("_noise_imu_arrays", &noise_imu_arrays_py);
   m.def("_history", &history_py, py::arg("db"), py::arg("unit"));
   // The functions that do not serve an IMU configuration yet refuse one with the command line's sentence.
   m.def("_refuse_imu", &refuse_imu, py::arg("scenario"), py::arg("function"));

@@ -559,19 +559,13 @@ TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   const std::filesystem::path dir = fresh_test_folder("imu-unserved");
   const std::string config = (dir / "imu.toml").string();
   { std::ofstream(config) << scenario_to_toml(default_imu_scenario()); }
-  const std::string record = (dir / "static.csv").string();
-  {
-    std::ofstream out(record);
-    out << "# gyrocal-record 1\ntime_s,main_angle_deg,counter_angle_deg,position_angle_deg,gyro_deg_h\n";
-    for (int i = 0; i < 64; ++i) out << i * 0.005 << ",0,0,0," << (i % 2) << "\n";
-  }
   const std::string json = (dir / "out.json").string();
   const std::vector<std::pair<std::string, std::string>> commands = {
       {"sensitivity", "sensitivity --config " + config + " --json " + json},
       {"montecarlo", "montecarlo --trials 2 --config " + config + " --json " + json},
-      {"noise", "noise " + record + " --config " + config + " --json " + json},
       {"inputs", "inputs --beta-deg 0 --time-s 1 --config " + config + " --json " + json},
   };
+  // (noise serves an IMU: tests/test_imu_noise.cpp.)
   for (const auto& [command, args] : commands) {
     const CliOutcome o = run_cli(args, dir);
     EXPECT_EQ(o.status, 1) << command << ": " << o.err;

@@ -76,7 +76,7 @@ TEST(OutputColumns, AColumnMissingFromTheHeaderIsRefusedNamingIt) {
   } catch (const Error& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("imu.csv, line 1"), std::string::npos) << m;
-    EXPECT_NE(m.find("record.outputs[1].column = 'ax' is not a column"), std::string::npos) << m;
+    EXPECT_NE(m.find("[[channel]] 2's column = 'ax' is not a column"), std::string::npos) << m;
   }
 }
 
@@ -90,7 +90,7 @@ TEST(OutputColumns, AnOutputBeyondItsBoundIsRefusedNamingItsColumn) {
   } catch (const Error& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("imu.csv, line 2: column 6 (ax)"), std::string::npos) << m;
-    EXPECT_NE(m.find("of record.outputs[1]"), std::string::npos) << m;
+    EXPECT_NE(m.find("output_scale of [[channel]] 2"), std::string::npos) << m;
   }
 }
 

@@ -1,4 +1,5 @@
-// gyrocal noise RECORD: the noise of a static record's output (overlapping Allan deviation, IEEE 952 terms).
+// gyrocal noise RECORD: the noise of a static record's output (overlapping Allan deviation, IEEE 952 terms);
+// of an IMU's record, every channel's (docs/imu.md).
 #include <fmt/format.h>
 
 #include "cli.hpp"
@@ -20,9 +21,10 @@ void register_noise(CLI::App& app) {
       "noise",
       "Noise of a record's output: overlapping Allan deviation with 68.3 % bounds and the IEEE 952 terms");
   sub->add_option("RECORD", opt->record, "Record of a static test (CSV, docs/contract.md)")->required();
-  sub->add_option("--config", opt->config,
-                  "Configuration file (TOML); only its [sensor] kind and [record] section (the record's "
-                  "layout) are used");
+  sub->add_option(
+      "--config", opt->config,
+      "Configuration file (TOML); only its [sensor] kind and [record] section (the record's "
+      "layout), and an IMU's [[channel]] tables (each channel's column, scale and form), are used");
   sub->add_option("--json", opt->json, "Write the result as JSON to FILE ('-' = standard output)");
   sub->add_option(
       "--html", opt->html,
@@ -43,7 +45,23 @@ void register_noise(CLI::App& app) {
     check_output(opt->html, OutputKind::kReport, opt->force, "--html");
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario s = load_configuration(opt->config);
-    refuse_imu(s, "noise");
+    if (s.is_imu()) {
+      // A whole IMU (docs/imu.md, "What serves an IMU"): every channel's terms, each in its own unit.
+      if (opt->toml)
+        throw Error(
+            "noise --toml prints one sensor's [gyro.noise] or [accelerometer.noise] section; an IMU's terms "
+            "belong in each [[channel]]'s [channel.noise]: take them from the table or --json "
+            "(docs/imu.md).");
+      if (!opt->html.empty())
+        throw Error(
+            "noise --html does not serve an IMU configuration yet ([sensor] kind = \"imu\"): its report "
+            "draws one output's Allan deviation; use the table or --json, which hold every channel's "
+            "(docs/imu.md).");
+      const ImuRecordNoise r = characterise_imu_record_noise(opt->record, s.channels(), *s.reading_layout());
+      if (!opt->json.empty()) write_result(opt->json, imu_noise_to_json(r), "noise", opt->force);
+      if (opt->json != "-") print_out("{}", imu_noise_table(r));
+      return;
+    }
     // With a configuration, its sensor's output is characterised (a record of the other sensor is refused);
     // without one, the record's output column says which sensor (accel_g: an accelerometer).
     RecordNoiseOptions noise_options;

@@ -18,6 +18,13 @@ std::string noise_table(const RecordNoise& r) {
                        sensor_noise_term(r.sensor, c.dominant[i]).key);
   }
   out += "\nFitted terms (68.3 % bounds above; terms at 1 standard uncertainty):\n";
+  out += noise_terms_lines(r);
+  return out;
+}
+
+std::string noise_terms_lines(const RecordNoise& r) {
+  const NoiseCharacterisation& c = r.noise;
+  std::string out;
   for (std::size_t t = 0; t < kNoiseTermCount; ++t) {
     const FittedNoiseTerm term = sensor_term(r, static_cast<NoiseTerm>(t));
     const auto key = sensor_noise_term(r.sensor, static_cast<NoiseTerm>(t)).key;
@@ -34,6 +41,20 @@ std::string noise_table(const RecordNoise& r) {
                                       kAccelerometerResolutionKey);
   }
   out += fmt::format("  weighted misfit per degree of freedom: {:.3g}\n", c.chi2_per_dof);
+  return out;
+}
+
+std::string imu_noise_table(const ImuRecordNoise& r) {
+  std::string out = fmt::format("{}: {} rows at {:.6g} Hz, {} channels\n", r.record, r.rows, r.sample_rate_hz,
+                                r.channels.size());
+  for (const ChannelNoise& c : r.channels) {
+    out +=
+        fmt::format("\n{} ({}, column {}; {} samples, Allan deviation in {}):\n", c.name,
+                    to_string(c.noise.sensor), c.column, c.noise.samples, noise_output_unit(c.noise.sensor));
+    out += noise_terms_lines(c.noise);
+  }
+  out +=
+      "\nTerms at 1 standard uncertainty; each channel's Allan deviation with its 68.3 % bounds: --json.\n";
   return out;
 }
 

@@ -44,5 +44,11 @@ std::string sensor_comparison_table(const std::vector<std::string>& labels,
 
 /// The Allan deviation with its bounds and dominant term, then the fitted terms with their uncertainties.
 std::string noise_table(const RecordNoise& result);
+/// The fitted terms of one characterised output, one line each in its sensor's keys and units (and an
+/// accelerometer's quantization_ug), then the fit's weighted misfit: noise_table's last part.
+std::string noise_terms_lines(const RecordNoise& result);
+/// The text table of `gyrocal noise` for an IMU: the record's rows and rate, then per channel (its sensor,
+/// column and samples) its fitted terms as noise_terms_lines writes them.
+std::string imu_noise_table(const ImuRecordNoise& result);
 
 }  // namespace gyrocal::cli

@@ -23,8 +23,8 @@ import numpy as np
 from ._gyrocal import Scenario
 from . import _gyrocal
 
-__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "history", "RECORD_COLUMNS",
-           "ArgumentTypeError"]
+__all__ = ["Scenario", "exact_inputs", "simulate", "calibrate", "noise", "imu_columns", "history",
+           "RECORD_COLUMNS", "ArgumentTypeError"]
 
 #: The record's required columns, in order (docs/contract.md, "Record (CSV)").
 RECORD_COLUMNS = ("time_s", "main_angle_deg", "counter_angle_deg", "position_angle_deg", "gyro_deg_h")
@@ -264,8 +264,9 @@ def exact_inputs(scenario, time_s, beta_deg):
 def simulate(scenario, seed=None):
     """The record `gyrocal simulate --seed SEED` writes, held in memory: a dict of float64 arrays named as the
     record's columns (RECORD_COLUMNS; an accelerometer's output is keyed accel_g, in g, as its record's header). seed=None takes the scenario's [test] seed, as without --seed; any other
-    seed is an integer from 0 to 2**64 - 1 (ValueError otherwise)."""
-    _gyrocal._refuse_imu(scenario, "gyrocal.simulate")
+    seed is an integer from 0 to 2**64 - 1 (ValueError otherwise). An IMU's scenario gives its record as the
+    command line writes it: time_s, the three angles and every channel's column in its own units (an increment as
+    an increment), keyed as its header (imu_columns(sc)), which calibrate and noise take back."""
     return _gyrocal._simulate(scenario, seed)
 
 
@@ -286,9 +287,20 @@ def calibrate(rec, scenario, method="least-squares", compensation="full", estima
     coefficients come in the contract's order (dF dI dO dS dII dOO dSS dIO dIS dOS, then the rate errors); an
     accelerometer's scenario ([sensor] kind) gives its eleven in its table's order (K0 K1 K2 K3 Kip Kio Kpo
     Kpp Koo delta_p delta_o), from a record whose output column is accel_g. method and compensation left None
-    take their defaults, as the command line without --method and --compensation."""
-    _gyrocal._refuse_imu(scenario, "gyrocal.calibrate")
+    take their defaults, as the command line without --method and --compensation.
+
+    An IMU's scenario ([sensor] kind = "imu", docs/imu.md) gives `gyrocal calibrate --json` of an IMU: "sensor"
+    "imu" and "channels" keyed by the channels' names. Its mapping holds the columns its file would hold, in their
+    own units (an increment as an increment): the time, the three angles and every channel's column, named as the
+    scenario's [record] and [[channel]] tables name them (gyrocal.imu_columns(sc))."""
     options = (method, compensation, reduction, estimate, gyro_model)
+    if scenario.sensor_kind == "imu":
+        # Every channel's column in one pass and one joint solve, as `gyrocal calibrate` of an IMU.
+        if isinstance(rec, str):
+            return _gyrocal._calibrate_imu_path(rec, scenario, *options)
+        names = _gyrocal._imu_columns(scenario, True)
+        return _gyrocal._calibrate_imu_arrays([_column(rec, name) for name in names], names, scenario, *options,
+                                              _ARRAYS_NAME)
     if isinstance(rec, str):
         return _gyrocal._calibrate_path(rec, scenario, *options)
     names = RECORD_COLUMNS[:4] + (_output_column(rec, scenario),)
@@ -303,9 +315,18 @@ def noise(rec, scenario=None):
     (a gyro's, deg/h) or accel_g (an accelerometer's, g; its terms keyed as [accelerometer.noise], in ug).
     A record's path is read through the scenario's [record] layout when it has one (as `gyrocal noise
     --config`), and the scenario's [sensor] kind says whose output it must hold; without a scenario the
-    record's output column says. The noise itself does not depend on the scenario."""
-    if scenario is not None:
-        _gyrocal._refuse_imu(scenario, "gyrocal.noise")
+    record's output column says. The noise itself does not depend on the scenario.
+
+    An IMU's scenario gives `gyrocal noise --json` of an IMU: "sensor" "imu" and "channels" keyed by the channels'
+    names, each a gyro's terms (deg/h) or an accelerometer's (ug). Its mapping holds the time and every channel's
+    column as its file would (gyrocal.imu_columns(sc, angles=False)); angle columns are not read from a
+    mapping."""
+    if scenario is not None and scenario.sensor_kind == "imu":
+        # Every channel's terms, each in its own sensor's unit, as `gyrocal noise --config` of an IMU.
+        if isinstance(rec, str):
+            return _gyrocal._noise_imu_path(rec, scenario)
+        names = _gyrocal._imu_columns(scenario, False)
+        return _gyrocal._noise_imu_arrays([_column(rec, name) for name in names], names, scenario, _ARRAYS_NAME)
     if isinstance(rec, str):
         return _gyrocal._noise_path(rec, scenario)
     if scenario is not None:
@@ -314,6 +335,17 @@ def noise(rec, scenario=None):
         column = _ACCEL_COLUMN if _has_column(rec, _ACCEL_COLUMN) and not _has_column(rec, _GYRO_COLUMN) \
             else _GYRO_COLUMN
     return _gyrocal._noise_arrays(_column(rec, "time_s"), _column(rec, column), column, _ARRAYS_NAME)
+
+
+@_arguments(scenario=_scenario)
+def imu_columns(scenario, angles=True):
+    """The columns an IMU's record is read with, as a tuple of names in order: the time, the three angle columns
+    (with angles=True: what calibrate needs; noise needs none), then every channel's column, as the scenario's
+    [record] and [[channel]] tables name them. A mapping given to calibrate or noise for an IMU holds these
+    columns in their own units, as the record's file does. A lone sensor's scenario raises ValueError."""
+    if not isinstance(angles, (bool, np.bool_)):
+        raise ArgumentTypeError(f"angles must be True or False, not {_type_name(angles)}.")
+    return tuple(_gyrocal._imu_columns(scenario, bool(angles)))
 
 
 @_arguments(db=_path, unit=_name)

@@ -13,6 +13,7 @@
 #include "gyrocal/core/units.hpp"
 #include "gyrocal/identify/record_check.hpp"
 #include "gyrocal/record/record.hpp"
+#include "gyrocal/sensor/channel.hpp"
 
 namespace gyrocal {
 namespace {
@@ -362,6 +363,70 @@ RecordNoise characterise_record_noise(const std::filesystem::path& path, const R
   }
   motion.check(name);
   return characterise(rate_deg_h, sampling.finish(), name, sensor);
+}
+
+namespace {
+
+/// characterise_imu_record_noise's work on an open reader; `reserve`: the rows expected (0: unknown).
+ImuRecordNoise imu_noise(RecordReader& reader, const std::vector<SensorChannel>& channels,
+                         const RecordNoiseOptions& options, std::size_t reserve) {
+  const std::string& name = reader.name();
+  if (reader.output_count() != channels.size())
+    throw Error(fmt::format("{}: the record is read with {} output columns for an IMU of {} channels.", name,
+                            reader.output_count(), channels.size()));
+  // Every channel's samples in its noise unit: deg/h as the reader gives a rate, ug from its g.
+  std::vector<double> to_noise_unit(channels.size(), 1.0);
+  for (std::size_t c = 0; c < channels.size(); ++c)
+    if (kind_of(channels[c].sensor) == SensorKind::kAccelerometer) to_noise_unit[c] = kMicroGPerG;
+  std::vector<std::vector<double>> values(channels.size());
+  for (std::vector<double>& v : values) v.reserve(reserve);
+  MotionCheck motion;
+  EvenSampling sampling(name, options);
+  RecordSample sample;
+  std::uint64_t rows = 0;
+  while (reader.next(sample)) {
+    sampling.add(sample.time_s);
+    motion.add(sample);
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+      // An increment's first row has no interval to be divided by (the reader gives NaN).
+      if (rows == 0 && channels[c].output.form == OutputForm::kIncrement) continue;
+      values[c].push_back(sample.outputs[c] * to_noise_unit[c]);
+    }
+    ++rows;
+  }
+  motion.check(name);
+  const double interval_s = sampling.finish();
+  ImuRecordNoise result;
+  result.record = name;
+  result.rows = rows;
+  result.sample_rate_hz = interval_s > 0.0 ? 1.0 / interval_s : 0.0;
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    const SensorChannel& channel = channels[c];
+    const std::string where =
+        fmt::format("{}, channel {} (column {})", name, channel.name, channel.output.column);
+    RecordNoise r = characterise(values[c], interval_s, where, kind_of(channel.sensor));
+    r.record = name;
+    result.channels.push_back({channel.name, channel.output.column, std::move(r)});
+    values[c] = {};  // its memory back before the next channel's Allan sums
+  }
+  return result;
+}
+
+}  // namespace
+
+ImuRecordNoise characterise_imu_record_noise(const std::filesystem::path& path,
+                                             const std::vector<SensorChannel>& channels,
+                                             const RecordLayout& layout, const RecordNoiseOptions& options) {
+  RecordReader reader(path, layout);  // refuses a record that lacks a channel's column, naming it
+  // At most 1 GiB reserved ahead over all channels.
+  const std::size_t reserve = std::min<std::size_t>(
+      count_lines(path), (std::size_t{1} << 27) / std::max<std::size_t>(channels.size(), 1));
+  return imu_noise(reader, channels, options, reserve);
+}
+
+ImuRecordNoise characterise_imu_record_noise(RecordReader& reader, const std::vector<SensorChannel>& channels,
+                                             const RecordNoiseOptions& options) {
+  return imu_noise(reader, channels, options, 0);
 }
 
 }  // namespace gyrocal

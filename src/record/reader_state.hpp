@@ -279,6 +279,13 @@ struct RecordReader::State {
   void read_header(std::string_view text);
   /// The layout's column keys and names, in slot order (time, main, counter, position, then each output).
   std::vector<std::pair<std::string, const std::string*>> mapped_columns() const;
+  /// What a refusal calls output `k`'s column, as the configuration names it: a lone sensor's
+  /// "record.output_column", an IMU's "[[channel]] 2's column" (k + 1: the channel's table in order; its
+  /// column is its name unless `column` is given).
+  std::string output_key(std::size_t k) const {
+    return layout && layout->outputs.empty() ? std::string("record.output_column")
+                                             : fmt::format("[[channel]] {}'s column", k + 1);
+  }
   /// Reads the head of a record through a layout (docs/records.md): blank lines, comment lines (metadata
   /// when they hold '='), an optional magic line, then the header.
   void read_mapped_head();
@@ -443,8 +450,9 @@ struct RecordReader::State {
         : layout->outputs.empty()
             ? fmt::format(", which reads as {} {} ((value - record.output_offset) / record.{})", output, unit,
                           outputs[k].scale_key())
-            : fmt::format(", which reads as {} {} ((value - offset) / scale of record.outputs[{}]{})", output,
-                          unit, k, output_increment[k] ? ", an increment divided by its interval" : "");
+            : fmt::format(", which reads as {} {} ((value - offset) / output_scale of [[channel]] {}{})",
+                          output, unit, k + 1,
+                          output_increment[k] ? ", an increment divided by its interval" : "");
     fail(fmt::format(
         "column {} ({}) is {}{}; an output is at most {} {} in magnitude (limits::kOutputMagnitude): no "
         "sensor "

@@ -151,14 +151,11 @@ void RecordReader::State::read_header(std::string_view text) {
 
 std::vector<std::pair<std::string, const std::string*>> RecordReader::State::mapped_columns() const {
   std::vector<std::pair<std::string, const std::string*>> mapped = {
-      {"time_column", &layout->time_column},
-      {"main_angle_column", &layout->main_angle_column},
-      {"counter_angle_column", &layout->counter_angle_column},
-      {"position_angle_column", &layout->position_angle_column}};
-  for (std::size_t i = 0; i < outputs.size(); ++i)
-    mapped.emplace_back(
-        layout->outputs.empty() ? std::string("output_column") : fmt::format("outputs[{}].column", i),
-        &outputs[i].column);
+      {"record.time_column", &layout->time_column},
+      {"record.main_angle_column", &layout->main_angle_column},
+      {"record.counter_angle_column", &layout->counter_angle_column},
+      {"record.position_angle_column", &layout->position_angle_column}};
+  for (std::size_t i = 0; i < outputs.size(); ++i) mapped.emplace_back(output_key(i), &outputs[i].column);
   return mapped;
 }
 
@@ -259,7 +256,7 @@ void RecordReader::State::read_mapped_header(std::string_view text) {
       if (columns[i] != wanted) continue;
       if (index != columns.size()) {
         fail(
-            fmt::format("the header line {} names '{}' twice (columns {} and {}), so record.{} is "
+            fmt::format("the header line {} names '{}' twice (columns {} and {}), so {} is "
                         "ambiguous",
                         header, printable(wanted), index + 1, i + 1, key));
       }
@@ -267,7 +264,7 @@ void RecordReader::State::read_mapped_header(std::string_view text) {
     }
     if (index == columns.size()) {
       const std::string problem = fmt::format(
-          "record.{} = '{}' is not a column of the header line {} (split at record.delimiter "
+          "{} = '{}' is not a column of the header line {} (split at record.delimiter "
           "{}, the columns found are {}){}",
           key, printable(wanted), header, delimiter_text(), found,
           names_any ? ""

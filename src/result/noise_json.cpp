@@ -46,6 +46,20 @@ nlohmann::json noise_to_json(const RecordNoise& r) {
   return j;
 }
 
+nlohmann::ordered_json imu_noise_to_json(const ImuRecordNoise& r) {
+  nlohmann::ordered_json j = {
+      {"record", r.record}, {"sensor", "imu"}, {"sample_rate_hz", r.sample_rate_hz}, {"samples", r.rows}};
+  j["channels"] = nlohmann::ordered_json::object();
+  for (const ChannelNoise& c : r.channels) {
+    nlohmann::ordered_json channel = {{"column", c.column}};
+    nlohmann::json lone = noise_to_json(c.noise);
+    lone.erase("record");
+    for (auto it = lone.begin(); it != lone.end(); ++it) channel[it.key()] = it.value();
+    j["channels"][c.name] = std::move(channel);
+  }
+  return j;
+}
+
 std::string noise_to_toml(const RecordNoise& r) {
   const bool accelerometer = r.sensor == SensorKind::kAccelerometer;
   std::string out = fmt::format("# Fitted by gyrocal noise from {} ({} samples at {} Hz).\n[{}.noise]\n",

@@ -285,6 +285,20 @@ SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& op
              [&sink](const RecordSample& s, double) { sink(s); });
 }
 
+SimulationSummary simulate_written(const Scenario& scenario, const SimulationOptions& options,
+                                   const SampleSink& sink) {
+  const Timeline timeline = make_timeline(scenario.test, scenario.model());
+  const std::vector<SensorChannel> channels = scenario.channels();
+  const bool imu = scenario.is_imu();
+  return run(scenario, timeline, options.seed.value_or(scenario.test.seed), options,
+             [&](const RecordSample& s, double interval_s) {
+               if (imu)
+                 sink(in_column_units(channels, s, interval_s));
+               else
+                 sink(s);
+             });
+}
+
 SimulationSummary simulate_record(const Scenario& scenario, const SimulationOptions& options,
                                   std::ostream& out) {
   const Timeline timeline = make_timeline(scenario.test, scenario.model());

@@ -1,11 +1,10 @@
 """A whole IMU's configuration from Python (issue 27; docs/imu.md): it loads, and every function that does not
-serve an IMU yet refuses it with the command line's sentence.
+serve an IMU yet refuses it with the command line's sentence (simulate, calibrate and noise serve one: test_imu.py).
 
 ctest runs this file as test_gyrocal.py is run (tests/CMakeLists.txt): PYTHONPATH=<build>/python and GYROCAL_CLI
 set to the command line's executable.
 """
 
-import numpy as np
 import pytest
 
 import gyrocal
@@ -31,9 +30,6 @@ def test_an_imu_configuration_loads():
 
 @pytest.mark.parametrize("name,call", [
     ("exact_inputs", lambda sc: gyrocal.exact_inputs(sc, time_s=0.0, beta_deg=0.0)),
-    ("simulate", lambda sc: gyrocal.simulate(sc, seed=1)),
-    ("calibrate", lambda sc: gyrocal.calibrate({"time_s": np.zeros(2)}, sc)),
-    ("noise", lambda sc: gyrocal.noise({"time_s": np.zeros(2), "gyro_deg_h": np.zeros(2)}, sc)),
 ])
 def test_functions_that_do_not_serve_an_imu_refuse_it(name, call):
     with pytest.raises(ValueError) as refusal:

@@ -18,6 +18,9 @@
 
 namespace gyrocal {
 
+struct SensorChannel;  // sensor/channel.hpp
+class RecordReader;    // record/record.hpp
+
 /// A fitted term as a sensor names it. characterise_noise() fits the terms of physics.md section 13 to the
 /// Allan variance of samples in the sensor's noise unit (deg/h, or ug) and states them as a gyro's; a
 /// sensor's value is `per_gyro_value` times that. For a gyro: [gyro.noise]'s keys, factor 1. For an
@@ -86,6 +89,42 @@ std::optional<double> output_grid_step(std::span<const double> values);
 RecordNoise characterise_record_noise(const std::filesystem::path& path,
                                       const RecordNoiseOptions& options = {},
                                       const std::optional<RecordLayout>& layout = std::nullopt);
+
+/// One channel of an IMU's static record, characterised on its own (docs/imu.md, "What serves an IMU";
+/// docs/noise.md, "An IMU's noise").
+struct ChannelNoise {
+  std::string name;    ///< the channel's name ("gx")
+  std::string column;  ///< the record's column that holds it
+  /// Its characterisation in its sensor's unit (deg/h for a gyro, ug for an accelerometer; noise.sensor says
+  /// which), terms keyed as its sensor's; noise.record is the record's name.
+  RecordNoise noise;
+};
+
+/// An IMU's static record, every channel characterised.
+struct ImuRecordNoise {
+  std::string record;           ///< the record's name
+  std::uint64_t rows = 0;       ///< rows read (an increment channel has one sample fewer: its first row)
+  double sample_rate_hz = 0.0;  ///< from the rows' mean interval, Hz
+  std::vector<ChannelNoise> channels;  ///< in the configuration's order
+};
+
+/// Reads the record at `path` once, through `layout` (Scenario::reading_layout(): one output column per
+/// channel, in `channels`' order), and characterises every channel's output on its own, as
+/// characterise_record_noise characterises a lone sensor's: a gyro channel in deg/h, its terms keyed as
+/// [gyro.noise]; an accelerometer channel in ug, keyed as [accelerometer.noise]. Each column is converted by
+/// its channel's scale and offset, and an increment column is divided by its row's interval (the reader's
+/// conversion, docs/records.md "Increments"); an increment channel's first row, which has no interval, is not
+/// one of its samples. Throws Error as characterise_record_noise does (a moving machine, uneven sampling), a
+/// channel's refusal (too few rows, a constant or clipped output) naming the channel and its column, and the
+/// reader's for a record that lacks a channel's column.
+ImuRecordNoise characterise_imu_record_noise(const std::filesystem::path& path,
+                                             const std::vector<SensorChannel>& channels,
+                                             const RecordLayout& layout,
+                                             const RecordNoiseOptions& options = {});
+/// The same from an open reader (through a layout with one output column per channel, in `channels`' order; a
+/// record held in memory, RecordReader::from_string); its name() stands for the record.
+ImuRecordNoise characterise_imu_record_noise(RecordReader& reader, const std::vector<SensorChannel>& channels,
+                                             const RecordNoiseOptions& options = {});
 
 /// The same for samples held in memory (time in s, output in deg/h, or in g for options.sensor an
 /// accelerometer); `name` stands for the record in messages.

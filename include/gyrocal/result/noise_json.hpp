@@ -19,6 +19,12 @@ namespace gyrocal {
 /// a grid (std 0: the grid's step is known to the values' precision).
 nlohmann::json noise_to_json(const RecordNoise& result);
 
+/// An IMU's noise (docs/contract.md): { "record", "sensor": "imu", "sample_rate_hz", "samples" (the rows),
+///   "channels": { name: { "column", "sensor", "unit", "sample_rate_hz", "samples", "allan", "terms",
+///   "chi2_per_dof" } } }, the channels in the configuration's order, each as noise_to_json writes a lone
+/// sensor's (without "record"), in its own sensor's unit and keys.
+nlohmann::ordered_json imu_noise_to_json(const ImuRecordNoise& result);
+
 /// The fitted terms as a `[gyro.noise]` (or `[accelerometer.noise]`) section that a configuration can take as
 /// it is: the keys of the section that the fit can measure (a term the fit did not keep is 0), each with its
 /// standard uncertainty in a comment, and the terms that are not keys of the section in comments.

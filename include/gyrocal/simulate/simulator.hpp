@@ -45,6 +45,13 @@ RecordMetadata simulation_metadata(const Scenario& scenario, const Timeline& tim
 SimulationSummary simulate(const Scenario& scenario, const SimulationOptions& options,
                            const SampleSink& sink);
 
+/// simulate() with each row as simulate_record writes it: an IMU's outputs in its columns' own units (offset
+/// + output_scale x value, an increment as the value times its row's interval, docs/records.md), in
+/// RecordSample::outputs in the channels' order; a lone sensor's rows as simulate() gives them (deg/h, or g).
+/// Throws Error as simulate() does.
+SimulationSummary simulate_written(const Scenario& scenario, const SimulationOptions& options,
+                                   const SampleSink& sink);
+
 /// What `simulate` would write for the scenario's test, without simulating it (plan prints it): its rows, its
 /// duration, s, and its size, bytes: the metadata and header exactly, the rows as the mean length of up to
 /// 2000 rows simulated at instants spread evenly over the test (the rows' numbers take their shortest exact
