@@ -19,6 +19,7 @@
 
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/units.hpp"
+#include "gyrocal/identify/dwell_model_route.hpp"
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/model/nominal.hpp"
 
@@ -98,7 +99,11 @@ std::vector<Reduction> releveled(const std::vector<Reduction>& reductions,
   out.reserve(reductions.size());
   for (std::size_t c = 0; c < reductions.size() && c < channels.size(); ++c) {
     std::optional<Reduction> own;
-    if (kind_of(channels[c].sensor) == SensorKind::kAccelerometer) {
+    // Only where a dwell follows its measured motion (else residual_levels has nothing to relevel, and its
+    // model terms would be one more reduction of every dwell).
+    const bool follows = std::any_of(reductions[c].dwells.begin(), reductions[c].dwells.end(),
+                                     [&](const Dwell& d) { return follows_measured_rate(model, d); });
+    if (follows && kind_of(channels[c].sensor) == SensorKind::kAccelerometer) {
       CalibrationOptions lone = options;
       lone.sensor = SensorKind::kAccelerometer;
       lone.estimate.clear();
