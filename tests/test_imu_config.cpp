@@ -548,20 +548,19 @@ TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
       "IMU\", "
       "lists the commands that do.";
   try {
-    refuse_imu(default_imu_scenario(), "sensitivity");
+    refuse_imu(default_imu_scenario(), "inputs");
     FAIL() << "an IMU was served";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "sensitivity" + expected_tail);
+    EXPECT_EQ(std::string(e.what()), "inputs" + expected_tail);
   }
-  EXPECT_NO_THROW(refuse_imu(default_scenario(), "sensitivity"));
-  EXPECT_NO_THROW(refuse_imu(default_accelerometer_scenario(), "sensitivity"));
+  EXPECT_NO_THROW(refuse_imu(default_scenario(), "inputs"));
+  EXPECT_NO_THROW(refuse_imu(default_accelerometer_scenario(), "inputs"));
 
   const std::filesystem::path dir = fresh_test_folder("imu-unserved");
   const std::string config = (dir / "imu.toml").string();
   { std::ofstream(config) << scenario_to_toml(default_imu_scenario()); }
   const std::string json = (dir / "out.json").string();
   const std::vector<std::pair<std::string, std::string>> commands = {
-      {"sensitivity", "sensitivity --config " + config + " --json " + json},
       {"montecarlo", "montecarlo --trials 2 --config " + config + " --json " + json},
       {"inputs", "inputs --beta-deg 0 --time-s 1 --config " + config + " --json " + json},
   };

@@ -11,9 +11,11 @@
 #include "cli.hpp"
 #include "gyrocal/analysis/sensitivity.hpp"
 #include "gyrocal/core/limits.hpp"
+#include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/coefficient_order.hpp"
 #include "gyrocal/result/sensitivity_json.hpp"
+#include "tables.hpp"
 
 namespace gyrocal::cli {
 namespace {
@@ -235,13 +237,25 @@ void register_sensitivity(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
-    refuse_imu(scenario, "sensitivity");
     SensitivityOptions options;
     options.calibration.gyro_model = chosen_gyro_model(opt->gyro_model, scenario);
     options.threshold = opt->threshold;
     options.threads = opt->threads;
     options.calibration.reduce = scenario.reduce;  // [reduce]: the reduction the study's calibrations use
     options.progress = ProgressBar("sensitivity");
+    if (scenario.is_imu()) {
+      // A whole IMU (docs/imu.md, "Sensitivity of an IMU"): its calibration's options as calibrate builds
+      // them (least squares, full compensation, [calibration] estimate), every channel's shifts.
+      options.calibration = calibration_options(scenario, CalibrationChoices{});
+      const ImuSensitivityResult result = imu_sensitivity_study(scenario, options);
+      if (!opt->json.empty()) {
+        nlohmann::ordered_json j = imu_sensitivity_to_json(result);
+        j["config"] = opt->config.empty() ? nlohmann::json(nullptr) : nlohmann::json(opt->config);
+        write_result(opt->json, std::move(j), "sensitivity", opt->force);
+      }
+      if (opt->json != "-") print_out("{}", imu_sensitivity_table(result));
+      return;
+    }
     const SensitivityResult result = sensitivity_study(scenario, options);
     if (!opt->json.empty()) {
       nlohmann::json j = sensitivity_to_json(result);

@@ -48,4 +48,32 @@ std::string imu_result_table(const ImuCalibrationResult& r) {
   return out;
 }
 
+std::string imu_sensitivity_table(const ImuSensitivityResult& r) {
+  std::string out = fmt::format(
+      "IMU error study: each machine error alone, not told to the calibration; an estimate is listed where "
+      "its shift exceeds {:g} of its predicted noise std (shift, and in std)\n",
+      r.threshold);
+  if (!r.not_identifiable.empty()) {
+    out += "not identifiable from this plan (no shift stated):";
+    for (const std::string& n : r.not_identifiable) out += " " + n;
+    out += "\n";
+  }
+  for (const ImuSensitivityRow& row : r.rows) {
+    out += fmt::format("\n{} = {:.6g} {}{}: ", row.term.label(), row.value, row.term.unit,
+                       row.typical ? " (typical)" : "");
+    if (row.matters.empty()) {
+      out += "no estimate moves by that much\n";
+      continue;
+    }
+    out += fmt::format("{} estimate{}\n", row.matters.size(), row.matters.size() == 1 ? "" : "s");
+    for (const std::string& name : row.matters) {
+      const double shift = row.shift.at(name), sigma = r.noise_std.at(name);
+      const PrintedUnit shown = printed_unit(r.units.at(name));
+      out += fmt::format("  {:<28} {:>+14.6g} {:<12} {:>+9.3g} std\n", name, shift * shown.factor, shown.unit,
+                         shift / sigma);
+    }
+  }
+  return out;
+}
+
 }  // namespace gyrocal::cli

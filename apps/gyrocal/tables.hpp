@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "gyrocal/analysis/record_noise.hpp"
+#include "gyrocal/analysis/sensitivity_imu.hpp"
 #include "gyrocal/identify/calibration.hpp"
 #include "gyrocal/identify/imu_calibration.hpp"
 #include "gyrocal/model/gyro.hpp"
@@ -30,6 +31,10 @@ PrintedUnit printed_unit(std::string_view unit);
 std::string result_table(const CalibrationResult& result);
 /// An IMU's calibration as text (imu_table.cpp): each channel's coefficients and misfit, the shared errors.
 std::string imu_result_table(const ImuCalibrationResult& result);
+
+/// An IMU's error study as text (imu_table.cpp): per machine error, the estimates it shifts beyond the
+/// threshold, each as its shift in its unit and in its predicted noise std.
+std::string imu_sensitivity_table(const ImuSensitivityResult& result);
 
 /// Several results side by side, with the truth in the first column when given.
 std::string comparison_table(const std::vector<std::string>& labels,

@@ -40,19 +40,18 @@ GyroNoise channel_output_noise(const Sensor& sensor) {
   return n;
 }
 
-ImuCalibrationResult predict_imu_calibration(const Scenario& s, const CalibrationOptions& options) {
-  check_test_feasible(s.test, options.reduce, s.centrifuge.rate_rad_s);
+std::vector<Reduction> planned_imu_reductions(const Scenario& s, const CentrifugeModel& truth,
+                                              const ReduceOptions& reduce) {
   const std::vector<SensorChannel>& channels = s.channels();
   Scenario planned = s;
-  planned.test = reduction_plan(s.test, reduction_kind(channels), options.reduce);
+  planned.test = reduction_plan(s.test, reduction_kind(channels), reduce);
   const Reduction plan = planned_reduction(planned);
-  const CentrifugeModel model = s.model();
   std::vector<Reduction> reductions;
   for (const SensorChannel& c : channels) {
     Reduction r = plan;
     for (ReducedPosition& p : r.positions) p.channel = static_cast<int>(reductions.size());
     const std::vector<PositionModelTerms> terms =
-        reduce_sensor_model_terms(r, model, options.reduce, c, kMaxModelSamplesPerDwell);
+        reduce_sensor_model_terms(r, truth, reduce, c, kMaxModelSamplesPerDwell);
     const Eigen::VectorXd u = true_products(c.sensor);
     for (std::size_t i = 0; i < r.positions.size(); ++i) {
       const DesignRow& row = terms[i].sensor_exact;
@@ -60,16 +59,26 @@ ImuCalibrationResult predict_imu_calibration(const Scenario& s, const Calibratio
       for (std::size_t k = 0; k < row.size; ++k) v += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
       r.positions[i].mean = v;
     }
-    set_predicted_std_errors(r, channel_output_noise(c.sensor), s.test.sample_rate_hz, options.reduce);
+    set_predicted_std_errors(r, channel_output_noise(c.sensor), s.test.sample_rate_hz, reduce);
     reductions.push_back(std::move(r));
   }
-  // The outputs are noise-free: no misfit, flat top or sign to test; the model terms on the bounded samples
-  // a prediction takes.
-  CalibrationOptions identify_options = options;
-  identify_options.test_misfit = false;
-  identify_options.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
-  identify_options.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
-  ImuCalibrationResult result = identify_imu(reductions, channels, model, identify_options, {});
+  return reductions;
+}
+
+CalibrationOptions planned_identify_options(const CalibrationOptions& options) {
+  CalibrationOptions o = options;
+  o.test_misfit = false;
+  o.least_squares.chi2_warning_sigma = std::numeric_limits<double>::infinity();
+  o.max_model_samples_per_dwell = kMaxModelSamplesPerDwell;
+  return o;
+}
+
+ImuCalibrationResult predict_imu_calibration(const Scenario& s, const CalibrationOptions& options) {
+  check_test_feasible(s.test, options.reduce, s.centrifuge.rate_rad_s);
+  const std::vector<SensorChannel>& channels = s.channels();
+  const CentrifugeModel model = s.model();
+  ImuCalibrationResult result = identify_imu(planned_imu_reductions(s, model, options.reduce), channels,
+                                             model, planned_identify_options(options), {});
   for (const SensorChannel& c : channels) {
     const GyroNoise n = channel_output_noise(c.sensor);
     const bool coloured =

@@ -75,4 +75,35 @@ nlohmann::json sensitivity_to_json(const SensitivityResult& r) {
   return out;
 }
 
+nlohmann::ordered_json imu_sensitivity_to_json(const ImuSensitivityResult& r) {
+  nlohmann::ordered_json out;
+  out["sensor"] = "imu";
+  out["threshold"] = r.threshold;
+  out["names"] = r.names;
+  out["units"] = nlohmann::ordered_json::object();
+  out["noise_std"] = nlohmann::ordered_json::object();
+  for (const std::string& name : r.names) {
+    out["units"][name] = r.units.at(name);
+    out["noise_std"][name] = r.noise_std.at(name);
+  }
+  out["not_identifiable"] = r.not_identifiable;
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (const ImuSensitivityRow& row : r.rows) {
+    nlohmann::ordered_json j;
+    j["error"] = row.term.error;
+    j["harmonic"] = row.term.harmonic;
+    j["phase_deg"] = row.term.phase_rad * kRadToDeg;
+    j["value"] = row.value;
+    j["unit"] = row.term.unit;
+    j["typical"] = row.typical;
+    j["shift"] = nlohmann::ordered_json::object();
+    for (const std::string& name : r.names)
+      if (const auto it = row.shift.find(name); it != row.shift.end()) j["shift"][name] = it->second;
+    j["matters"] = row.matters;
+    rows.push_back(std::move(j));
+  }
+  out["rows"] = std::move(rows);
+  return out;
+}
+
 }  // namespace gyrocal

@@ -1,6 +1,8 @@
 #pragma once
 // Before an IMU's test is run (docs/imu.md, "Planning an IMU"): what its calibration will give, per channel,
 // from the plan and each channel's configured noise, through the same joint solve a record gets.
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "gyrocal/config/scenario.hpp"
@@ -20,6 +22,17 @@ Eigen::VectorXd true_products(const Sensor& sensor);
 /// in (the sensor's: deg/h for a gyro; an accelerometer's output per g times g, K1 x 1e-6 per ug): what
 /// set_predicted_std_errors takes.
 GyroNoise channel_output_noise(const Sensor& sensor);
+
+/// The plan's dwells as calibrate_imu_record reduces a record of them (reduction_plan of reduction_kind), one
+/// reduction per channel (its positions numbered with the channel), each position's mean the channel's
+/// noise-free reduced output at its configured truth on the machine `truth`, its standard errors from its
+/// configured white noise (set_predicted_std_errors with channel_output_noise).
+std::vector<Reduction> planned_imu_reductions(const Scenario& scenario, const CentrifugeModel& truth,
+                                              const ReduceOptions& reduce);
+
+/// `options` for identify_imu on noise-free planned reductions: no misfit, flat top or sign tested (chi2 is
+/// zero by construction), the model terms on the bounded samples a prediction takes.
+CalibrationOptions planned_identify_options(const CalibrationOptions& options);
 
 /// `gyrocal plan` of an IMU: the plan's dwells reduced as calibrate_imu_record reduces a record of it (to the
 /// harmonic content of a revolution when any channel is an accelerometer), every channel's noise-free outputs

@@ -124,7 +124,7 @@ Scenario default_imu_scenario();
 /// Throws Error "<command> does not serve an IMU configuration yet ([sensor] kind = "imu"); docs/imu.md,
 /// "What serves an IMU", lists the commands that do." when `scenario` describes a whole IMU (is_imu());
 /// nothing for a lone sensor. The one check at the entry of every command that does not serve an IMU yet
-/// (sensitivity, montecarlo, noise, inputs, the Python module's functions).
+/// (docs/imu.md, "What serves an IMU", lists both kinds).
 void refuse_imu(const Scenario& scenario, std::string_view command);
 
 /// The sentence refuse_imu throws, for `command` and what it was given (`input`: "configuration", or

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gyrocal/analysis/sensitivity.hpp"
+#include "gyrocal/analysis/sensitivity_imu.hpp"
 
 namespace gyrocal {
 
@@ -17,5 +18,12 @@ namespace gyrocal {
 /// true where the configuration had zero and the typical magnitude was used. Shifts are in each estimate's
 /// unit.
 nlohmann::json sensitivity_to_json(const SensitivityResult& result);
+
+/// An IMU's study (docs/contract.md, "IMU"): { "sensor": "imu", "threshold", "names": [every estimate in
+/// order: "gx.dF" .. "az.delta_o", then the estimated errors' labels], "units": {name: unit}, "noise_std":
+/// {name: predicted std}, "not_identifiable": [names], "rows": [ { "error", "harmonic", "phase_deg", "value",
+/// "unit", "typical", "shift": {name: shift}, "matters": [names] } ] }; the error not told to the
+/// calibration, shifts in each estimate's unit.
+nlohmann::ordered_json imu_sensitivity_to_json(const ImuSensitivityResult& result);
 
 }  // namespace gyrocal
