@@ -562,10 +562,9 @@ TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   const std::string json = (dir / "out.json").string();
   const std::vector<std::pair<std::string, std::string>> commands = {
       {"sensitivity", "sensitivity --config " + config + " --json " + json},
-      {"montecarlo", "montecarlo --trials 2 --config " + config + " --json " + json},
       {"inputs", "inputs --beta-deg 0 --time-s 1 --config " + config + " --json " + json},
   };
-  // (noise serves an IMU: tests/test_imu_noise.cpp.)
+  // (noise serves an IMU: tests/test_imu_noise.cpp; montecarlo --samples: tests/test_imu_montecarlo.cpp.)
   for (const auto& [command, args] : commands) {
     const CliOutcome o = run_cli(args, dir);
     EXPECT_EQ(o.status, 1) << command << ": " << o.err;

@@ -70,13 +70,17 @@ std::string montecarlo_imu_table(const ImuMonteCarloResult& r, double seconds) {
       "stated std.\n",
       r.trials, r.seed, seconds, seconds / static_cast<double>(r.trials), r.channels.size(),
       to_string(r.gyro_model));
-  const auto header = [](const std::string& what) {
-    return fmt::format("{:<16}{:>13}{:>13}{:>13}{:>13}{:>9}{:>8}  {}\n", what, "mean error", "std",
+  std::size_t width = 16;  // the rate errors' names are longer than the coefficients'
+  for (const ImuChannelDistribution& c : r.channels)
+    for (const ImuEstimateDistribution& e : c.coefficients) width = std::max(width, e.name.size() + 2);
+  for (const ImuEstimateDistribution& e : r.machine_errors) width = std::max(width, e.name.size() + 2);
+  const auto header = [width](const std::string& what) {
+    return fmt::format("{:<{}}{:>13}{:>13}{:>13}{:>13}{:>9}{:>8}  {}\n", what, width, "mean error", "std",
                        "stated std", "planned std", "z mean", "z std", "unit");
   };
-  const auto row = [&r](const ImuEstimateDistribution& e) {
-    return fmt::format("{:<16}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}{:>9.3g}{:>8.3g}  {}{}\n", e.name, e.mean,
-                       e.std, e.stated_std, e.planned_std, e.z_mean, e.z_std, e.unit,
+  const auto row = [&r, width](const ImuEstimateDistribution& e) {
+    return fmt::format("{:<{}}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}{:>9.3g}{:>8.3g}  {}{}\n", e.name, width,
+                       e.mean, e.std, e.stated_std, e.planned_std, e.z_mean, e.z_std, e.unit,
                        e.trials < r.trials ? fmt::format(" ({} trials identified it)", e.trials) : "");
   };
   for (const ImuChannelDistribution& c : r.channels) {
@@ -84,13 +88,13 @@ std::string montecarlo_imu_table(const ImuMonteCarloResult& r, double seconds) {
     s += header("coefficient");
     for (const ImuEstimateDistribution& e : c.coefficients) s += row(e);
     for (const auto& [name, reason] : c.not_identifiable)
-      s += fmt::format("{:<16}not identifiable: {}\n", name, reason);
+      s += fmt::format("{:<{}}not identifiable: {}\n", name, width, reason);
   }
   if (!r.machine_errors.empty() || !r.not_identifiable.empty()) {
     s += "\nmachine errors estimated\n" + header("error");
     for (const ImuEstimateDistribution& e : r.machine_errors) s += row(e);
     for (const auto& [name, reason] : r.not_identifiable)
-      s += fmt::format("{:<16}not identifiable: {}\n", name, reason);
+      s += fmt::format("{:<{}}not identifiable: {}\n", name, width, reason);
   }
   s += "\nsources: each channel's [channel.noise]";
   for (std::size_t k = 0; k < r.sources.size(); ++k)
