@@ -116,7 +116,7 @@ TEST(ImuMonteCarlo, AnErrorTheCalibrationIsNotToldMovesTheScaleFactorsBeyondThei
 }
 
 TEST(ImuMonteCarlo, TheSameSeedGivesTheSameResultWhateverTheThreads) {
-  const long long n = testing::sanitized() ? 3 : 4;
+  const long long n = testing::sanitized() ? 2 : 4;
   const Scenario s = short_imu();
   const std::string one = montecarlo_imu_to_json(monte_carlo_imu(s, samples(s, n, 1))).dump();
   const std::string two = montecarlo_imu_to_json(monte_carlo_imu(s, samples(s, n, 2))).dump();
