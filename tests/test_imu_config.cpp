@@ -545,8 +545,7 @@ TEST(ImuConfig, ALoneSensorsSectionsAreRefusedInAnImu) {
 TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   const std::string expected_tail =
       " does not serve an IMU configuration yet ([sensor] kind = \"imu\"); docs/imu.md, \"What serves an "
-      "IMU\", "
-      "lists the commands that do.";
+      "IMU\", lists the commands that do.";
   try {
     refuse_imu(default_imu_scenario(), "inputs");
     FAIL() << "an IMU was served";
@@ -561,10 +560,10 @@ TEST(ImuConfig, CommandsThatDoNotServeAnImuRefuseItInOneSentence) {
   { std::ofstream(config) << scenario_to_toml(default_imu_scenario()); }
   const std::string json = (dir / "out.json").string();
   const std::vector<std::pair<std::string, std::string>> commands = {
-      {"montecarlo", "montecarlo --trials 2 --config " + config + " --json " + json},
       {"inputs", "inputs --beta-deg 0 --time-s 1 --config " + config + " --json " + json},
   };
-  // (noise serves an IMU: tests/test_imu_noise.cpp.)
+  // (plan, sensitivity, noise and montecarlo --samples serve an IMU: tests/test_imu_cli.cpp,
+  // test_imu_sensitivity.cpp, test_imu_noise.cpp, test_imu_montecarlo.cpp.)
   for (const auto& [command, args] : commands) {
     const CliOutcome o = run_cli(args, dir);
     EXPECT_EQ(o.status, 1) << command << ": " << o.err;

@@ -8,10 +8,13 @@
 
 #include "cli.hpp"
 #include "gyrocal/analysis/montecarlo.hpp"
+#include "gyrocal/analysis/montecarlo_imu.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
+#include "gyrocal/identify/scenario_options.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/result/coefficient_order.hpp"
+#include "gyrocal/result/montecarlo_imu_json.hpp"
 #include "gyrocal/result/montecarlo_json.hpp"
 
 namespace gyrocal::cli {
@@ -53,6 +56,73 @@ std::string montecarlo_table(const MonteCarloResult& r, double seconds) {
   for (std::size_t k = 0; k < r.sources.size(); ++k)
     s += fmt::format("  {} {:g} {}", r.sources[k], r.source_std[k], r.source_units[k]);
   return s + "\n";
+}
+
+/// An IMU's table: per channel each coefficient's mean error, its std, the mean stated std, the plan's std
+/// and the z-score's mean and std; then the estimated machine errors alike.
+std::string montecarlo_imu_table(const ImuMonteCarloResult& r, double seconds) {
+  std::string s = fmt::format(
+      "{} trials (samples mode, seed {}) in {:.2f} s ({:.3g} s a trial): an IMU of {} "
+      "channels, least squares with compensation full, which knows the configured errors only, gyro model "
+      "{}.\nError = estimate - truth (a machine error's truth: its value drawn in the trial). Stated: the "
+      "mean "
+      "over the trials of the std each calibration states; planned: the plan's. z = error / the trial's "
+      "stated std.\n",
+      r.trials, r.seed, seconds, seconds / static_cast<double>(r.trials), r.channels.size(),
+      to_string(r.gyro_model));
+  std::size_t width = 16;  // the rate errors' names are longer than the coefficients'
+  for (const ImuChannelDistribution& c : r.channels)
+    for (const ImuEstimateDistribution& e : c.coefficients) width = std::max(width, e.name.size() + 2);
+  for (const ImuEstimateDistribution& e : r.machine_errors) width = std::max(width, e.name.size() + 2);
+  const auto header = [width](const std::string& what) {
+    return fmt::format("{:<{}}{:>13}{:>13}{:>13}{:>13}{:>9}{:>8}  {}\n", what, width, "mean error", "std",
+                       "stated std", "planned std", "z mean", "z std", "unit");
+  };
+  const auto row = [&r, width](const ImuEstimateDistribution& e) {
+    return fmt::format("{:<{}}{:>13.4g}{:>13.4g}{:>13.4g}{:>13.4g}{:>9.3g}{:>8.3g}  {}{}\n", e.name, width,
+                       e.mean, e.std, e.stated_std, e.planned_std, e.z_mean, e.z_std, e.unit,
+                       e.trials < r.trials ? fmt::format(" ({} trials identified it)", e.trials) : "");
+  };
+  for (const ImuChannelDistribution& c : r.channels) {
+    s += fmt::format("\nchannel {} ({})\n", c.name, to_string(c.sensor));
+    s += header("coefficient");
+    for (const ImuEstimateDistribution& e : c.coefficients) s += row(e);
+    for (const auto& [name, reason] : c.not_identifiable)
+      s += fmt::format("{:<{}}not identifiable: {}\n", name, width, reason);
+  }
+  if (!r.machine_errors.empty() || !r.not_identifiable.empty()) {
+    s += "\nmachine errors estimated\n" + header("error");
+    for (const ImuEstimateDistribution& e : r.machine_errors) s += row(e);
+    for (const auto& [name, reason] : r.not_identifiable)
+      s += fmt::format("{:<{}}not identifiable: {}\n", name, width, reason);
+  }
+  s += "\nsources: each channel's [channel.noise]";
+  for (std::size_t k = 0; k < r.sources.size(); ++k)
+    s += fmt::format("  {} {:g} {}", r.sources[k], r.source_std[k], r.source_units[k]);
+  return s + "\n";
+}
+
+/// `montecarlo` of an IMU (docs/montecarlo.md, "An IMU"): the samples mode, the joint calibration with the
+/// configuration's [calibration] estimate.
+void run_imu_montecarlo(const Scenario& scenario, MonteCarloOptions options, const std::string& compensation,
+                        const std::string& method, const std::string& gyro_model, const std::string& config,
+                        const std::string& json, bool force) {
+  CalibrationChoices choices;
+  choices.method = method;
+  choices.compensation = compensation == "self" ? "full" : compensation;
+  choices.gyro_model = gyro_model;
+  options.calibration = calibration_options(scenario, choices);
+  options.self = compensation == "self";
+  options.progress = ProgressBar("Monte Carlo");
+  const auto start = std::chrono::steady_clock::now();
+  const ImuMonteCarloResult result = monte_carlo_imu(scenario, options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!json.empty()) {
+    nlohmann::ordered_json j = montecarlo_imu_to_json(result);
+    j["config"] = config.empty() ? nlohmann::json(nullptr) : nlohmann::json(config);
+    write_result(json, j, "montecarlo", force);
+  }
+  if (json != "-") print_out("{}", montecarlo_imu_table(result, seconds));
 }
 
 /// The most trials gyrocal runs. Fast mode: about 2 us a trial and core on the default scenario (two
@@ -119,12 +189,16 @@ void register_montecarlo(CLI::App& app) {
     refuse_to_overwrite_input(opt->json, opt->config);
     check_output(opt->json, OutputKind::kResult, opt->force, "--json");
     const Scenario scenario = load_configuration(opt->config);
-    refuse_imu(scenario, "montecarlo");
     MonteCarloOptions options;
     options.trials = opt->trials;
     options.seed = seed->count() ? opt->seed : scenario.test.seed;
     options.mode = opt->samples ? MonteCarloMode::kSamples : MonteCarloMode::kFast;
     options.threads = opt->threads;
+    if (scenario.is_imu()) {
+      run_imu_montecarlo(scenario, options, opt->compensation, opt->method, opt->gyro_model, opt->config,
+                         opt->json, opt->force);
+      return;
+    }
     options.calibration.method = parse_method(opt->method);
     options.self = opt->compensation == "self";
     options.calibration.compensation = parse_compensation(options.self ? "full" : opt->compensation);
