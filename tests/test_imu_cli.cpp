@@ -153,6 +153,16 @@ TEST(ImuCli, PlanPredictsTheUncertaintiesCalibrateStates) {
     // The plan's outputs are the truth's: the estimate is the configured (zero) error, to rounding.
     EXPECT_LE(std::abs(e.at("value").get<double>()), 1e-6 * e.at("std").get<double>()) << e.at("error");
   }
+  // --gyro-model reaches every gyro channel (it once kept the configuration's model): drift+rate adds the
+  // scale factor error and the input axis' two misalignments to each gyro's ten coefficients.
+  const auto rate = run_cli(
+      "plan --config " + at(dir, "short.toml") + " --gyro-model drift+rate --json " + at(dir, "rate.json"),
+      dir);
+  ASSERT_EQ(rate.status, 0) << rate.err;
+  const nlohmann::json r = nlohmann::json::parse(slurp(dir / "rate.json"));
+  for (const std::string n : {"gx", "gy", "gz"})
+    EXPECT_EQ(r.at("channels").at(n).at("coefficients").size(), 13u) << n;
+  EXPECT_EQ(r.at("channels").at("ax").at("coefficients").size(), 11u);
 }
 
 }  // namespace

@@ -361,8 +361,14 @@ const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) con
 }
 
 ImuCalibrationResult identify_imu(const std::vector<Reduction>& record_reductions,
-                                  const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
-                                  const CalibrationOptions& options, std::span<const OutputRange> ranges) {
+                                  const std::vector<SensorChannel>& configured_channels,
+                                  const CentrifugeModel& model, const CalibrationOptions& options,
+                                  std::span<const OutputRange> ranges) {
+  // Every gyro channel fits the options' gyro model (--gyro-model, else [calibration] gyro_model), as a lone
+  // gyro's least squares does: the channels carry the one the configuration was loaded with.
+  std::vector<SensorChannel> channels = configured_channels;
+  for (SensorChannel& c : channels)
+    if (auto* g = std::get_if<Gyro>(&c.sensor)) g->model = options.gyro_model;
   if (channels.empty() || record_reductions.size() != channels.size())
     throw Error(
         fmt::format("an IMU's calibration takes one reduction per channel: {} channels, {} reductions.",

@@ -71,9 +71,10 @@ struct ImuCalibrationResult {
 
 /// The joint identification of an IMU from its channels' reductions (one per channel, in `channels`' order,
 /// from one pass over the record: reduce_record_channels), on `model` (the machine with its configured
-/// errors). The options' method must be least squares with full compensation; their `estimate` are the shared
-/// machine errors, estimated by Gauss-Newton on the exact model as a lone sensor's self-calibration
-/// (docs/self_calibration.md). Throws gyrocal::Error, naming the channel, for a channel whose residuals are
+/// errors). Every gyro channel fits options.gyro_model (the channels' own model is the one their
+/// configuration was loaded with). The options' method must be least squares with full compensation; their
+/// `estimate` are the shared machine errors, estimated by Gauss-Newton on the exact model as a lone sensor's
+/// self-calibration (docs/self_calibration.md). Throws gyrocal::Error, naming the channel, for a channel whose residuals are
 /// many times its noise (a dead, clipped or sign-flipped channel) and for the mount's misalignment among the
 /// errors estimated (each channel's tilts are measured against the mount: docs/imu.md).
 /// `ranges`, when given (one per channel, over the record's samples), let a channel's flat top (saturated or
