@@ -24,6 +24,9 @@ std::string imu_result_table(const ImuCalibrationResult& r) {
       out += fmt::format("{:<16} {:>30}  {}\n", e.name,
                          e.identifiable ? format_value_std(e.value, e.std) : std::string("not identifiable"),
                          e.unit);
+    if (!c.combinations.empty()) out += "combinations the data identify\n";
+    for (const NamedEstimate& e : c.combinations)
+      out += fmt::format("  {} = {}  {}\n", e.name, format_value_std(e.value, e.std), e.unit);
   }
   if (!r.machine_errors.empty()) {
     out += fmt::format("\nmachine errors estimated ({} Gauss-Newton iterations)\n", r.iterations);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -24,6 +25,7 @@
 #include "gyrocal/model/nominal.hpp"
 
 #include "closed_form_identify.hpp"
+#include "imu_combinations.hpp"
 #include "position_covariance.hpp"
 #include "residual_levels.hpp"
 #include "self_calibration.hpp"
@@ -354,6 +356,46 @@ std::vector<InputAxisAngle> input_axis_angles(const std::vector<SensorChannel>& 
 
 }  // namespace
 
+/// A channel's combinations (identify_detail::channel_combinations) as estimates of its coefficients: a
+/// gyro's products are its coefficients (a combination that takes a drift+rate gyro's (1 + e) dO or dS is not
+/// stated: it is not one of its coefficients'); an accelerometer's (K1 K0, K1, K1 K2, ...) divided by its
+/// fitted K1 (a combination that takes K1 itself is not stated), K1's own uncertainty (~1e-6 of it) left
+/// out of the std. `coefficients`: the channel's table (names and units, in its products' order);
+/// `std_of(row)`: the std of row' x over the joint unknowns. Each in its pivot coefficient's unit.
+std::vector<NamedEstimate> stated_combinations(const SensorChannel& channel, const Eigen::VectorXd& u,
+                                               const std::vector<CoefficientEstimate>& coefficients,
+                                               const LeastSquaresSolution& sol, Eigen::Index offset,
+                                               Eigen::Index nc,
+                                               const std::function<double(const Eigen::VectorXd&)>& std_of) {
+  std::vector<NamedEstimate> out;
+  // The coefficients' names, in the products' order (a product K1 Kx named by its coefficient Kx).
+  std::vector<std::string> names;
+  for (const CoefficientEstimate& e : coefficients) names.push_back(e.name);
+  if (static_cast<Eigen::Index>(names.size()) < nc) return out;
+  const bool accelerometer = kind_of(channel.sensor) == SensorKind::kAccelerometer;
+  const auto scale_at = static_cast<Eigen::Index>(AccelCoefficient::K1);
+  for (const identify_detail::ChannelCombination& comb :
+       identify_detail::channel_combinations(sol, offset, nc)) {
+    const Eigen::VectorXd& w = comb.weights;
+    const double largest = w.cwiseAbs().maxCoeff();
+    if (accelerometer && std::abs(w[scale_at]) > 1e-12 * largest) continue;
+    if (!accelerometer && nc > static_cast<Eigen::Index>(kNumGyroCoefficients) + 1 &&
+        w.tail(2).cwiseAbs().maxCoeff() > 1e-12 * largest)
+      continue;
+    const double divisor = accelerometer ? u[scale_at] : 1.0;
+    Eigen::VectorXd row = Eigen::VectorXd::Zero(sol.estimate.size());
+    row.segment(offset, nc) = w / divisor;
+    NamedEstimate e;
+    e.name = identify_detail::combination_text(comb, names);
+    e.unit = coefficients[static_cast<std::size_t>(comb.pivot)].unit;
+    e.value = w.dot(u) / divisor;
+    e.std = std_of(row);
+    e.coefficients.assign(w.data(), w.data() + w.size());
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
 const ImuChannelResult* ImuCalibrationResult::channel(std::string_view name) const {
   for (const ImuChannelResult& c : channels)
     if (c.name == name) return &c;
@@ -591,6 +633,11 @@ ImuCalibrationResult identify_imu(const std::vector<Reduction>& record_reduction
       e.std = std::sqrt(row.dot(js.covariance * row)) * student(reductions, problems, js, row) *
               out.misfit.scale * (k1 ? std::abs(output_scale) : 1.0);
     }
+    out.combinations =
+        stated_combinations(ch, u, out.coefficients, sol, offsets[c], nc, [&](const Eigen::VectorXd& row) {
+          return std::sqrt(row.dot(js.covariance * row)) * student(reductions, problems, js, row) *
+                 out.misfit.scale;
+        });
     r.channels.push_back(std::move(out));
   }
   // The triad's geometry, from the channels whose two tilts are both fitted.

@@ -16,8 +16,13 @@ nlohmann::ordered_json imu_calibration_to_json(const ImuCalibrationResult& r) {
     nlohmann::ordered_json one;
     one["sensor"] = std::string(to_string(c.sensor));
     one["coefficients"] = coefficients_to_json(c.coefficients);
-    // A plan that identifies every channel leaves no combination to state (docs/imu.md).
+    // What the plan leaves unidentifiable of it, combined as the data identify it (docs/imu.md).
     one["combinations"] = nlohmann::ordered_json::array();
+    for (const NamedEstimate& e : c.combinations) {
+      nlohmann::ordered_json x = {{"name", e.name}, {"value", e.value}, {"std", e.std}, {"unit", e.unit}};
+      x["coefficients"] = e.coefficients;
+      one["combinations"].push_back(std::move(x));
+    }
     one["misfit"] = misfit_to_json(c.misfit);
     one["misfit"]["chi2"] = c.misfit.chi2;
     one["misfit"]["dof"] = c.misfit.dof;

@@ -28,6 +28,10 @@ struct ImuChannelResult {
   /// Its coefficients, named and unitted as the lone sensor's (an accelerometer's K1 in the channel's
   /// output units per g: its output_scale times the fitted ratio), std from the joint solve.
   std::vector<CoefficientEstimate> coefficients;
+  /// Where its plan leaves coefficients unidentifiable: the combinations of them the data identify (docs/
+  /// imu.md, "When a plan leaves a coefficient unidentifiable"), each with its weights on the coefficients
+  /// (NamedEstimate::coefficients, the pivot's 1) in its pivot coefficient's unit.
+  std::vector<NamedEstimate> combinations;
   std::vector<double> products;            ///< the fitted products, in the sensor's design-row order
   std::vector<ReducedPosition> positions;  ///< its reduced positions (each with its channel's number)
   std::vector<double> residuals;           ///< per position: reduced output - fitted model, output unit
@@ -74,11 +78,11 @@ struct ImuCalibrationResult {
 /// errors). Every gyro channel fits options.gyro_model (the channels' own model is the one their
 /// configuration was loaded with). The options' method must be least squares with full compensation; their
 /// `estimate` are the shared machine errors, estimated by Gauss-Newton on the exact model as a lone sensor's
-/// self-calibration (docs/self_calibration.md). Throws gyrocal::Error, naming the channel, for a channel whose residuals are
-/// many times its noise (a dead, clipped or sign-flipped channel) and for the mount's misalignment among the
-/// errors estimated (each channel's tilts are measured against the mount: docs/imu.md).
-/// `ranges`, when given (one per channel, over the record's samples), let a channel's flat top (saturated or
-/// clipped) be refused by its name before anything is fitted.
+/// self-calibration (docs/self_calibration.md). Throws gyrocal::Error, naming the channel, for a channel
+/// whose residuals are many times its noise (a dead, clipped or sign-flipped channel) and for the mount's
+/// misalignment among the errors estimated (each channel's tilts are measured against the mount:
+/// docs/imu.md). `ranges`, when given (one per channel, over the record's samples), let a channel's flat top
+/// (saturated or clipped) be refused by its name before anything is fitted.
 ImuCalibrationResult identify_imu(const std::vector<Reduction>& reductions,
                                   const std::vector<SensorChannel>& channels, const CentrifugeModel& model,
                                   const CalibrationOptions& options,
