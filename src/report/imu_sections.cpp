@@ -42,9 +42,10 @@ std::vector<std::string> channel_order(const json& result) {
   const json& channels = result.at("channels");
   if (const json* positions = find(result, "positions"); positions && positions->is_array())
     for (const json& p : *positions)
-      if (const json* c = find(p, "channel");
-          c && c->is_string() && channels.contains(*c) && seen.insert(c->get<std::string>()).second)
-        names.push_back(c->get<std::string>());
+      if (const json* c = find(p, "channel"); c && c->is_string()) {
+        const std::string& name = c->get_ref<const std::string&>();
+        if (channels.contains(name) && seen.insert(name).second) names.push_back(name);
+      }
   for (const auto& [name, c] : channels.items())
     if (seen.insert(name).second) names.push_back(name);
   return names;
