@@ -252,9 +252,10 @@ bool is_imu_result(const json& result) {
   if (!result.is_object()) return false;
   const std::string kind = result_kind(result);
   if (kind != "calibration" && kind != "plan") return false;
+  // A lone sensor's result has no `channels`: one that has them is an IMU's, checked as one whatever its
+  // `sensor` says (check_imu_result refuses any but "imu").
   const auto sensor = result.find("sensor");
-  if (sensor != result.end()) return *sensor == "imu";
-  return result.contains("channels");
+  return (sensor != result.end() && *sensor == "imu") || result.contains("channels");
 }
 
 std::string render_imu_html_report(const json& result, const HtmlReportOptions& options) {

@@ -14,8 +14,9 @@
 
 namespace gyrocal {
 
-/// True when `result` is an IMU's calibration or plan result: a JSON object whose `sensor` is "imu", or
-/// which keys its estimates by channel (`channels`) and is not a unit's history (result_kind).
+/// True when `result` is an IMU's calibration or plan result (result_kind, so not a unit's history): a JSON
+/// object whose `sensor` is "imu", or which keys its estimates by channel (`channels`), whatever its `sensor`
+/// (check_imu_result then refuses a `sensor` other than "imu").
 bool is_imu_result(const nlohmann::json& result);
 
 /// Checks an IMU result before its page is drawn (docs/contract.md, "IMUs"): `channels` (1 to
