@@ -275,6 +275,9 @@ TEST_F(ImuReport, AMalformedResultIsRefusedNamingItsKeyAndNothingIsWritten) {
   };
   const std::vector<Case> cases = {
       {"channels is missing", [](json& r) { r.erase("channels"); }},
+      // A result with channels is an IMU's whatever its sensor says.
+      {"sensor must be a string, not an array", [](json& r) { r["sensor"] = json::array(); }},
+      {"sensor must be \"imu\", not a string (\"gyro\")", [](json& r) { r["sensor"] = "gyro"; }},
       {"channels holds no channel", [](json& r) { r["channels"] = json::object(); }},
       {"channels.gy.coefficients.dO.std must be a number (or null), not a string (\"0.1\")",
        [](json& r) { r["channels"]["gy"]["coefficients"]["dO"]["std"] = "0.1"; }},
