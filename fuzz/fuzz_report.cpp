@@ -3,7 +3,8 @@
 // when it cannot open a JSON object, and parse_result_json (valid JSON holding an object, at most
 // limits::kResultDepth levels deep and limits::kResultNames distinct names); then the check that some section
 // is present, and the HTML report itself (src/report/html_report.cpp), which reads every section and turns a
-// section it cannot read into a problem sentence. A clean refusal (gyrocal::Error) is fine; anything else
+// section it cannot read into a problem sentence (an IMU's result is checked whole first and refused by the
+// key's path). A clean refusal (gyrocal::Error) is fine; anything else
 // escaping, a crash, a leak or undefined behaviour is a finding. So is a problem sentence that carries a
 // library's internal message (nlohmann::json's "[json.exception...]") instead of one of ours, and a file
 // read that answers otherwise than the same bytes parsed in memory. The same JSON is also read as `history
@@ -91,7 +92,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::string html;
   try {
     html = gyrocal::render_html_report(result, options);
-  } catch (const gyrocal::Error&) {
+  } catch (const gyrocal::Error& e) {
+    // An IMU's result is checked whole and refused by the key's path (src/report/imu_check.cpp): a sentence
+    // of ours, never the library's.
+    if (std::string_view(e.what()).find("[json.exception.") != std::string_view::npos) {
+      std::fprintf(stderr, "internal message in a report refusal: %s\n", e.what());
+      std::abort();
+    }
     return 0;
   }
   if (html.rfind("<!DOCTYPE html>", 0) != 0) std::abort();

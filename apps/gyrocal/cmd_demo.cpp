@@ -137,20 +137,15 @@ void accelerometer_demo(const std::string& out, bool force) {
 
 /// `gyrocal demo --sensor imu`: the default IMU (docs/imu.md: six channels written as increments) on the
 /// accelerometer demo's arm, simulated, calibrated jointly with the radius error and stretch estimated from
-/// the unit's own data, every channel's truth beside its estimates; DIR/record.csv and DIR/result.json (the
-/// HTML report does not serve an IMU yet).
+/// the unit's own data, every channel's truth beside its estimates; DIR/record.csv, DIR/result.json and
+/// DIR/report.html (imu_report.hpp).
 void imu_demo(const std::string& out, bool force) {
   const Scenario s = demo_imu_scenario();
   AtomicOutputFolder folder(out, "the demo's outputs");
-  const auto rule = [force](OutputKind kind) {
-    return [force, kind](const std::filesystem::path& existing) {
-      may_replace(existing.string(), kind, force, "--out");
-    };
-  };
-  const std::string record_staged = folder.path("record.csv", rule(OutputKind::kDemoRecord)).string();
-  const std::string result_staged = folder.path("result.json", rule(OutputKind::kResult)).string();
-  const std::string record = folder.final_path("record.csv").string();
-  const std::string result_path = folder.final_path("result.json").string();
+  const DemoFiles files = stage_demo_files(folder, force);
+  const std::string& record_staged = files.record_staged;
+  const std::string& record = files.record;
+  const std::string& result_path = files.result;
   print_out(
       "gyrocal demo --sensor imu: the default IMU ({} channels as increments) on R0 {} m + {:g} um, rates {} "
       "rad/s, static set, four beta, {} gamma.\n",
@@ -194,9 +189,15 @@ void imu_demo(const std::string& out, bool force) {
   j["truth_machine"] = {{"radius_error_m", s.errors.radius_error_m},
                         {"radius_stretch_m_per_rad2_s2", s.errors.radius_stretch_m_per_rad2_s2}};
   mark_result(j, "calibration");
-  write_file_atomically(result_staged, j.dump(2) + "\n", false);
+  write_file_atomically(files.result_staged, j.dump(2) + "\n", false);
+  // The page is drawn from the result as `gyrocal report` reads it back (imu_report.hpp).
+  HtmlReportOptions report;
+  report.title = "gyrocal demo: the default IMU";
+  report.source = result_path;
+  write_file_atomically(files.report_staged, render_html_report(nlohmann::json::parse(j.dump()), report),
+                        false);
   folder.commit();
-  print_out("\nwrote {} and {}\n", record, result_path);
+  print_out("\nwrote {}, {} and {}\n", record, result_path, files.report);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "gyrocal/history/read.hpp"
 #include "gyrocal/report/history_report.hpp"
 #include "gyrocal/report/html_report.hpp"
+#include "gyrocal/report/imu_report.hpp"
 
 namespace gyrocal::cli {
 
@@ -100,9 +101,9 @@ void register_report(CLI::App& app) {
                       "from its database: "
                       "gyrocal report --history DATABASE --unit SERIAL --html FILE.",
                       opt->result));
-    // An IMU's result keys its coefficients by channel (docs/imu.md), which the report does not draw yet.
-    if (result_json.is_object() && result_json.contains("channels"))
-      throw Error(imu_not_served("report", "result"));
+    // An IMU's result (its estimates keyed by channel, docs/imu.md) is checked whole first: a missing or
+    // malformed key is refused, named, before anything is drawn or written.
+    if (is_imu_result(result_json)) check_imu_result(result_json, opt->result);
     const std::vector<std::string> sections = report_sections_present(result_json);
     if (sections.empty())
       throw Error(fmt::format(
@@ -118,10 +119,12 @@ void register_report(CLI::App& app) {
     // A report is derived from its result and cheap to write again: an earlier report is replaced,
     // any other existing file only with --force (docs/report.md).
     write_output(opt->html, html, OutputKind::kReport, opt->force, "--html");
-    say_written(opt->html,
-                fmt::format("wrote {}: the {} report of {} ({} sections)\n",
-                            opt->html == "-" ? "standard output" : opt->html,
-                            kind == "montecarlo" ? "Monte Carlo" : kind, opt->result, sections.size()));
+    say_written(opt->html, fmt::format("wrote {}: the {} report of {} ({} sections)\n",
+                                       opt->html == "-" ? "standard output" : opt->html,
+                                       is_imu_result(result_json) ? "IMU " + kind
+                                       : kind == "montecarlo"     ? std::string("Monte Carlo")
+                                                                  : kind,
+                                       opt->result, sections.size()));
   });
 }
 

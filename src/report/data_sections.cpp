@@ -146,13 +146,18 @@ void data_quality(const json& result, Page&, std::string& out) {
   if (find(q, "encoder_glitch_rows"))
     rows.push_back({text_cell("rows dropped inside dwells: their encoders left the line"),
                     num_cell(num(number(q, "encoder_glitch_rows", "data_quality"), 15))});
+  if (find(q, "increments_dropped"))
+    rows.push_back(
+        {text_cell("rows left out of dwells: their increment's interval is unknown (after a gap, a lost "
+                   "row, or the record's first row)"),
+         num_cell(num(number(q, "increments_dropped", "data_quality"), 15))});
   if (read && used && *read > 0)
     rows.push_back(
         {text_cell("share of the rows used"), num_cell(fmt::format("{:.1f} %", 100.0 * *used / *read))});
   // Fields a later gyrocal may add: shown as they are.
   for (const auto& [key, v] : q.items()) {
     if (key == "rows_read" || key == "rows_used" || key == "outliers" || key == "gaps" || key == "dwells" ||
-        key == "rejected" || key == "encoder_glitch_rows")
+        key == "rejected" || key == "encoder_glitch_rows" || key == "increments_dropped")
       continue;
     rows.push_back({text_cell(key), v.is_number() ? num_cell(value_text(v)) : text_cell(value_text(v))});
   }

@@ -363,7 +363,12 @@ void machine_errors(const json& result, Page&, std::string& out) {
     header.insert(header.end(), {"estimate", "standard uncertainty \xCF\x83", kExpandedHeader});
   header.insert(header.end(), extra_fields.begin(), extra_fields.end());
   const bool accelerometer = is_accelerometer(result);
-  out += accelerometer
+  const json* sensor_j = find(result, "sensor");
+  const bool imu = sensor_j && sensor_j->is_string() && sensor_j->get<std::string>() == "imu";
+  out += imu ? "<p class=\"note\">Machine errors shared by every channel, estimated from all the channels' "
+               "data together with their coefficients in one joint fit (--estimate, docs/imu.md); lengths in "
+               "\xC2\xB5m"
+         : accelerometer
              ? "<p class=\"note\">Machine errors estimated from the accelerometer's data together with the "
                "coefficients (--estimate, docs/self_calibration.md); lengths in \xC2\xB5m. The radius is "
                "measured as \xCF\x89\xC2\xB2R/g: it is as right as the local gravity (1 ppm of g is "

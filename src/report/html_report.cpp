@@ -12,6 +12,7 @@
 #include "gyrocal/core/bounded_read.hpp"
 #include "gyrocal/core/error.hpp"
 #include "gyrocal/core/limits.hpp"
+#include "gyrocal/report/imu_report.hpp"
 #include "page.hpp"
 #include "section_renderers.hpp"
 #include "sections.hpp"
@@ -290,6 +291,8 @@ const PageKind* page_of(const nlohmann::json& result) {
 std::string render_html_report(const nlohmann::json& result, const HtmlReportOptions& options) {
   if (!result.is_object())
     throw Error(fmt::format("a result must be a JSON object, not a JSON {}", result.type_name()));
+  // An IMU's result keys its estimates by channel: its own page, checked whole first (imu_report.hpp).
+  if (is_imu_result(result)) return render_imu_html_report(result, options);
   const PageKind* kind = page_of(result);
   if (kind == nullptr)
     throw Error(fmt::format("the output of `gyrocal {}` has no report page", result_kind(result)));
@@ -304,6 +307,7 @@ std::string render_html_report(const nlohmann::json& result, const HtmlReportOpt
 
 std::vector<std::string> report_sections_present(const nlohmann::json& result) {
   if (!result.is_object()) return {};
+  if (is_imu_result(result)) return imu_report_sections(result);
   const PageKind* kind = page_of(result);
   if (kind == nullptr) return {};
   return report::sections_applying(kind->sections(), result);
