@@ -155,9 +155,10 @@ py::tuple exact_inputs_py(const Scenario& scenario, const Column& time_s, double
   return py::make_tuple(omega, force);
 }
 
-/// An IMU's record as `gyrocal simulate` writes it: time_s, the three angles, then every channel's column in
-/// its own units (simulate_written), keyed as its header.
-py::dict simulate_imu_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
+/// The record `gyrocal simulate` writes, keyed as its header: time_s, the three angles, then the output: a
+/// lone sensor's in deg/h (gyro_deg_h) or g (accel_g), an IMU's every channel's column in its own units
+/// (simulate_written).
+py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
   const std::vector<SensorChannel> channels = scenario.channels();
   std::vector<std::vector<double>> columns(4 + channels.size());
   {
@@ -174,31 +175,9 @@ py::dict simulate_imu_py(const Scenario& scenario, std::optional<std::uint64_t> 
   }
   py::dict out;
   for (std::size_t c = 0; c < columns.size(); ++c) {
-    const std::string key = c < 4 ? std::string(kRecordColumns[c]) : channels[c - 4].output.column;
-    out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
-  }
-  return out;
-}
-
-py::dict simulate_py(const Scenario& scenario, std::optional<std::uint64_t> seed) {
-  if (scenario.is_imu()) return simulate_imu_py(scenario, seed);
-  std::vector<double> columns[5];
-  {
-    py::gil_scoped_release release;
-    SimulationOptions options;
-    options.seed = seed;
-    simulate(scenario, options, [&columns](const RecordSample& s) {
-      columns[0].push_back(s.time_s);
-      columns[1].push_back(s.main_angle_deg);
-      columns[2].push_back(s.counter_angle_deg);
-      columns[3].push_back(s.position_angle_deg);
-      columns[4].push_back(s.outputs[0]);
-    });
-  }
-  py::dict out;
-  for (std::size_t c = 0; c < kRecordColumns.size(); ++c) {
-    // The output keyed by the sensor's own column (gyro_deg_h, or accel_g in g), as the record's header.
-    const std::string key(c == 4 ? native_output_column(scenario.sensor_kind) : kRecordColumns[c]);
+    const std::string key = c < 4               ? std::string(kRecordColumns[c])
+                            : scenario.is_imu() ? channels[c - 4].output.column
+                                                : std::string(native_output_column(scenario.sensor_kind));
     out[py::str(key)] = py::array_t<double>(static_cast<py::ssize_t>(columns[c].size()), columns[c].data());
   }
   return out;

@@ -12,11 +12,11 @@
 namespace gyrocal::identify_detail {
 /// A sensor's dwells whose model terms follow the measured motion (PositionModelTerms::sensor_periods), with
 /// their covariance's level measured from the scatter between revolutions of the output minus the model
-/// (docs/accelerometer.md, "The drive's ripple"): a drive's ripple moves an accelerometer's centripetal input
-/// from one revolution to the next by far more than its noise, and that motion is in the model. The model
-/// is the design rows at the products of a first least squares on the output's own levels (the estimate is
-/// that scatter's weights' only use; the machine errors a self-calibration estimates change the model by
-/// far less between revolutions and are left out). nullopt when no dwell follows.
+/// (docs/accelerometer_internals.md, "The drive's ripple"): a drive's ripple moves an accelerometer's
+/// centripetal input from one revolution to the next by far more than its noise, and that motion is in the
+/// model. The model is the design rows at the products of a first least squares on the output's own levels
+/// (the estimate is that scatter's weights' only use; the machine errors a self-calibration estimates change
+/// the model by far less between revolutions and are left out). nullopt when no dwell follows.
 std::optional<Reduction> residual_levels(const Reduction& reduction,
                                          const std::vector<PositionModelTerms>& model_terms,
                                          const CentrifugeModel& model, const CalibrationOptions& options) {
