@@ -14,6 +14,7 @@
 #include <functional>
 #include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -358,6 +359,26 @@ TEST_F(ImuReport, ChromiumDrawsThePageWithoutError) {
 
 // `demo --sensor imu` writes report.html beside record.csv and result.json: the page of its result, each
 // channel's truth beside its estimates (the truth's cell as the result's `truth` states it).
+// An IMU's sensitivity study and Monte Carlo have no page yet: a lone sensor's page would misread their
+// per-channel shapes (it once wrote one with a section that "could not be read"), so each is refused, named,
+// and nothing is written.
+TEST_F(ImuReport, AnImusSensitivityStudyOrMonteCarloIsRefusedNotDrawnHalf) {
+  const std::vector<std::pair<std::string, std::string>> studies = {
+      {"sensitivity study",
+       "sensitivity --config " + at(dir_, "short.toml") + " --json " + at(dir_, "s.json")},
+      {"Monte Carlo", "montecarlo --samples --trials 2 --config " + at(dir_, "short.toml") + " --json " +
+                          at(dir_, "s.json")}};
+  for (const auto& [what, command] : studies) {
+    const auto made = run_cli(command + " --force", dir_);
+    ASSERT_EQ(made.status, 0) << made.err;
+    const auto rep = run_cli("report " + at(dir_, "s.json") + " --html " + at(dir_, "s.html"), dir_);
+    EXPECT_EQ(rep.status, 1) << what;
+    EXPECT_NE(rep.err.find("is an IMU's " + what + ", which report does not draw yet"), std::string::npos)
+        << rep.err;
+    EXPECT_FALSE(fs::exists(dir_ / "s.html")) << what;
+  }
+}
+
 TEST(ImuReportDemo, TheDemoWritesThePage) {
   const fs::path dir = test::fresh_test_folder("imu-report-demo");
   const auto o = run_cli("demo --sensor imu --out " + at(dir, "demo"), dir);

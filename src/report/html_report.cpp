@@ -293,6 +293,16 @@ std::string render_html_report(const nlohmann::json& result, const HtmlReportOpt
     throw Error(fmt::format("a result must be a JSON object, not a JSON {}", result.type_name()));
   // An IMU's result keys its estimates by channel: its own page, checked whole first (imu_report.hpp).
   if (is_imu_result(result)) return render_imu_html_report(result, options);
+  // An IMU's sensitivity study and Monte Carlo hold every channel's figures in shapes of their own, which a
+  // lone sensor's page would misread (a section "could not be read"): refused, not drawn half.
+  if (const auto sensor = result.find("sensor"); sensor != result.end() && *sensor == "imu")
+    throw Error(fmt::format(
+        "{}is an IMU's {}, which report does not draw yet (its JSON holds every channel's figures); report "
+        "draws an IMU's calibration and plan (docs/imu.md, \"What serves an IMU\")",
+        options.source.empty() ? std::string() : options.source + " ",
+        result_kind(result) == "montecarlo"    ? std::string("Monte Carlo")
+        : result_kind(result) == "sensitivity" ? std::string("sensitivity study")
+                                               : result_kind(result)));
   const PageKind* kind = page_of(result);
   if (kind == nullptr)
     throw Error(fmt::format("the output of `gyrocal {}` has no report page", result_kind(result)));
