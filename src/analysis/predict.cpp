@@ -647,12 +647,8 @@ CalibrationResult predict_sensor_calibration(const Scenario& s, const Calibratio
       reduce_sensor_model_terms(r, model, options.reduce, channel);
   const Accelerometer& a = std::get<Accelerometer>(sensor);
   const Eigen::VectorXd u = a.products();
-  for (std::size_t i = 0; i < r.positions.size(); ++i) {
-    const DesignRow& row = model_terms[i].sensor_exact;
-    double e = row.known;
-    for (std::size_t k = 0; k < row.size; ++k) e += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
-    r.positions[i].mean = e;
-  }
+  for (std::size_t i = 0; i < r.positions.size(); ++i)
+    r.positions[i].mean = design_output(model_terms[i].sensor_exact, u);
   // The noise as the simulator draws it, in output units (analysis/estimates.hpp output_noise); its
   // covariance through the reduction in closed form as the gyro's (coloured_noise_position_covariance).
   const GyroNoise noise = output_noise(s);

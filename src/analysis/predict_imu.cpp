@@ -30,7 +30,7 @@ Eigen::VectorXd true_products(const Sensor& sensor) {
 GyroNoise channel_output_noise(const Sensor& sensor) {
   if (const auto* g = std::get_if<Gyro>(&sensor)) return g->noise;
   // As the simulator draws it (simulate/accelerometer_noise.hpp): the generators in ug referred to the input,
-  // times K1 x 1e-6 in output units (analysis/estimates.hpp output_noise, for a lone accelerometer).
+  // times K1 x 1e-6 in output units (a lone accelerometer's too: analysis/estimates.hpp output_noise).
   const Accelerometer& a = std::get<Accelerometer>(sensor);
   GyroNoise n = accelerometer_noise_as_generator_parameters(a.noise);
   const double scale = 1e-6 * std::abs(a.coefficients[AccelCoefficient::K1]);
@@ -53,12 +53,8 @@ std::vector<Reduction> planned_imu_reductions(const Scenario& s, const Centrifug
     const std::vector<PositionModelTerms> terms =
         reduce_sensor_model_terms(r, truth, reduce, c, kMaxModelSamplesPerDwell);
     const Eigen::VectorXd u = true_products(c.sensor);
-    for (std::size_t i = 0; i < r.positions.size(); ++i) {
-      const DesignRow& row = terms[i].sensor_exact;
-      double v = row.known;
-      for (std::size_t k = 0; k < row.size; ++k) v += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
-      r.positions[i].mean = v;
-    }
+    for (std::size_t i = 0; i < r.positions.size(); ++i)
+      r.positions[i].mean = design_output(terms[i].sensor_exact, u);
     set_predicted_std_errors(r, channel_output_noise(c.sensor), s.test.sample_rate_hz, reduce);
     reductions.push_back(std::move(r));
   }

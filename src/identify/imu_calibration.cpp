@@ -126,13 +126,6 @@ struct ChannelProblem {
   WeightedPositions weighted;             ///< its positions, weighted by its own levels
 };
 
-/// The reduced model output of one position at products u: known + sum_j u_j r_j.
-double model_output(const DesignRow& row, const Eigen::VectorXd& u) {
-  double v = row.known;
-  for (std::size_t j = 0; j < row.size; ++j) v += u[static_cast<Eigen::Index>(j)] * row.regressors[j];
-  return v;
-}
-
 /// How one channel's reduced design rows move with each estimated error: per error, per position, the
 /// forward difference of the known part and of each regressor from `at` (the rows at the configured
 /// machine, already reduced for the first step), with the error's typical magnitude as the step, per unit of
@@ -180,7 +173,7 @@ Eigen::MatrixXd error_columns(const RowDerivatives& d, const Eigen::VectorXd& u,
   Eigen::MatrixXd out(m, static_cast<Eigen::Index>(d.per_error.size()));
   for (std::size_t a = 0; a < d.per_error.size(); ++a)
     for (Eigen::Index i = 0; i < m; ++i)
-      out(i, static_cast<Eigen::Index>(a)) = model_output(d.per_error[a][static_cast<std::size_t>(i)], u);
+      out(i, static_cast<Eigen::Index>(a)) = design_output(d.per_error[a][static_cast<std::size_t>(i)], u);
   return out;
 }
 

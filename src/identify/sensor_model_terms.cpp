@@ -31,6 +31,12 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order) {
   return out;
 }
 
+double design_output(const DesignRow& row, const Eigen::VectorXd& u) {
+  double v = row.known;
+  for (std::size_t k = 0; k < row.size; ++k) v += row.regressors[k] * u[static_cast<Eigen::Index>(k)];
+  return v;
+}
+
 SensorKind reduction_kind(const std::vector<SensorChannel>& channels) {
   const bool any_accelerometer = std::any_of(channels.begin(), channels.end(), [](const SensorChannel& c) {
     return kind_of(c.sensor) == SensorKind::kAccelerometer;

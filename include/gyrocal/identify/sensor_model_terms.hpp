@@ -26,6 +26,10 @@ std::vector<double> harmonic_content_gammas_rad(int harmonic_order);
 /// spinning dwell reduced to harmonic_content_gammas_rad (TestSpec::spinning_gamma_rad) whatever [test]
 /// gamma_deg lists, since values at the seed's four gammas fold the third harmonic onto the first and lose
 /// K3 and the radius (docs/accelerometer.md). Static holds keep gamma_deg.
+/// A design row's output at products u (the sensor's design-row order and units): known + sum_j u_j r_j, in
+/// the output's unit. u holds at least row.size products.
+double design_output(const DesignRow& row, const Eigen::VectorXd& u);
+
 /// The sensor whose reduction a record of `channels` takes (reduction_plan's `sensor`): a lone sensor's own;
 /// an IMU's an accelerometer's (a spinning dwell to the harmonic content of a revolution: its K3 and the
 /// radius need it) when any channel is one, a gyro's reduction serving at any gamma, else a gyro's.
