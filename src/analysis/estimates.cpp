@@ -5,10 +5,10 @@
 #include <utility>
 
 #include "gyrocal/analysis/predict.hpp"
+#include "gyrocal/analysis/predict_imu.hpp"
 #include "gyrocal/identify/sensor_model_terms.hpp"
 #include "gyrocal/identify/unknowns.hpp"
 #include "gyrocal/plan/positions.hpp"
-#include "gyrocal/simulate/accelerometer_noise.hpp"
 
 namespace gyrocal {
 
@@ -53,15 +53,9 @@ std::vector<FlatEstimate> flatten_estimates(const CalibrationResult& r, const Sc
 }
 
 GyroNoise output_noise(const Scenario& s) {
+  // A lone gyro's [gyro.noise]; a lone accelerometer's as an IMU channel's (analysis/predict_imu.hpp).
   if (s.sensor_kind == SensorKind::kGyro) return s.noise;
-  // As the simulator draws it (simulate/accelerometer_noise.hpp): the gyro's generators in ug referred to the
-  // input, times K1 x 1e-6 in output units.
-  GyroNoise g = accelerometer_noise_as_generator_parameters(s.accelerometer.noise);
-  const double scale = 1e-6 * std::abs(s.accelerometer.coefficients[AccelCoefficient::K1]);
-  g.angle_random_walk_deg_rt_h *= scale;
-  g.bias_instability_deg_h *= scale;
-  g.quantization_deg_h *= scale;
-  return g;
+  return channel_output_noise(Sensor{s.accelerometer});
 }
 
 PlannedSensorTest planned_sensor_test(const Scenario& s, const CentrifugeModel& told,
