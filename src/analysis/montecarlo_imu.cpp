@@ -102,10 +102,8 @@ ImuMonteCarloResult monte_carlo_imu(const Scenario& scenario, const MonteCarloOp
         "estimate each trial (docs/imu.md).");
   const CalibrationOptions& calibration = options.calibration;
 
-  // The configured unit, every gyro channel on the chosen gyro model.
-  Scenario configured = scenario;
-  for (SensorChannel& c : configured.imu_channels)
-    if (auto* g = std::get_if<Gyro>(&c.sensor)) g->model = calibration.gyro_model;
+  // The configured unit (identify_imu fits every gyro channel on calibration.gyro_model).
+  const Scenario& configured = scenario;
   const std::vector<SensorChannel> channels = configured.channels();
   const CentrifugeModel told = configured.model();
 
